@@ -1,0 +1,75 @@
+/* Uniform-grid neighbour search. A dense grid over the scene domain; particles are sorted by
+ * cell (counting sort, row-major cell order, x fastest) and the particle arrays permuted into
+ * that order, so that the three cells of a row along x form one contiguous index range: a
+ * neighbour query is 3 ranges in 2D and 9 in 3D, walked in memory order. The cell size is the
+ * largest radius in use (k*h with pairwise forces), so both h and k*h queries use one grid;
+ * callers filter by distance. */
+#ifndef PFSPH_GRID_H
+#define PFSPH_GRID_H
+
+#include "pfsph/particles.h"
+
+typedef struct pfsph_grid {
+    int dim;
+    pfsph_real lo[3], hi[3]; /* domain [m]; particles outside are removed by sort */
+    pfsph_real cell, inv_cell;
+    int nc[3];          /* cells per axis (nc[2] == 1 in 2D) */
+    size_t ncells;
+    uint32_t *start;    /* ncells + 1 entries: cell c holds [start[c], start[c+1]) */
+    uint32_t *key;      /* scratch, per particle */
+    uint32_t *perm;     /* scratch, per particle */
+    void *tmp;          /* scratch for the permutation */
+    size_t cap;
+} pfsph_grid;
+
+typedef struct pfsph_ranges {
+    uint32_t b[9], e[9];
+    int n;
+} pfsph_ranges;
+
+/* Grid over [lo, hi] with cells of edge `cell`. */
+int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_real hi[3],
+                    pfsph_real cell);
+void pfsph_grid_free(pfsph_grid *g);
+
+/* Remove particles outside the domain (or with non-finite positions; count added to *removed
+ * if not NULL), sort the rest by cell and fill g->start. Deterministic for any thread count. */
+int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed);
+
+/* Index ranges (into the sorted set) of the cells around a point; the union covers every
+ * particle within distance g->cell of (x, y, z). The point may lie outside the domain. */
+static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_real y,
+                                     pfsph_real z, pfsph_ranges *r)
+{
+    int c[3];
+    const pfsph_real p[3] = {x, y, z};
+    for (int a = 0; a < 3; a++) {
+        pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
+        c[a] = t < 0 ? -1 : (t >= (pfsph_real)g->nc[a] ? g->nc[a] : (int)t);
+    }
+    r->n = 0;
+    int x0 = c[0] - 1 < 0 ? 0 : c[0] - 1;
+    int x1 = c[0] + 1 >= g->nc[0] ? g->nc[0] - 1 : c[0] + 1;
+    if (x0 > x1) return;
+    int zlo = g->dim == 3 ? c[2] - 1 : 0, zhi = g->dim == 3 ? c[2] + 1 : 0;
+    for (int cz = zlo; cz <= zhi; cz++) {
+        if (cz < 0 || cz >= g->nc[2]) continue;
+        for (int cy = c[1] - 1; cy <= c[1] + 1; cy++) {
+            if (cy < 0 || cy >= g->nc[1]) continue;
+            size_t row = ((size_t)cz * (size_t)g->nc[1] + (size_t)cy) * (size_t)g->nc[0];
+            uint32_t b = g->start[row + (size_t)x0], e = g->start[row + (size_t)x1 + 1];
+            if (b < e) {
+                r->b[r->n] = b;
+                r->e[r->n] = e;
+                r->n++;
+            }
+        }
+    }
+}
+
+/* Test oracle: indices j != i of ps with |x_i - x_j| < radius, ascending; returns the count
+ * (writes at most max). O(n). */
+size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real radius,
+                             uint32_t *out, size_t max);
+
+#endif

@@ -1,0 +1,32 @@
+/* Frame files: VTK XML PolyData (.vtp, binary appended, ParaView) and binary little-endian PLY
+ * (Blender), written atomically (temporary file in the same directory, then rename), and read
+ * back (round-trip tests, the renderer). */
+#ifndef PFSPH_IO_H
+#define PFSPH_IO_H
+
+#include <stdbool.h>
+
+#include "pfsph/particles.h"
+
+/* What to write besides positions, velocities, density, pressure, phase (always written). */
+typedef struct pfsph_io_opts {
+    int dim;              /* 2 or 3: 2D files still carry z = 0 */
+    bool write_id;        /* uint32 "id" */
+    bool write_speed;     /* float "speed" = |v| */
+    const char *aux_name; /* name for the aux field, NULL to skip it (e.g. "volume", "lifetime") */
+    double time;          /* simulated time, stored as field data / comment */
+} pfsph_io_opts;
+
+int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o,
+                    pfsph_error *err);
+int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o,
+                    pfsph_error *err);
+/* Read files written by the functions above into ps (initialised by the callee; free with
+ * pfsph_particles_free). Fields absent from the file are zero. *time may be NULL. */
+int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_error *err);
+int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_error *err);
+
+/* Atomic whole-file write: data goes to "<path>.tmp.<pid>", fsync, rename. */
+int pfsph_write_file_atomic(const char *path, const void *data, size_t len, pfsph_error *err);
+
+#endif

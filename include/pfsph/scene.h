@@ -1,0 +1,131 @@
+/* A scene: everything a JSON scene file describes, validated, in SI units. The loader
+ * (scene.c) fills it; pfsph_sim_create turns it into particles. Documented key by key in
+ * docs/scene-format.md. */
+#ifndef PFSPH_SCENE_H
+#define PFSPH_SCENE_H
+
+#include <stdbool.h>
+
+#include "pfsph/types.h"
+#include "pfsph/pairwise.h"
+#include "pfsph/diffuse.h"
+
+#define PFSPH_MAX_BLOCKS 64
+#define PFSPH_MAX_SOLIDS 64
+#define PFSPH_NAME_LEN 64
+#define PFSPH_PATH_LEN 1024
+
+enum pfsph_solver { PFSPH_SOLVER_WCSPH = 0, PFSPH_SOLVER_PCISPH = 1 };
+enum pfsph_phase_kind { PFSPH_PHASE_FLUID = 0, PFSPH_PHASE_GAS = 1, PFSPH_PHASE_SOLID = 2 };
+enum pfsph_shape {
+    PFSPH_SHAPE_BOX = 0,
+    PFSPH_SHAPE_SPHERE,    /* a disc in 2D */
+    PFSPH_SHAPE_CYLINDER,  /* axis along `axis`; a box-like slab... in 2D a disc */
+    PFSPH_SHAPE_CONTAINER, /* hollow box: walls on all sides, optionally open at the top */
+    PFSPH_SHAPE_PLANE,     /* finite plane patch inside the domain */
+};
+
+typedef struct pfsph_phase {
+    char name[PFSPH_NAME_LEN];
+    int kind;              /* enum pfsph_phase_kind */
+    double rest_density;   /* kg/m^3 */
+    double viscosity;      /* kinematic, m^2/s */
+    float color[3];        /* 0..1 */
+} pfsph_phase;
+
+/* A region of fluid particles. */
+typedef struct pfsph_block {
+    int shape;             /* BOX or SPHERE (or CYLINDER) */
+    int phase;             /* index into scene phases */
+    double min[3], max[3]; /* BOX */
+    double center[3];      /* SPHERE, CYLINDER */
+    double radius;         /* SPHERE, CYLINDER */
+    double height;         /* CYLINDER, along axis */
+    int axis;              /* CYLINDER: 0 x, 1 y, 2 z */
+    double velocity[3];    /* initial velocity, m/s */
+} pfsph_block;
+
+/* A static solid sampled with boundary particles. */
+typedef struct pfsph_solid {
+    int shape;
+    int phase;             /* a phase of kind SOLID (its own pair coefficients) */
+    double min[3], max[3]; /* BOX, CONTAINER */
+    double center[3];      /* SPHERE, CYLINDER; a point on PLANE */
+    double normal[3];      /* PLANE, unit */
+    double radius;         /* SPHERE, CYLINDER */
+    double height;         /* CYLINDER */
+    int axis;              /* CYLINDER */
+    int layers;            /* boundary particle layers, >= 1 */
+    bool open_top;         /* CONTAINER */
+} pfsph_solid;
+
+typedef struct pfsph_output {
+    char dir[PFSPH_PATH_LEN]; /* run directory */
+    bool vtp, ply;            /* formats */
+    bool write_boundary;      /* also write the boundary set */
+    unsigned fields;          /* bitmask of extra fields, see PFSPH_OUT_* */
+    int frame_interval;       /* write every n-th frame (1 = every frame) */
+} pfsph_output;
+
+enum { PFSPH_OUT_ID = 1u << 0, PFSPH_OUT_SPEED = 1u << 1, PFSPH_OUT_ACCEL = 1u << 2 };
+
+typedef struct pfsph_camera {
+    bool set;
+    double eye[3], target[3], up[3];
+    double fov_deg;
+    int width, height;
+    char color_by[PFSPH_NAME_LEN]; /* "phase" or a field name: "speed", "density", "pressure" */
+} pfsph_camera;
+
+typedef struct pfsph_scene {
+    char source[PFSPH_PATH_LEN]; /* file it was read from ("<embedded>" for the default) */
+    char name[PFSPH_NAME_LEN];
+    int dim;                   /* 2 or 3 */
+    double particle_radius;    /* m; spacing = 2 r */
+    double support_factor;     /* h = support_factor * spacing, default 2 */
+    double gravity[3];         /* m/s^2 */
+    double domain_min[3], domain_max[3]; /* particles leaving it are removed */
+    int solver;                /* enum pfsph_solver */
+    /* time stepping */
+    double cfl;                /* dt <= cfl * spacing / vmax */
+    double dt_min, dt_max;     /* s */
+    double end_time;           /* s */
+    double fps;                /* frames per second of output */
+    uint64_t seed;
+    int threads;               /* 0: OpenMP default */
+    /* WCSPH */
+    double sound_speed;        /* m/s; 0 = automatic (10 x estimated max speed) */
+    double gamma;              /* Tait exponent, default 7 */
+    /* PCISPH */
+    double pcisph_tolerance;   /* average relative density error, default 0.005 */
+    int pcisph_min_iter, pcisph_max_iter;
+    /* phases */
+    int nphases;
+    pfsph_phase phases[PFSPH_MAX_PHASES];
+    int nblocks;
+    pfsph_block blocks[PFSPH_MAX_BLOCKS];
+    int nsolids;
+    pfsph_solid solids[PFSPH_MAX_SOLIDS];
+    pfsph_pairwise_params pairwise; /* see pairwise.h */
+    pfsph_diffuse_params diffuse;   /* see diffuse.h */
+    pfsph_output output;
+    pfsph_camera camera;
+} pfsph_scene;
+
+/* Fill s with the defaults of every key (docs/scene-format.md). */
+void pfsph_scene_defaults(pfsph_scene *s);
+
+/* Parse and validate a scene from JSON text. `source` names the file in messages. On error
+ * returns PFSPH_EINPUT and err->msg reads "<source>: <json path>: <reason>". */
+int pfsph_scene_parse(pfsph_scene *s, const char *json, const char *source, pfsph_error *err);
+
+/* Read a file and parse it. */
+int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err);
+
+/* The embedded default scene (a small 3D dam break against an obstacle), as JSON text. */
+const char *pfsph_scene_default_json(void);
+
+/* Index of the phase called name, or -1. */
+int pfsph_scene_phase_index(const pfsph_scene *s, const char *name);
+
+#endif

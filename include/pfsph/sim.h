@@ -1,0 +1,73 @@
+/* The simulation: particle sets, grids, solver state and the time step loop. Stages receive a
+ * pfsph_ctx, the read-mostly view of the current state, so that a stage can be tested alone
+ * on a hand-made particle set. */
+#ifndef PFSPH_SIM_H
+#define PFSPH_SIM_H
+
+#include "pfsph/grid.h"
+#include "pfsph/kernel.h"
+#include "pfsph/particles.h"
+#include "pfsph/scene.h"
+
+/* What every stage may read. Fluid arrays are in grid order (grid sorted this step). */
+typedef struct pfsph_ctx {
+    int dim;
+    pfsph_real spacing;  /* initial particle spacing d = 2 r [m] */
+    pfsph_real h;        /* SPH support radius [m] */
+    pfsph_real V0;       /* rest particle volume d^dim */
+    pfsph_real nd0;      /* rest number density 1 / V0 */
+    pfsph_kernel kern;   /* support h */
+    pfsph_particles *fluid;    /* fluid and gas particles */
+    pfsph_particles *boundary; /* static solid particles; aux = Akinci volume [m^d] */
+    pfsph_grid *grid;          /* fluid grid; cell >= max radius in use */
+    pfsph_grid *bgrid;         /* boundary grid, same geometry */
+    pfsph_real mass[PFSPH_MAX_PHASES];         /* particle mass per phase: rho0 * V0 */
+    pfsph_real rest_density[PFSPH_MAX_PHASES];
+    pfsph_real nu[PFSPH_MAX_PHASES];           /* kinematic viscosity per phase */
+    pfsph_real *ax, *ay, *az; /* per-step non-pressure acceleration of fluid particles */
+    pfsph_real *nd;           /* per-step number density of fluid particles (Eq. 23) */
+    const pfsph_scene *scene;
+    double time, dt;
+    uint64_t step;
+} pfsph_ctx;
+
+enum pfsph_stage {
+    PFSPH_STAGE_GRID, PFSPH_STAGE_DENSITY, PFSPH_STAGE_FORCES, PFSPH_STAGE_PAIRWISE,
+    PFSPH_STAGE_PRESSURE, PFSPH_STAGE_INTEGRATE, PFSPH_STAGE_DIFFUSE, PFSPH_STAGE_OUTPUT,
+    PFSPH_NSTAGES
+};
+extern const char *const pfsph_stage_names[PFSPH_NSTAGES];
+
+typedef struct pfsph_step_stats {
+    double dt;
+    double vmax;            /* m/s */
+    double density_err_avg; /* mean of (rho - rho0) / rho0 over fluid, compressed side only */
+    double density_err_max;
+    double ekin;            /* J */
+    int iterations;         /* PCISPH iterations of the last step */
+} pfsph_step_stats;
+
+typedef struct pfsph_sim pfsph_sim;
+
+/* Build particles from the scene. Scene is copied. */
+int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err);
+void pfsph_sim_destroy(pfsph_sim *sim);
+/* Advance by one time step, never past t_limit. */
+int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err);
+/* Advance to exactly time t. */
+int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err);
+
+double pfsph_sim_time(const pfsph_sim *sim);
+uint64_t pfsph_sim_steps(const pfsph_sim *sim);
+const pfsph_ctx *pfsph_sim_ctx(const pfsph_sim *sim);
+const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim);
+/* Seconds spent per stage so far. */
+const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);
+size_t pfsph_sim_removed(const pfsph_sim *sim);
+/* Diffuse particles (NULL when off). */
+const pfsph_particles *pfsph_sim_diffuse(const pfsph_sim *sim);
+/* Number of particles and bytes a scene would need, without allocating them. */
+int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
+                         size_t *bytes, pfsph_error *err);
+
+#endif

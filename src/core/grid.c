@@ -1,0 +1,126 @@
+/* Counting-sort uniform grid (see grid.h for the layout and why). */
+#include "pfsph/grid.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_real hi[3],
+                    pfsph_real cell)
+{
+    memset(g, 0, sizeof(*g));
+    g->dim = dim;
+    g->cell = cell;
+    g->inv_cell = (pfsph_real)1 / cell;
+    g->ncells = 1;
+    for (int a = 0; a < 3; a++) {
+        g->lo[a] = lo[a];
+        g->hi[a] = hi[a];
+        if (a == 2 && dim == 2) {
+            g->nc[a] = 1;
+            continue;
+        }
+        double n = ceil((double)(hi[a] - lo[a]) / (double)cell);
+        if (n < 1) n = 1;
+        if (n > 1e7) return PFSPH_ENOMEM;
+        g->nc[a] = (int)n;
+        g->ncells *= (size_t)n;
+    }
+    if (g->ncells > ((size_t)1 << 31)) return PFSPH_ENOMEM;
+    g->start = calloc(g->ncells + 1, sizeof(uint32_t));
+    return g->start ? PFSPH_OK : PFSPH_ENOMEM;
+}
+
+void pfsph_grid_free(pfsph_grid *g)
+{
+    if (!g) return;
+    free(g->start);
+    free(g->key);
+    free(g->perm);
+    free(g->tmp);
+    memset(g, 0, sizeof(*g));
+}
+
+static int ensure(pfsph_grid *g, size_t n)
+{
+    if (n <= g->cap) return PFSPH_OK;
+    size_t cap = n + n / 4 + 64;
+    uint32_t *k = realloc(g->key, cap * sizeof(uint32_t));
+    if (!k) return PFSPH_ENOMEM;
+    g->key = k;
+    uint32_t *p = realloc(g->perm, cap * sizeof(uint32_t));
+    if (!p) return PFSPH_ENOMEM;
+    g->perm = p;
+    void *t = realloc(g->tmp, cap * sizeof(pfsph_real));
+    if (!t) return PFSPH_ENOMEM;
+    g->tmp = t;
+    g->cap = cap;
+    return PFSPH_OK;
+}
+
+int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
+{
+    size_t n = ps->n;
+    int rc = ensure(g, n);
+    if (rc) return rc;
+    const uint32_t outside = UINT32_MAX;
+    const pfsph_real *pos[3] = {ps->x, ps->y, ps->z};
+    const int dim = g->dim;
+
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        size_t lin = 0, stride = 1;
+        uint32_t key = 0;
+        for (int a = 0; a < dim; a++) {
+            pfsph_real v = pos[a][i];
+            /* written so that NaN fails the test */
+            if (!(v >= g->lo[a] && v <= g->hi[a])) {
+                key = outside;
+                break;
+            }
+            int c = (int)((v - g->lo[a]) * g->inv_cell);
+            if (c >= g->nc[a]) c = g->nc[a] - 1;
+            lin += (size_t)c * stride;
+            stride *= (size_t)g->nc[a];
+        }
+        if (key != outside) key = (uint32_t)lin;
+        g->key[i] = key;
+    }
+
+    /* Counting sort, stable: the same order for any thread count. */
+    memset(g->start, 0, (g->ncells + 1) * sizeof(uint32_t));
+    size_t kept = 0;
+    for (size_t i = 0; i < n; i++)
+        if (g->key[i] != outside) {
+            g->start[g->key[i] + 1]++;
+            kept++;
+        }
+    for (size_t c = 0; c < g->ncells; c++) g->start[c + 1] += g->start[c];
+    /* use start[c] as the running insertion cursor, then restore */
+    for (size_t i = 0; i < n; i++) {
+        uint32_t k = g->key[i];
+        if (k != outside) g->perm[g->start[k]++] = (uint32_t)i;
+    }
+    for (size_t c = g->ncells; c > 0; c--) g->start[c] = g->start[c - 1];
+    g->start[0] = 0;
+
+    if (removed) *removed += n - kept;
+    return pfsph_particles_permute(ps, g->perm, kept, g->tmp);
+}
+
+size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real radius,
+                             uint32_t *out, size_t max)
+{
+    size_t cnt = 0;
+    double r2 = (double)radius * (double)radius;
+    for (size_t j = 0; j < ps->n; j++) {
+        if (j == i) continue;
+        double dx = (double)ps->x[i] - ps->x[j], dy = (double)ps->y[i] - ps->y[j],
+               dz = (double)ps->z[i] - ps->z[j];
+        if (dx * dx + dy * dy + dz * dz < r2) {
+            if (cnt < max) out[cnt] = (uint32_t)j;
+            cnt++;
+        }
+    }
+    return cnt;
+}

@@ -1,0 +1,99 @@
+/* Structure-of-arrays particle storage: allocation, growth, append and permutation. */
+#include "pfsph/particles.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static void *grow(void *p, size_t old_bytes, size_t new_bytes)
+{
+    unsigned char *q = realloc(p, new_bytes ? new_bytes : 1);
+    if (q && new_bytes > old_bytes) memset(q + old_bytes, 0, new_bytes - old_bytes);
+    return q;
+}
+
+int pfsph_particles_reserve(pfsph_particles *ps, size_t cap)
+{
+    if (cap <= ps->cap) return PFSPH_OK;
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        void *q = grow(ps->f[k], ps->cap * sizeof(pfsph_real), cap * sizeof(pfsph_real));
+        if (!q) return PFSPH_ENOMEM;
+        ps->f[k] = q;
+    }
+    void *q = grow(ps->phase, ps->cap, cap);
+    if (!q) return PFSPH_ENOMEM;
+    ps->phase = q;
+    q = grow(ps->id, ps->cap * sizeof(uint32_t), cap * sizeof(uint32_t));
+    if (!q) return PFSPH_ENOMEM;
+    ps->id = q;
+    ps->cap = cap;
+    return PFSPH_OK;
+}
+
+int pfsph_particles_init(pfsph_particles *ps, size_t cap)
+{
+    memset(ps, 0, sizeof(*ps));
+    return pfsph_particles_reserve(ps, cap);
+}
+
+void pfsph_particles_free(pfsph_particles *ps)
+{
+    if (!ps) return;
+    for (int k = 0; k < PFSPH_NFIELDS; k++) free(ps->f[k]);
+    free(ps->phase);
+    free(ps->id);
+    memset(ps, 0, sizeof(*ps));
+}
+
+long pfsph_particles_push(pfsph_particles *ps, const pfsph_real x[3], const pfsph_real v[3],
+                          uint8_t phase)
+{
+    if (ps->n == ps->cap) {
+        size_t cap = ps->cap ? ps->cap * 2 : 1024;
+        if (pfsph_particles_reserve(ps, cap) != PFSPH_OK) return -1;
+    }
+    size_t i = ps->n++;
+    for (int k = 0; k < PFSPH_NFIELDS; k++) ps->f[k][i] = 0;
+    ps->x[i] = x[0];
+    ps->y[i] = x[1];
+    ps->z[i] = x[2];
+    if (v) {
+        ps->vx[i] = v[0];
+        ps->vy[i] = v[1];
+        ps->vz[i] = v[2];
+    }
+    ps->phase[i] = phase;
+    ps->id[i] = ps->next_id++;
+    return (long)i;
+}
+
+int pfsph_particles_permute(pfsph_particles *ps, const uint32_t *perm, size_t n_new, void *tmp)
+{
+    void *own = NULL;
+    size_t n = ps->n > n_new ? ps->n : n_new;
+    if (!tmp) {
+        own = malloc((n ? n : 1) * sizeof(pfsph_real));
+        if (!own) return PFSPH_ENOMEM;
+        tmp = own;
+    }
+    pfsph_real *t = tmp;
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        pfsph_real *a = ps->f[k];
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n_new; i++) t[i] = a[perm[i]];
+        memcpy(a, t, n_new * sizeof(pfsph_real));
+    }
+    uint32_t *tu = tmp;
+    for (size_t i = 0; i < n_new; i++) tu[i] = ps->id[perm[i]];
+    memcpy(ps->id, tu, n_new * sizeof(uint32_t));
+    uint8_t *tb = tmp;
+    for (size_t i = 0; i < n_new; i++) tb[i] = ps->phase[perm[i]];
+    memcpy(ps->phase, tb, n_new);
+    ps->n = n_new;
+    free(own);
+    return PFSPH_OK;
+}
+
+size_t pfsph_particles_bytes_per_particle(void)
+{
+    return PFSPH_NFIELDS * sizeof(pfsph_real) + sizeof(uint8_t) + sizeof(uint32_t);
+}
