@@ -11,7 +11,9 @@
 
 typedef struct pfsph_grid {
     int dim;
-    pfsph_real lo[3], hi[3]; /* domain [m]; particles outside are removed by sort */
+    pfsph_real lo[3], hi[3]; /* extent of the cells [m] */
+    pfsph_real keep_lo[3], keep_hi[3]; /* particles outside this box are removed by sort
+                                        * (defaults to the cell extent) */
     pfsph_real cell, inv_cell;
     int nc[3];          /* cells per axis (nc[2] == 1 in 2D) */
     size_t ncells;

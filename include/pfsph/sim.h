@@ -64,6 +64,10 @@ const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim);
 /* Seconds spent per stage so far. */
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);
 size_t pfsph_sim_removed(const pfsph_sim *sim);
+/* Account time spent outside the step (output) to a stage. */
+void pfsph_sim_add_stage_time(pfsph_sim *sim, int stage, double seconds);
+/* Speed of sound used by WCSPH (scene value or the automatic one) [m/s]. */
+double pfsph_sim_sound_speed(const pfsph_sim *sim);
 /* Diffuse particles (NULL when off). */
 const pfsph_particles *pfsph_sim_diffuse(const pfsph_sim *sim);
 /* Number of particles and bytes a scene would need, without allocating them. */

@@ -2,6 +2,7 @@
 #ifndef PFSPH_TYPES_H
 #define PFSPH_TYPES_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -10,9 +11,11 @@
 #ifdef PFSPH_DOUBLE
 typedef double pfsph_real;
 #define PFSPH_REAL_NAME "double"
+#define pfsph_sqrt sqrt
 #else
 typedef float pfsph_real;
 #define PFSPH_REAL_NAME "float"
+#define pfsph_sqrt sqrtf
 #endif
 
 #define PFSPH_MAX_PHASES 16

@@ -16,6 +16,8 @@ int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_
     for (int a = 0; a < 3; a++) {
         g->lo[a] = lo[a];
         g->hi[a] = hi[a];
+        g->keep_lo[a] = lo[a];
+        g->keep_hi[a] = hi[a];
         if (a == 2 && dim == 2) {
             g->nc[a] = 1;
             continue;
@@ -74,7 +76,7 @@ int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
         for (int a = 0; a < dim; a++) {
             pfsph_real v = pos[a][i];
             /* written so that NaN fails the test */
-            if (!(v >= g->lo[a] && v <= g->hi[a])) {
+            if (!(v >= g->keep_lo[a] && v <= g->keep_hi[a] && v >= g->lo[a] && v <= g->hi[a])) {
                 key = outside;
                 break;
             }

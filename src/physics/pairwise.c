@@ -1,14 +1,435 @@
-/* Pairwise interaction forces (placeholder until the module lands). */
+/* Pairwise interaction forces of PF-SPH (Yang et al.): cosine pair force over k*h (Eqs. 3, 5, 6),
+ * the anisotropic filter T_i (Eqs. 7-12), and the parameters: lambda of Eq. 13 for the cosine
+ * force, surface tension and contact angle targets (Eqs. 13-16, 21), the `pfsph check` report.
+ * Derivations: docs/pairwise.md. */
 #include "pfsph/pairwise.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "pfsph/eigen.h"
+#include "pfsph/scene.h"
+#include "pfsph/sim.h"
+
+static const double PI = 3.14159265358979323846;
+
+struct pfsph_pairwise {
+    int dim;
+    double R; /* k h */
+};
+
+double pfsph_pairwise_shape(double r, double R)
+{
+    if (r > R) return 0.0;
+    return cos(1.5 * PI * r / R); /* Eq. 6 */
+}
+
+void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, double eps_min,
+                                  double T[3][3])
+{
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) T[a][b] = a == b ? 1.0 : 0.0;
+    if (!(eta > 0)) return;
+    double w[3] = {0, 0, 0}, v[3][3] = {{0}};
+    if (dim == 2) {
+        const double c2[2][2] = {{C[0][0], C[0][1]}, {C[0][1], C[1][1]}};
+        double w2[2], v2[2][2];
+        pfsph_eigen_sym2(c2, w2, v2);
+        w[0] = w2[0];
+        w[1] = w2[1];
+        for (int a = 0; a < 2; a++)
+            for (int b = 0; b < 2; b++) v[a][b] = v2[a][b];
+    } else {
+        pfsph_eigen_sym3(C, w, v);
+    }
+    if (!(w[0] > 0)) return; /* no neighbours: nothing to be anisotropic about */
+    /* Eqs. 8-9: eigenvalues normalised by the largest (NOTES item 4), clamped below. */
+    double floor_ = eps_min > 1e-12 ? eps_min : 1e-12;
+    double e[3];
+    for (int k = 0; k < dim; k++) {
+        double t = w[k] / w[0];
+        e[k] = t > floor_ ? t : floor_;
+    }
+    /* Eqs. 10-11: G = R diag(1/e) R^T; its spectral norm is 1/e_min, so G/|G| has eigenvalues
+     * e_min/e_k in (0, 1] and is the identity for an isotropic C (NOTES item 3). */
+    double emin = e[dim - 1];
+    for (int k = 0; k < dim; k++)
+        if (e[k] < emin) emin = e[k];
+    for (int a = 0; a < dim; a++)
+        for (int b = 0; b < dim; b++) {
+            double g = 0;
+            for (int k = 0; k < dim; k++) g += v[a][k] * v[b][k] * (emin / e[k]);
+            T[a][b] = (a == b ? 1.0 - eta : 0.0) + eta * g;
+        }
+}
+
+int pfsph_pairwise_create(pfsph_pairwise **out, const pfsph_ctx *ctx, pfsph_error *err)
+{
+    *out = NULL;
+    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    double R = pp->k * (double)ctx->h;
+    if (ctx->grid && (double)ctx->grid->cell < R * (1.0 - 1e-6))
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "pairwise: grid cell %g m is smaller than the pair force radius k*h = "
+                          "%g m (size cells with pfsph_pairwise_radius)",
+                          (double)ctx->grid->cell, R);
+    pfsph_pairwise *pw = calloc(1, sizeof(*pw));
+    if (!pw) return pfsph_fail(err, PFSPH_ENOMEM, "pairwise: out of memory");
+    pw->dim = ctx->dim;
+    pw->R = R;
+    *out = pw;
+    return PFSPH_OK;
+}
+
+void pfsph_pairwise_destroy(pfsph_pairwise *pw) { free(pw); }
+
+/* Constants of one apply call, shared by all particles. */
+typedef struct pw_job {
+    const pfsph_ctx *ctx;
+    double coef[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES]; /* c[a][b] m_b: acceleration per unit f */
+    pfsph_real R, R2;
+    double U_R;      /* 3 pi / (2 R) */
+    pfsph_kernel kk; /* cubic spline with support k h, for Eq. 7 (NOTES item 2) */
+    bool filter;
+    double eta, eps_min;
+    int center;
+} pw_job;
+
+static void job_init(pw_job *J, const pfsph_ctx *ctx)
+{
+    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    J->ctx = ctx;
+    for (int a = 0; a < PFSPH_MAX_PHASES; a++)
+        for (int b = 0; b < PFSPH_MAX_PHASES; b++)
+            J->coef[a][b] = pp->c[a][b] * (double)ctx->mass[b];
+    double R = pp->k * (double)ctx->h;
+    J->R = (pfsph_real)R;
+    J->R2 = (pfsph_real)(R * R);
+    J->U_R = 1.5 * PI / R;
+    pfsph_kernel_init(&J->kk, ctx->dim, (pfsph_real)R);
+    J->filter = pp->filter && pp->eta > 0;
+    J->eta = pp->eta;
+    J->eps_min = pp->eps_min;
+    J->center = pp->center;
+}
+
+/* Sums over one particle set for fluid particle i at (xi, yi, zi) of phase pa. acc gets
+ * sum_j c m_j f(r) r_ij / r (Eq. 3 divided by m_i); S (if want_vir) gets sum_j of the same
+ * scalar times r_ij r_ij^T; the covariance sums (if J->filter) get w, w d, w d d^T with
+ * d = x_j - x_i (Eq. 7). */
+static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g,
+                           size_t self, pfsph_real xi, pfsph_real yi, pfsph_real zi, int pa,
+                           double acc[3], bool want_vir, double S[6], double *sw, double sx[3],
+                           double sxx[6])
+{
+    pfsph_ranges rg;
+    pfsph_grid_ranges(g, xi, yi, zi, &rg);
+    const double *coef = J->coef[pa];
+    for (int q = 0; q < rg.n; q++)
+        for (uint32_t j = rg.b[q]; j < rg.e[q]; j++) {
+            if ((size_t)j == self) continue;
+            pfsph_real dx = xi - ps->x[j], dy = yi - ps->y[j], dz = zi - ps->z[j];
+            pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+            if (r2 >= J->R2 || r2 <= 0) continue; /* r = 0: no direction, no force */
+            double r = sqrt((double)r2);
+            double cf = coef[ps->phase[j]];
+            if (cf != 0.0) {
+                /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0). */
+                double s = cf * cos(J->U_R * r) / r;
+                acc[0] += s * dx;
+                acc[1] += s * dy;
+                acc[2] += s * dz;
+                if (want_vir) {
+                    S[0] += s * dx * dx;
+                    S[1] += s * dx * dy;
+                    S[2] += s * dx * dz;
+                    S[3] += s * dy * dy;
+                    S[4] += s * dy * dz;
+                    S[5] += s * dz * dz;
+                }
+            }
+            if (J->filter) {
+                double w = (double)pfsph_kernel_w(&J->kk, (pfsph_real)r);
+                double d0 = -(double)dx, d1 = -(double)dy, d2 = -(double)dz;
+                *sw += w;
+                sx[0] += w * d0;
+                sx[1] += w * d1;
+                sx[2] += w * d2;
+                sxx[0] += w * d0 * d0;
+                sxx[1] += w * d0 * d1;
+                sxx[2] += w * d0 * d2;
+                sxx[3] += w * d1 * d1;
+                sxx[4] += w * d1 * d2;
+                sxx[5] += w * d2 * d2;
+            }
+        }
+}
+
+/* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial and
+ * T_i itself. */
+static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir,
+                            double *vir, double Tout[9])
+{
+    const pfsph_ctx *ctx = J->ctx;
+    const pfsph_particles *f = ctx->fluid;
+    pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+    int pa = f->phase[i];
+    double S[6] = {0, 0, 0, 0, 0, 0};
+    double sw = (double)pfsph_kernel_w0(&J->kk); /* the sum of Eq. 7 includes j = i */
+    double sx[3] = {0, 0, 0}, sxx[6] = {0, 0, 0, 0, 0, 0};
+    acc[0] = acc[1] = acc[2] = 0;
+    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, acc, want_vir, S, &sw, sx, sxx);
+    if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0)
+        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)-1, xi, yi, zi, pa, acc, want_vir, S, &sw,
+                sx, sxx);
+    double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    if (J->filter) {
+        double inv = 1.0 / sw;
+        double C[3][3] = {{sxx[0] * inv, sxx[1] * inv, sxx[2] * inv},
+                          {sxx[1] * inv, sxx[3] * inv, sxx[4] * inv},
+                          {sxx[2] * inv, sxx[4] * inv, sxx[5] * inv}};
+        if (J->center == PFSPH_PW_CENTER_MEAN) {
+            double mu[3] = {sx[0] * inv, sx[1] * inv, sx[2] * inv};
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++) C[a][b] -= mu[a] * mu[b];
+        }
+        pfsph_pairwise_filter_matrix(ctx->dim, C, J->eta, J->eps_min, T);
+        double a0 = T[0][0] * acc[0] + T[0][1] * acc[1] + T[0][2] * acc[2];
+        double a1 = T[1][0] * acc[0] + T[1][1] * acc[1] + T[1][2] * acc[2];
+        double a2 = T[2][0] * acc[0] + T[2][1] * acc[1] + T[2][2] * acc[2];
+        acc[0] = a0; /* Eq. 12 */
+        acc[1] = a1;
+        acc[2] = a2;
+    }
+    if (want_vir) {
+        /* sum_j r_ij . (T f_ji) = m_i tr(T S), S = sum_j s_j r_ij r_ij^T (symmetric). */
+        const double Sm[3][3] = {{S[0], S[1], S[2]}, {S[1], S[3], S[4]}, {S[2], S[4], S[5]}};
+        double tr = 0;
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) tr += T[a][b] * Sm[b][a];
+        *vir = (double)ctx->mass[pa] * tr;
+    }
+    if (Tout)
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) Tout[3 * a + b] = T[a][b];
+}
+
+void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
+{
+    (void)pw;
+    if (!ctx->scene->pairwise.enabled) return;
+    pw_job J;
+    job_init(&J, ctx);
+    const size_t n = ctx->fluid->n;
+    pfsph_real *ax = ctx->ax, *ay = ctx->ay, *az = ctx->az;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (size_t i = 0; i < n; i++) {
+        double acc[3];
+        particle(&J, i, acc, false, NULL, NULL);
+        ax[i] += (pfsph_real)acc[0];
+        ay[i] += (pfsph_real)acc[1];
+        az[i] += (pfsph_real)acc[2];
+    }
+}
+
+void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T)
+{
+    (void)pw;
+    pw_job J;
+    job_init(&J, ctx);
+    if (!ctx->scene->pairwise.enabled)
+        for (int a = 0; a < PFSPH_MAX_PHASES; a++)
+            for (int b = 0; b < PFSPH_MAX_PHASES; b++) J.coef[a][b] = 0;
+    const size_t n = ctx->fluid->n;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (size_t i = 0; i < n; i++) {
+        double acc[3], v = 0;
+        particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL);
+        if (vir) vir[i] = v;
+    }
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Parameters and targets */
 
 void pfsph_pairwise_defaults(pfsph_pairwise_params *p)
 {
     memset(p, 0, sizeof(*p));
-    p->k = cbrt(80.0 / 30.0);
+    p->k = cbrt(80.0 / 30.0); /* Eq. 5 */
     p->filter = true;
     p->eta = 0.2;
     p->eps_min = 0.5;
+    p->center = PFSPH_PW_CENTER_PARTICLE; /* Eq. 7 as written */
+}
+
+double pfsph_pairwise_lambda(int dim, double R)
+{
+    const double U = 1.5 * PI;
+    if (dim == 2) {
+        /* sigma = -(n^2/3) int_0^R r^3 F(r) dr with F = s cos(U r / R). */
+        return R * R * R * R * (U * U * U - 6.0 * U - 6.0) / (3.0 * U * U * U * U);
+    }
+    /* sigma = -(pi n^2/8) int_0^R r^4 F(r) dr (NOTES item 6). */
+    double U2 = U * U;
+    return PI / 8.0 * R * R * R * R * R * (U2 * U2 - 12.0 * U2 + 24.0) / (U2 * U2 * U);
+}
+
+pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h)
+{
+    if (!s->pairwise.enabled) return 0;
+    return (pfsph_real)(s->pairwise.k * (double)h);
+}
+
+static bool is_solid(const pfsph_scene *s, int a) { return s->phases[a].kind == PFSPH_PHASE_SOLID; }
+
+int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfsph_error *err)
+{
+    pfsph_pairwise_params *pp = &s->pairwise;
+    pp->resolved = false;
+    if (!pp->enabled) return PFSPH_OK;
+    if (!(spacing > 0) || !(h > 0) || !(pp->k >= 1.0))
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "pairwise: need spacing > 0, h > 0 and k >= 1 (got %g, %g, %g)",
+                          (double)spacing, (double)h, pp->k);
+    const int np = s->nphases;
+    const double R = pp->k * (double)h;
+    const double lam = pfsph_pairwise_lambda(s->dim, R);
+    double rho[PFSPH_MAX_PHASES];
+    for (int a = 0; a < np; a++) rho[a] = s->phases[a].rest_density;
+
+    /* 1. Cohesion from a surface tension against the (unsimulated) air: Eq. 13 with
+     * c_beta = 0, sigma = lambda c rho^2 (Eq. 14 with n m = rho). */
+    for (int a = 0; a < np; a++) {
+        if (!pp->sigma_set[a][a]) continue;
+        if (is_solid(s, a) || !(rho[a] > 0))
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "pairwise: surface tension target on phase \"%s\" needs a fluid "
+                              "phase with rest_density > 0",
+                              s->phases[a].name);
+        pp->c[a][a] = pp->sigma[a][a] / (lam * rho[a] * rho[a]);
+    }
+    /* 2. Interfacial tension between two fluids: Eq. 13 solved for c_ab. */
+    for (int a = 0; a < np; a++)
+        for (int b = a + 1; b < np; b++) {
+            if (!pp->sigma_set[a][b]) continue;
+            if (is_solid(s, a) || is_solid(s, b) || !(rho[a] > 0) || !(rho[b] > 0))
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "pairwise: surface tension between \"%s\" and \"%s\": both "
+                                  "must be fluid phases with rest_density > 0 (use "
+                                  "contact_angle for a solid)",
+                                  s->phases[a].name, s->phases[b].name);
+            double self = pp->c[a][a] * rho[a] * rho[a] + pp->c[b][b] * rho[b] * rho[b];
+            double cab = (self - pp->sigma[a][b] / lam) / (2.0 * rho[a] * rho[b]);
+            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]))
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
+                                  "more than their cohesions give with c = 0 (at most %g N/m); "
+                                  "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
+                                  pp->sigma[a][b], s->phases[a].name, s->phases[b].name,
+                                  lam * self, s->phases[a].name, s->phases[b].name);
+            pp->c[a][b] = pp->c[b][a] = cab > 0 ? cab : 0.0;
+        }
+    /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. */
+    for (int a = 0; a < np; a++)
+        for (int b = a + 1; b < np; b++) {
+            if (!pp->angle_set[a][b]) continue;
+            int fl = is_solid(s, a) ? b : a, so = is_solid(s, a) ? a : b;
+            if (!is_solid(s, so) || is_solid(s, fl))
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "pairwise: contact angle between \"%s\" and \"%s\" needs one "
+                                  "fluid and one solid phase",
+                                  s->phases[a].name, s->phases[b].name);
+            if (!(pp->c[fl][fl] > 0))
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "pairwise: contact angle of \"%s\" on \"%s\" needs a cohesion "
+                                  "(c or sigma of \"%s\" with itself) > 0 (Eq. 21)",
+                                  s->phases[fl].name, s->phases[so].name, s->phases[fl].name);
+            if (!(rho[so] > 0))
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "pairwise: contact angle on \"%s\" needs its rest_density > 0 "
+                                  "(boundary particle mass)",
+                                  s->phases[so].name);
+            double th = pp->angle_deg[a][b] * PI / 180.0;
+            double cw = 0.5 * (1.0 + cos(th)) * pp->c[fl][fl] * rho[fl] / rho[so];
+            if (cw < 0) cw = 0; /* cos(180 deg) rounding */
+            pp->c[a][b] = pp->c[b][a] = cw;
+        }
+    for (int a = 0; a < np; a++)
+        for (int b = 0; b < np; b++) {
+            if (pp->c[a][b] != pp->c[b][a]) pp->c[b][a] = pp->c[a][b] = 0.5 * (pp->c[a][b] + pp->c[b][a]);
+            if (!isfinite(pp->c[a][b]) || pp->c[a][b] < 0)
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "pairwise: coefficient between \"%s\" and \"%s\" is %g; it "
+                                  "must be finite and >= 0",
+                                  s->phases[a].name, s->phases[b].name, pp->c[a][b]);
+        }
+    pp->radius = R;
+    pp->lambda = lam;
+    pp->resolved = true;
+    return PFSPH_OK;
+}
+
+void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
+{
+    const pfsph_pairwise_params *pp = &s->pairwise;
+    if (!pp->enabled) {
+        fprintf(out, "pairwise forces: off\n");
+        return;
+    }
+    const int np = s->nphases;
+    fprintf(out, "pairwise forces: k = %.4g", pp->k);
+    if (pp->resolved) fprintf(out, ", radius k*h = %.4g m, lambda = %.4g m^%d", pp->radius,
+                              pp->lambda, s->dim + 2);
+    if (pp->filter && pp->eta > 0)
+        fprintf(out, "\n  anisotropic filter on: eta = %g, eps_min = %g, centre = %s\n", pp->eta,
+                pp->eps_min, pp->center == PFSPH_PW_CENTER_MEAN ? "mean" : "particle");
+    else
+        fprintf(out, "\n  anisotropic filter off (momentum conserved exactly)\n");
+    fprintf(out, "  coefficients c[a][b] (%s):\n  %-14s", s->dim == 2 ? "N m/kg^2, 2D" : "N/kg^2",
+            "");
+    for (int b = 0; b < np; b++) fprintf(out, " %12.12s", s->phases[b].name);
+    fprintf(out, "\n");
+    for (int a = 0; a < np; a++) {
+        fprintf(out, "  %-14.14s", s->phases[a].name);
+        for (int b = 0; b < np; b++) fprintf(out, " %12.5g", pp->c[a][b]);
+        fprintf(out, "\n");
+    }
+    for (int a = 0; a < np; a++)
+        for (int b = a; b < np; b++) {
+            if (pp->sigma_set[a][b])
+                fprintf(out, "  target: sigma(%s, %s) = %g N/m -> c = %.6g\n", s->phases[a].name,
+                        s->phases[b].name, pp->sigma[a][b], pp->c[a][b]);
+            if (pp->angle_set[a][b])
+                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (Eq. 21)\n",
+                        s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b]);
+        }
+    if (!pp->resolved) return;
+    double lam = pp->lambda;
+    for (int a = 0; a < np; a++) {
+        if (s->phases[a].kind == PFSPH_PHASE_SOLID) continue;
+        double ra = s->phases[a].rest_density;
+        if (pp->c[a][a] > 0)
+            fprintf(out, "  predicted: sigma(%s, air) = %.5g N/m (Eq. 16 with c_air = 0)\n",
+                    s->phases[a].name, lam * pp->c[a][a] * ra * ra);
+        for (int b = a + 1; b < np; b++) {
+            double rb = s->phases[b].rest_density;
+            if (s->phases[b].kind == PFSPH_PHASE_SOLID) {
+                if (!(pp->c[a][a] > 0) || !(rb > 0)) continue;
+                double cs = 2.0 * pp->c[a][b] * rb / (pp->c[a][a] * ra) - 1.0;
+                const char *note = cs > 1 ? " (complete wetting)" : "";
+                if (cs > 1) cs = 1;
+                if (cs < -1) cs = -1;
+                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (Eq. 21)\n",
+                        s->phases[a].name, s->phases[b].name, acos(cs) * 180.0 / PI, note);
+            } else {
+                double sg = lam * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb -
+                                   2.0 * pp->c[a][b] * ra * rb);
+                if (pp->c[a][a] > 0 || pp->c[b][b] > 0 || pp->c[a][b] > 0)
+                    fprintf(out, "  predicted: sigma(%s, %s) = %.5g N/m (Eq. 13)%s\n",
+                            s->phases[a].name, s->phases[b].name, sg,
+                            sg < 0 ? " -- negative: the fluids mix" : "");
+            }
+        }
+    }
 }

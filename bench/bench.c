@@ -1,0 +1,207 @@
+/* Throughput benchmark: a 3D dam break built in memory with a chosen number of fluid particles,
+ * run for a few steps; prints particle-steps per second, time per stage, neighbour counts and
+ * peak memory per particle. Results are recorded in docs/benchmarks.md. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include <omp.h>
+
+#include "pfsph/grid.h"
+#include "pfsph/scene.h"
+#include "pfsph/sim.h"
+
+static void usage(void)
+{
+    fprintf(stderr,
+            "usage: bench [--particles N] [--steps N] [--warmup N] [--solver wcsph|pcisph]\n"
+            "             [--pairwise] [--threads N]\n"
+            "Runs a 3D dam break of about N fluid particles (default 50000) for --steps steps\n"
+            "(default 20) after --warmup steps (default 3) and prints throughput figures.\n");
+}
+
+/* Mean number of neighbours j != i within h of each fluid particle: fluid ones through the
+ * fluid grid, boundary ones through the boundary grid. Uses the grid of the last step. */
+static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_nb)
+{
+    const pfsph_particles *f = c->fluid, *b = c->boundary;
+    const double h2 = (double)c->h * (double)c->h;
+    long long nf = 0, nb = 0;
+    const long n = (long)f->n;
+#pragma omp parallel for reduction(+ : nf, nb) schedule(static)
+    for (long i = 0; i < n; i++) {
+        pfsph_ranges r;
+        pfsph_grid_ranges(c->grid, f->x[i], f->y[i], f->z[i], &r);
+        for (int k = 0; k < r.n; k++)
+            for (uint32_t j = r.b[k]; j < r.e[k]; j++) {
+                if ((long)j == i) continue;
+                double dx = f->x[i] - f->x[j], dy = f->y[i] - f->y[j], dz = f->z[i] - f->z[j];
+                if (dx * dx + dy * dy + dz * dz < h2) nf++;
+            }
+        if (b && b->n > 0 && c->bgrid) {
+            pfsph_grid_ranges(c->bgrid, f->x[i], f->y[i], f->z[i], &r);
+            for (int k = 0; k < r.n; k++)
+                for (uint32_t j = r.b[k]; j < r.e[k]; j++) {
+                    double dx = f->x[i] - b->x[j], dy = f->y[i] - b->y[j],
+                           dz = f->z[i] - b->z[j];
+                    if (dx * dx + dy * dy + dz * dz < h2) nb++;
+                }
+        }
+    }
+    *fluid_nb = n > 0 ? (double)nf / (double)n : 0;
+    *bnd_nb = n > 0 ? (double)nb / (double)n : 0;
+}
+
+int main(int argc, char **argv)
+{
+    long target = 50000, steps = 20, warmup = 3;
+    int pcisph = 0, pairwise = 0, threads = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--particles") && v) { target = atol(v); i++; }
+        else if (!strcmp(a, "--steps") && v) { steps = atol(v); i++; }
+        else if (!strcmp(a, "--warmup") && v) { warmup = atol(v); i++; }
+        else if (!strcmp(a, "--threads") && v) { threads = atoi(v); i++; }
+        else if (!strcmp(a, "--solver") && v) {
+            if (!strcmp(v, "wcsph")) pcisph = 0;
+            else if (!strcmp(v, "pcisph")) pcisph = 1;
+            else { usage(); return 2; }
+            i++;
+        } else if (!strcmp(a, "--pairwise")) pairwise = 1;
+        else { usage(); return !strcmp(a, "--help") || !strcmp(a, "-h") ? 0 : 2; }
+    }
+    if (target < 100 || steps < 1 || warmup < 0 || threads < 0) { usage(); return 2; }
+
+    /* The block is 3 x 4 x 3 lattice units per unit k (0.45 x 0.6 x 0.45 m as in
+     * scenes/dam_break_3d.json), so n = 36 k^3; the spacing follows from the 0.6 m height.
+     * Extents carry a quarter spacing extra so floor(extent / d) cannot round down. */
+    double k = cbrt((double)target / 36.0);
+    long nx = lround(3 * k), ny = lround(4 * k), nz = lround(3 * k);
+    if (nx < 1) nx = 1;
+    if (nz < 1) nz = 1;
+    if (ny < 1) ny = 1;
+    const double d = 0.6 / (double)ny, r = 0.5 * d;
+    const double bx = ((double)nx + 0.25) * d, by = ((double)ny + 0.25) * d,
+                 bz = ((double)nz + 0.25) * d;
+    const double tx = 1.5 / 0.45 * bx, ty = 1.5 * by, tz = bz; /* tank inner size */
+    const double m = 3.0 * d + 0.05;                           /* room for walls */
+
+    char pair[256] = "";
+    if (pairwise)
+        snprintf(pair, sizeof pair,
+                 ",\n\"pairwise\": {\"coefficients\": [{\"phases\": [\"water\", \"water\"], "
+                 "\"c\": 1000}]}");
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"name\": \"bench\", \"dimension\": 3, \"particle_radius\": %.9g,\n"
+             "\"gravity\": [0, -9.81, 0], \"threads\": %d,\n"
+             "\"domain\": {\"min\": [%.9g, %.9g, %.9g], \"max\": [%.9g, %.9g, %.9g]},\n"
+             "\"solver\": {\"type\": \"%s\", \"tolerance\": 0.005, \"min_iterations\": 3, "
+             "\"max_iterations\": 50},\n"
+             "\"time\": {\"end\": 100, \"cfl\": 0.4, \"dt_max\": 0.004},\n"
+             "\"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, "
+             "\"viscosity\": 1e-3}, {\"name\": \"wall\", \"kind\": \"solid\"}],\n"
+             "\"fluid\": [{\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [%.9g, %.9g, %.9g], "
+             "\"phase\": \"water\"}],\n"
+             "\"solids\": [{\"shape\": \"container\", \"min\": [0, 0, 0], "
+             "\"max\": [%.9g, %.9g, %.9g], \"open_top\": true, \"layers\": 2, "
+             "\"phase\": \"wall\"}],\n"
+             "\"output\": {\"directory\": \"bench_run\", \"formats\": [], \"boundary\": false}"
+             "%s}\n",
+             r, threads, -m, -m, -m, tx + m, ty + m, tz + m, pcisph ? "pcisph" : "wcsph", bx,
+             by, bz, tx, ty, tz, pair);
+
+    static pfsph_scene scene;
+    pfsph_error err = {0};
+    if (pfsph_scene_parse(&scene, json, "<bench>", &err) != PFSPH_OK) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        return 2;
+    }
+    size_t est_f = 0, est_b = 0, est_bytes = 0;
+    if (pfsph_scene_estimate(&scene, &est_f, &est_b, &est_bytes, &err) != PFSPH_OK) est_bytes = 0;
+
+    pfsph_sim *sim = NULL;
+    double t0 = omp_get_wtime();
+    if (pfsph_sim_create(&sim, &scene, &err) != PFSPH_OK) {
+        fprintf(stderr, "bench: %s\n", err.msg);
+        return 1;
+    }
+    double t_create = omp_get_wtime() - t0;
+    const pfsph_ctx *ctx = pfsph_sim_ctx(sim);
+    const size_t n_fluid0 = ctx->fluid->n, n_bnd = ctx->boundary ? ctx->boundary->n : 0;
+
+    printf("pfsph bench: 3D dam break, solver %s%s, %d threads (OMP_WAIT_POLICY=%s)\n",
+           pcisph ? "pcisph" : "wcsph", pairwise ? " + pairwise" : "",
+           threads > 0 ? threads : omp_get_max_threads(),
+           getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
+    printf("  block %ld x %ld x %ld, particle radius %.4g m, h %.4g m, tank %.3f x %.3f x %.3f m\n",
+           nx, ny, nz, r, (double)ctx->h, tx, ty, tz);
+    printf("  fluid particles     %zu\n  boundary particles  %zu\n", n_fluid0, n_bnd);
+    printf("  create              %.3f s (estimate %.1f MB)\n", t_create, (double)est_bytes / 1e6);
+
+    int rc = 0;
+    for (long s = 0; s < warmup && rc == PFSPH_OK; s++) rc = pfsph_sim_step(sim, 1e9, &err);
+    double st0[PFSPH_NSTAGES];
+    memcpy(st0, pfsph_sim_stage_seconds(sim), sizeof st0);
+    const double sim_t0 = pfsph_sim_time(sim);
+    long iters = 0, done = 0;
+    double fluid_steps = 0;
+    t0 = omp_get_wtime();
+    for (long s = 0; s < steps && rc == PFSPH_OK; s++) {
+        size_t nf = ctx->fluid->n;
+        rc = pfsph_sim_step(sim, 1e9, &err);
+        if (rc != PFSPH_OK) break;
+        iters += pfsph_sim_stats(sim)->iterations;
+        fluid_steps += (double)nf;
+        done++;
+    }
+    const double wall = omp_get_wtime() - t0;
+    if (rc != PFSPH_OK)
+        printf("  FAILED at step %llu (t = %.4g s): %s\n",
+               (unsigned long long)pfsph_sim_steps(sim), pfsph_sim_time(sim), err.msg);
+
+    const pfsph_step_stats *st = pfsph_sim_stats(sim);
+    const double rate = wall > 0 ? fluid_steps / wall : 0;
+    printf("  steps               %ld measured after %ld warm-up, %.4f s simulated, last dt %.3g s\n",
+           done, warmup, pfsph_sim_time(sim) - sim_t0, st->dt);
+    printf("  last step           vmax %.3g m/s, density error avg %.3g%% max %.3g%%\n", st->vmax,
+           100 * st->density_err_avg, 100 * st->density_err_max);
+    printf("  wall time           %.3f s (%.2f ms/step)\n", wall, done ? 1e3 * wall / (double)done : 0);
+    printf("  throughput          %.4g fluid particle-steps/s\n", rate);
+
+    double nbf = 0, nbb = 0;
+    count_neighbours(ctx, &nbf, &nbb);
+    printf("  neighbours within h %.1f fluid + %.1f boundary per fluid particle\n", nbf, nbb);
+    const double avg_it = done ? (double)iters / (double)done : 0;
+    if (pcisph) printf("  PCISPH iterations   %.2f per step (average)\n", avg_it);
+
+    const double *st1 = pfsph_sim_stage_seconds(sim);
+    double tot = 0;
+    for (int i = 0; i < PFSPH_NSTAGES; i++) tot += st1[i] - st0[i];
+    printf("  stage        seconds      %%\n");
+    for (int i = 0; i < PFSPH_NSTAGES; i++) {
+        double sec = st1[i] - st0[i];
+        printf("  %-10s %9.4f  %5.1f\n", pfsph_stage_names[i], sec, tot > 0 ? 100 * sec / tot : 0);
+    }
+    printf("  %-10s %9.4f  (wall %.4f)\n", "sum", tot, wall);
+
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    const double rss = (double)ru.ru_maxrss * 1024.0; /* Linux: kilobytes */
+    const double bpp = n_fluid0 ? rss / (double)n_fluid0 : 0;
+    printf("  peak RSS            %.1f MB = %.0f bytes per fluid particle (boundary and process "
+           "included)\n", rss / 1e6, bpp);
+
+    /* One line for grep. */
+    printf("BENCH solver=%s pairwise=%d threads=%d fluid=%zu boundary=%zu steps=%ld wall_s=%.3f "
+           "psteps_per_s=%.4g iters=%.2f nb_fluid=%.1f nb_bnd=%.1f bytes_per_particle=%.0f "
+           "status=%s\n",
+           pcisph ? "pcisph" : "wcsph", pairwise, threads > 0 ? threads : omp_get_max_threads(),
+           n_fluid0, n_bnd, done, wall, rate, avg_it, nbf, nbb, bpp,
+           rc == PFSPH_OK ? "ok" : "failed");
+    pfsph_sim_destroy(sim);
+    return rc == PFSPH_OK ? 0 : 3;
+}

@@ -1,0 +1,15 @@
+/* Eigen-decomposition of small symmetric matrices (2x2 closed form, 3x3 cyclic Jacobi), used by
+ * the anisotropic filter of the pairwise forces (PF Eqs. 8-10). Double precision throughout. */
+#ifndef PFSPH_EIGEN_H
+#define PFSPH_EIGEN_H
+
+/* Symmetric 2x2 matrix a (only a[0][1] of the off-diagonal is read). Eigenvalues in descending
+ * order into w; v[r][c] holds the eigenvector of w[c] in column c (orthonormal, right-handed). */
+void pfsph_eigen_sym2(const double a[2][2], double w[2], double v[2][2]);
+
+/* Symmetric 3x3 matrix a (upper triangle read). Eigenvalues descending into w, eigenvectors as
+ * the columns of v (orthonormal). Returns the number of Jacobi sweeps used (<= 32); the
+ * off-diagonal norm after the last sweep is below 1e-15 of the matrix norm. */
+int pfsph_eigen_sym3(const double a[3][3], double w[3], double v[3][3]);
+
+#endif

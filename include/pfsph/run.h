@@ -1,0 +1,34 @@
+/* Running a scene into a run directory: frames, statistics, summary. The library reports
+ * progress through a callback and never prints. */
+#ifndef PFSPH_RUN_H
+#define PFSPH_RUN_H
+
+#include "pfsph/scene.h"
+
+typedef struct pfsph_progress {
+    int frame, nframes;   /* frames done / total */
+    double time, end_time;
+    uint64_t steps;
+    double wall_s;        /* seconds since the run started */
+    double steps_per_s;
+    size_t n_fluid;
+} pfsph_progress;
+
+typedef void (*pfsph_progress_fn)(const pfsph_progress *p, void *user);
+
+typedef struct pfsph_run_opts {
+    const char *out_dir;    /* NULL: scene->output.dir */
+    double end_time;        /* < 0: scene->end_time */
+    const char *scene_text; /* the scene file's text, saved as RUN/scene.json (NULL: none) */
+    pfsph_progress_fn progress;
+    void *user;
+} pfsph_run_opts;
+
+/* Run the scene. Returns PFSPH_OK, PFSPH_EIO (output directory), PFSPH_EUNSTABLE (blow-up;
+ * frames written so far are kept) or PFSPH_ENOMEM. */
+int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err);
+
+/* mkdir -p; PFSPH_EIO with a message on failure. */
+int pfsph_mkdirs(const char *path, pfsph_error *err);
+
+#endif

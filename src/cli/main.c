@@ -1,0 +1,293 @@
+/* The pfsph program: run, check, render, bench. Parses the command line, prints progress and
+ * errors, maps library status codes to exit statuses (2 bad input, 3 unstable, 1 other). */
+#include <errno.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "pfsph/pairwise.h"
+#include "pfsph/render.h"
+#include "pfsph/run.h"
+#include "pfsph/scene.h"
+#include "pfsph/sim.h"
+
+static const char *USAGE =
+    "usage: pfsph run [SCENE] [-o DIR] [--threads N] [--end T] [--render] [--quiet]\n"
+    "       pfsph check SCENE\n"
+    "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
+    "                            [--size WxH]\n"
+    "       pfsph --version\n"
+    "Without SCENE, `pfsph run` runs the embedded default scene (a small 3D dam break) into\n"
+    "./pfsph_default_run and renders PNG previews.\n";
+
+static int exit_code(int rc)
+{
+    switch (rc) {
+    case PFSPH_OK: return 0;
+    case PFSPH_EINPUT: return 2;
+    case PFSPH_EUNSTABLE: return 3;
+    default: return 1;
+    }
+}
+
+static int usage_error(const char *fmt, const char *arg)
+{
+    fprintf(stderr, "pfsph: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\n%s", USAGE);
+    return 2;
+}
+
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap);
+    while (buf) {
+        size_t r = fread(buf + n, 1, cap - n - 1, f);
+        n += r;
+        if (r == 0) break;
+        if (n + 1 == cap) {
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    fclose(f);
+    if (buf) buf[n] = 0;
+    return buf;
+}
+
+/* Loads SCENE (or the default when path is NULL); prints the error. */
+static int load_scene(const char *path, pfsph_scene *s, char **text)
+{
+    pfsph_error err = {0};
+    int rc;
+    if (!path) {
+        *text = strdup(pfsph_scene_default_json());
+        rc = pfsph_scene_parse(s, *text, "<default scene>", &err);
+    } else {
+        *text = read_text(path);
+        if (!*text) {
+            fprintf(stderr, "pfsph: %s: cannot read: %s\n", path, strerror(errno));
+            return 2;
+        }
+        rc = pfsph_scene_parse(s, *text, path, &err);
+    }
+    if (rc) {
+        fprintf(stderr, "pfsph: %s\n", err.msg);
+        return exit_code(rc);
+    }
+    return 0;
+}
+
+static long physical_memory(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? pages * size : 0;
+}
+
+static int check_memory(const pfsph_scene *s, int verbose)
+{
+    size_t nf = 0, nb = 0, bytes = 0;
+    pfsph_error err = {0};
+    int rc = pfsph_scene_estimate(s, &nf, &nb, &bytes, &err);
+    if (rc) {
+        fprintf(stderr, "pfsph: %s\n", err.msg);
+        return exit_code(rc);
+    }
+    long mem = physical_memory();
+    if (verbose) {
+        printf("particles: %zu fluid, %zu boundary\n", nf, nb);
+        printf("memory estimate: %.1f MiB (%.0f bytes per fluid particle)%s\n", (double)bytes / 1048576.0,
+               nf ? (double)bytes / (double)nf : 0.0, "");
+    }
+    if (mem > 0 && (double)bytes > 0.8 * (double)mem) {
+        fprintf(stderr, "pfsph: %s: the scene needs about %.1f GiB, more than 80%% of this machine's %.1f GiB; "
+                "enlarge particle_radius or shrink the fluid\n", s->source, (double)bytes / 1073741824.0,
+                (double)mem / 1073741824.0);
+        return 2;
+    }
+    return 0;
+}
+
+typedef struct progress_state {
+    int tty, quiet;
+} progress_state;
+
+static void show_progress(const pfsph_progress *p, void *user)
+{
+    progress_state *ps = user;
+    if (ps->quiet) return;
+    double frac = p->nframes ? (double)p->frame / p->nframes : 1;
+    double eta = frac > 0 ? p->wall_s * (1 - frac) / frac : 0;
+    if (ps->tty) {
+        char bar[31];
+        int filled = (int)(frac * 30);
+        for (int i = 0; i < 30; i++) bar[i] = i < filled ? '#' : '.';
+        bar[30] = 0;
+        fprintf(stderr, "\r[%s] frame %d/%d  t=%.3f/%.3f s  %.0f steps/s  ETA %02d:%02d  ", bar, p->frame,
+                p->nframes, p->time, p->end_time, p->steps_per_s, (int)eta / 60, (int)eta % 60);
+        if (p->frame == p->nframes) fputc('\n', stderr);
+    } else {
+        fprintf(stderr, "frame %d/%d t=%.4f s steps=%llu %.0f steps/s fluid=%zu eta=%.0f s\n", p->frame,
+                p->nframes, p->time, (unsigned long long)p->steps, p->steps_per_s, p->n_fluid, eta);
+    }
+    fflush(stderr);
+}
+
+static int cmd_run(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out = NULL;
+    double end = -1;
+    int threads = 0, render = 0, quiet = 0;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            if (++i >= argc) return usage_error("%s needs a directory", a);
+            out = argv[i];
+        } else if (!strcmp(a, "--threads")) {
+            char *e;
+            if (++i >= argc) return usage_error("%s needs a number", a);
+            threads = (int)strtol(argv[i], &e, 10);
+            if (*e || threads < 1 || threads > 1024) return usage_error("--threads: '%s' is not a thread count 1..1024", argv[i]);
+        } else if (!strcmp(a, "--end")) {
+            char *e;
+            if (++i >= argc) return usage_error("%s needs a time in seconds", a);
+            end = strtod(argv[i], &e);
+            if (*e || !(end >= 0)) return usage_error("--end: '%s' is not a time >= 0", argv[i]);
+        } else if (!strcmp(a, "--render")) {
+            render = 1;
+        } else if (!strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else if (a[0] == '-') {
+            return usage_error("unknown option '%s'", a);
+        } else if (!scene_path) {
+            scene_path = a;
+        } else {
+            return usage_error("unexpected argument '%s'", a);
+        }
+    }
+    static pfsph_scene s;
+    char *text = NULL;
+    int rc = load_scene(scene_path, &s, &text);
+    if (!rc) rc = check_memory(&s, 0);
+    if (rc) {
+        free(text);
+        return rc;
+    }
+    if (!scene_path) render = 1;
+    if (threads > 0) omp_set_num_threads(threads);
+    else if (s.threads > 0) omp_set_num_threads(s.threads);
+    progress_state ps = {isatty(2), quiet};
+    pfsph_run_opts o = {.out_dir = out, .end_time = end, .scene_text = text, .progress = show_progress, .user = &ps};
+    const char *dir = out ? out : s.output.dir;
+    if (!quiet) fprintf(stderr, "pfsph %s: %s -> %s (%d threads)\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads());
+    pfsph_error err = {0};
+    rc = pfsph_run(&s, &o, &err);
+    free(text);
+    if (rc) {
+        if (ps.tty && !quiet) fputc('\n', stderr);
+        fprintf(stderr, "pfsph: %s\n", err.msg);
+        return exit_code(rc);
+    }
+    if (render) {
+        pfsph_render_opts ro = {0};
+        ro.last = -1;
+        ro.quiet = quiet;
+        int count = 0;
+        rc = pfsph_render_run(dir, &ro, &count, &err);
+        if (rc) {
+            fprintf(stderr, "pfsph: render: %s\n", err.msg);
+            return exit_code(rc);
+        }
+        if (!quiet) fprintf(stderr, "rendered %d frames into %s/png\n", count, dir);
+    }
+    if (!quiet) fprintf(stderr, "done: %s\n", dir);
+    return 0;
+}
+
+static int cmd_check(int argc, char **argv)
+{
+    if (argc != 1) return usage_error("%s", "check takes exactly one scene file");
+    static pfsph_scene s;
+    char *text = NULL;
+    int rc = load_scene(argv[0], &s, &text);
+    free(text);
+    if (rc) return rc;
+    printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids\n", s.source, s.dim,
+           s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
+    rc = check_memory(&s, 1);
+    if (rc) return rc;
+    if (s.pairwise.enabled) {
+        pfsph_error err = {0};
+        double d = 2 * s.particle_radius;
+        rc = pfsph_pairwise_resolve(&s, (pfsph_real)d, (pfsph_real)(s.support_factor * d), &err);
+        if (rc) {
+            fprintf(stderr, "pfsph: %s\n", err.msg);
+            return exit_code(rc);
+        }
+        pfsph_pairwise_report(&s, stdout);
+    }
+    return 0;
+}
+
+static int cmd_render(int argc, char **argv)
+{
+    const char *dir = NULL;
+    pfsph_render_opts o = {0};
+    o.last = -1;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "--video")) o.video = true;
+        else if (!strcmp(a, "--color-by")) {
+            if (++i >= argc) return usage_error("%s needs a field", a);
+            o.color_by = argv[i];
+        } else if (!strcmp(a, "--size")) {
+            if (++i >= argc || sscanf(argv[i], "%dx%d", &o.width, &o.height) != 2 || o.width < 16 ||
+                o.height < 16 || o.width > 16384 || o.height > 16384)
+                return usage_error("--size: '%s' is not WxH (16..16384)", i < argc ? argv[i] : "");
+        } else if (a[0] == '-') return usage_error("unknown option '%s'", a);
+        else if (!dir) dir = a;
+        else return usage_error("unexpected argument '%s'", a);
+    }
+    if (!dir) return usage_error("%s", "render needs a run directory");
+    pfsph_error err = {0};
+    int count = 0;
+    int rc = pfsph_render_run(dir, &o, &count, &err);
+    if (rc) {
+        fprintf(stderr, "pfsph: %s\n", err.msg);
+        return exit_code(rc);
+    }
+    printf("rendered %d frames into %s/png\n", count, dir);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fputs(USAGE, stderr);
+        return 2;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
+        printf("pfsph %s (%s precision, OpenMP %d threads)\n", PFSPH_VERSION, PFSPH_REAL_NAME, omp_get_max_threads());
+        return 0;
+    }
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        fputs(USAGE, stdout);
+        return 0;
+    }
+    if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
+    if (!strcmp(cmd, "check")) return cmd_check(argc - 2, argv + 2);
+    if (!strcmp(cmd, "render")) return cmd_render(argc - 2, argv + 2);
+    return usage_error("unknown command '%s'", cmd);
+}

@@ -1,0 +1,220 @@
+/* Atomic file output (temporary file in the same directory, fsync, rename) and whole-file reads,
+ * used by every writer so a crash or a full disk never leaves a half-written frame behind. */
+#include "io/io_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "pfsph/io.h"
+
+static char *dup_str(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d) memcpy(d, s, n);
+    return d;
+}
+
+static void afile_release(pfsph__afile *a)
+{
+    free(a->path);
+    free(a->tmp);
+    a->path = a->tmp = NULL;
+    a->f = NULL;
+}
+
+int pfsph__afile_open(pfsph__afile *a, const char *path, pfsph_error *err)
+{
+    memset(a, 0, sizeof *a);
+    if (!path || !*path) return pfsph_fail(err, PFSPH_EIO, "empty output path");
+    size_t n = strlen(path) + 32;
+    a->path = dup_str(path);
+    a->tmp = malloc(n);
+    if (!a->path || !a->tmp) {
+        afile_release(a);
+        return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
+    }
+    snprintf(a->tmp, n, "%s.tmp.%ld", path, (long)getpid());
+    int fd = open(a->tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0) {
+        int e = errno;
+        afile_release(a);
+        return pfsph_fail(err, PFSPH_EIO, "%s: cannot create temporary file: %s", path,
+                          strerror(e));
+    }
+    a->f = fdopen(fd, "wb");
+    if (!a->f) {
+        int e = errno;
+        close(fd);
+        unlink(a->tmp);
+        afile_release(a);
+        return pfsph_fail(err, PFSPH_EIO, "%s: %s", path, strerror(e));
+    }
+    return PFSPH_OK;
+}
+
+int pfsph__afile_write(pfsph__afile *a, const void *data, size_t len, pfsph_error *err)
+{
+    if (!a->f)
+        return pfsph_fail(err, PFSPH_EIO, "%s: write after failure", a->path ? a->path : "?");
+    if (len && fwrite(data, 1, len, a->f) != len) {
+        int e = errno;
+        return pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", a->path,
+                          strerror(e ? e : EIO));
+    }
+    return PFSPH_OK;
+}
+
+void pfsph__afile_abort(pfsph__afile *a)
+{
+    if (a->f) fclose(a->f);
+    if (a->tmp) unlink(a->tmp);
+    afile_release(a);
+}
+
+/* Make the rename itself durable; failure here is not an error for the data. */
+static void sync_parent_dir(const char *path)
+{
+    char *d = dup_str(path);
+    if (!d) return;
+    char *slash = strrchr(d, '/');
+    const char *dir = ".";
+    if (slash) {
+        if (slash == d) slash[1] = 0;
+        else *slash = 0;
+        dir = d;
+    }
+    int fd = open(dir, O_RDONLY);
+    if (fd >= 0) {
+        (void)fsync(fd);
+        close(fd);
+    }
+    free(d);
+}
+
+int pfsph__afile_commit(pfsph__afile *a, pfsph_error *err)
+{
+    if (!a->f) {
+        pfsph__afile_abort(a);
+        return pfsph_fail(err, PFSPH_EIO, "commit of a failed file");
+    }
+    const char *what = NULL;
+    int e = 0;
+    if (fflush(a->f) != 0) what = "write failed", e = errno;
+    else if (fsync(fileno(a->f)) != 0) what = "fsync failed", e = errno;
+    int rc = fclose(a->f);
+    a->f = NULL;
+    if (!what && rc != 0) what = "close failed", e = errno;
+    if (!what && rename(a->tmp, a->path) != 0) what = "rename failed", e = errno;
+    if (what) {
+        pfsph_fail(err, PFSPH_EIO, "%s: %s: %s", a->path, what, strerror(e ? e : EIO));
+        pfsph__afile_abort(a);
+        return PFSPH_EIO;
+    }
+    sync_parent_dir(a->path);
+    afile_release(a);
+    return PFSPH_OK;
+}
+
+int pfsph_write_file_atomic(const char *path, const void *data, size_t len, pfsph_error *err)
+{
+    pfsph__afile a;
+    int rc = pfsph__afile_open(&a, path, err);
+    if (rc != PFSPH_OK) return rc;
+    rc = pfsph__afile_write(&a, data, len, err);
+    if (rc != PFSPH_OK) {
+        pfsph__afile_abort(&a);
+        return rc;
+    }
+    return pfsph__afile_commit(&a, err);
+}
+
+int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_error *err)
+{
+    *data = NULL;
+    *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return pfsph_fail(err, PFSPH_EIO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        return pfsph_fail(err, PFSPH_EIO, "%s: not a regular file", path);
+    }
+    size_t n = (size_t)st.st_size;
+    unsigned char *buf = malloc(n + 1);
+    if (!buf) {
+        fclose(f);
+        return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory for %zu bytes", path, n);
+    }
+    size_t got = fread(buf, 1, n, f);
+    int bad = ferror(f);
+    fclose(f);
+    if (bad || got != n) {
+        free(buf);
+        return pfsph_fail(err, PFSPH_EIO, "%s: read failed", path);
+    }
+    buf[n] = 0;
+    *data = buf;
+    *len = n;
+    return PFSPH_OK;
+}
+
+int pfsph__enc_init(pfsph__enc *e, pfsph__afile *a, pfsph_error *err)
+{
+    memset(e, 0, sizeof *e);
+    e->a = a;
+    e->err = err;
+    e->cap = 1u << 20;
+    e->buf = malloc(e->cap);
+    if (!e->buf) return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", a->path);
+    return PFSPH_OK;
+}
+
+int pfsph__enc_flush(pfsph__enc *e)
+{
+    if (e->failed) {
+        e->len = 0;
+        return PFSPH_EIO;
+    }
+    int rc = pfsph__afile_write(e->a, e->buf, e->len, e->err);
+    e->len = 0;
+    if (rc != PFSPH_OK) e->failed = 1;
+    return rc;
+}
+
+void pfsph__enc_free(pfsph__enc *e)
+{
+    free(e->buf);
+    e->buf = NULL;
+}
+
+size_t pfsph__type_size(int type)
+{
+    switch (type) {
+    case PFSPH__T_I8: case PFSPH__T_U8: return 1;
+    case PFSPH__T_I16: case PFSPH__T_U16: return 2;
+    case PFSPH__T_I32: case PFSPH__T_U32: case PFSPH__T_F32: return 4;
+    case PFSPH__T_I64: case PFSPH__T_U64: case PFSPH__T_F64: return 8;
+    default: return 0;
+    }
+}
+
+double pfsph__get_as_double(int type, const unsigned char *src)
+{
+    switch (type) {
+    case PFSPH__T_I8: return (double)(int8_t)src[0];
+    case PFSPH__T_U8: return (double)src[0];
+    case PFSPH__T_I16: { int16_t v; pfsph__get_le(&v, src, 2); return v; }
+    case PFSPH__T_U16: { uint16_t v; pfsph__get_le(&v, src, 2); return v; }
+    case PFSPH__T_I32: { int32_t v; pfsph__get_le(&v, src, 4); return v; }
+    case PFSPH__T_U32: { uint32_t v; pfsph__get_le(&v, src, 4); return v; }
+    case PFSPH__T_I64: { int64_t v; pfsph__get_le(&v, src, 8); return (double)v; }
+    case PFSPH__T_U64: { uint64_t v; pfsph__get_le(&v, src, 8); return (double)v; }
+    case PFSPH__T_F32: { float v; pfsph__get_le(&v, src, 4); return v; }
+    case PFSPH__T_F64: { double v; pfsph__get_le(&v, src, 8); return v; }
+    default: return 0;
+    }
+}

@@ -1,0 +1,196 @@
+/* The run driver: a scene in, a run directory out (frames, stats.csv, summary.json). */
+#include "pfsph/run.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "pfsph/io.h"
+#include "pfsph/sim.h"
+
+int pfsph_mkdirs(const char *path, pfsph_error *err)
+{
+    char buf[PFSPH_PATH_LEN + 64];
+    if (strlen(path) >= sizeof buf) return pfsph_fail(err, PFSPH_EIO, "%s: path too long", path);
+    strcpy(buf, path);
+    for (char *p = buf + 1;; p++) {
+        if (*p == '/' || *p == 0) {
+            char c = *p;
+            *p = 0;
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return pfsph_fail(err, PFSPH_EIO, "%s: cannot create directory: %s", buf, strerror(errno));
+            struct stat st;
+            if (stat(buf, &st) != 0 || !S_ISDIR(st.st_mode))
+                return pfsph_fail(err, PFSPH_EIO, "%s: exists and is not a directory", buf);
+            *p = c;
+            if (!c) break;
+        }
+    }
+    return PFSPH_OK;
+}
+
+static int write_set(const pfsph_scene *s, const char *dir, const char *name, int frame,
+                     const pfsph_particles *ps, const char *aux, double time, pfsph_error *err)
+{
+    char path[PFSPH_PATH_LEN + 64];
+    pfsph_io_opts o = {.dim = s->dim,
+                       .write_id = (s->output.fields & PFSPH_OUT_ID) != 0,
+                       .write_speed = (s->output.fields & PFSPH_OUT_SPEED) != 0,
+                       .aux_name = aux,
+                       .time = time};
+    int rc;
+    if (s->output.vtp) {
+        snprintf(path, sizeof path, "%s/frames/%s_%05d.vtp", dir, name, frame);
+        if ((rc = pfsph_write_vtp(path, ps, &o, err))) return rc;
+    }
+    if (s->output.ply) {
+        snprintf(path, sizeof path, "%s/frames/%s_%05d.ply", dir, name, frame);
+        if ((rc = pfsph_write_ply(path, ps, &o, err))) return rc;
+    }
+    return PFSPH_OK;
+}
+
+static int write_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_sim *sim,
+                       pfsph_error *err)
+{
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    double t = pfsph_sim_time(sim);
+    int rc = write_set(s, dir, "fluid", frame, c->fluid, NULL, t, err);
+    if (!rc && frame == 0 && c->boundary->n)
+        rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
+    const pfsph_particles *d = pfsph_sim_diffuse(sim);
+    if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);
+    return rc;
+}
+
+static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
+{
+    const pfsph_step_stats *st = pfsph_sim_stats(sim);
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    fprintf(f, "%d,%.9g,%.6g,%llu,%zu,%zu,%.6g,%.6g,%.6g,%.9g,%d", frame, pfsph_sim_time(sim), st->dt,
+            (unsigned long long)pfsph_sim_steps(sim), c->fluid->n, pfsph_sim_removed(sim), st->vmax,
+            st->density_err_avg, st->density_err_max, st->ekin, st->iterations);
+    const pfsph_particles *d = pfsph_sim_diffuse(sim);
+    if (c->scene->diffuse.enabled) {
+        size_t cnt[3] = {0, 0, 0};
+        if (d) {
+            for (size_t i = 0; i < d->n; i++)
+                if (d->phase[i] < 3) cnt[d->phase[i]]++;
+        }
+        fprintf(f, ",%zu,%zu,%zu", cnt[0], cnt[1], cnt[2]);
+    }
+    fputc('\n', f);
+    fflush(f);
+}
+
+static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim *sim,
+                         int frames, double wall, const char *status, const char *message,
+                         pfsph_error *err)
+{
+    cJSON *j = cJSON_CreateObject();
+    cJSON_AddStringToObject(j, "program", "pfsph");
+    cJSON_AddStringToObject(j, "version", PFSPH_VERSION);
+    cJSON_AddStringToObject(j, "precision", PFSPH_REAL_NAME);
+    cJSON_AddStringToObject(j, "scene", s->source);
+    cJSON_AddStringToObject(j, "status", status);
+    if (message) cJSON_AddStringToObject(j, "message", message);
+    cJSON_AddNumberToObject(j, "threads", omp_get_max_threads());
+    cJSON_AddNumberToObject(j, "dimension", s->dim);
+    cJSON_AddStringToObject(j, "solver", s->solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph");
+    if (sim) {
+        const pfsph_ctx *c = pfsph_sim_ctx(sim);
+        cJSON *n = cJSON_AddObjectToObject(j, "particles");
+        cJSON_AddNumberToObject(n, "fluid", (double)c->fluid->n);
+        cJSON_AddNumberToObject(n, "boundary", (double)c->boundary->n);
+        cJSON_AddNumberToObject(n, "removed", (double)pfsph_sim_removed(sim));
+        const pfsph_particles *d = pfsph_sim_diffuse(sim);
+        if (d) cJSON_AddNumberToObject(n, "diffuse", (double)d->n);
+        cJSON_AddNumberToObject(j, "simulated_time", pfsph_sim_time(sim));
+        cJSON_AddNumberToObject(j, "steps", (double)pfsph_sim_steps(sim));
+        cJSON *st = cJSON_AddObjectToObject(j, "stage_seconds");
+        const double *ss = pfsph_sim_stage_seconds(sim);
+        for (int k = 0; k < PFSPH_NSTAGES; k++) cJSON_AddNumberToObject(st, pfsph_stage_names[k], ss[k]);
+    }
+    cJSON_AddNumberToObject(j, "frames", frames);
+    cJSON_AddNumberToObject(j, "wall_seconds", wall);
+    char *text = cJSON_Print(j);
+    cJSON_Delete(j);
+    if (!text) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    char path[PFSPH_PATH_LEN + 64];
+    snprintf(path, sizeof path, "%s/summary.json", dir);
+    int rc = pfsph_write_file_atomic(path, text, strlen(text), err);
+    free(text);
+    return rc;
+}
+
+int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
+{
+    const char *dir = o && o->out_dir ? o->out_dir : s->output.dir;
+    double end = o && o->end_time >= 0 ? o->end_time : s->end_time;
+    char path[PFSPH_PATH_LEN + 64];
+    int rc;
+    double w0 = omp_get_wtime();
+    if ((rc = pfsph_mkdirs(dir, err))) return rc;
+    snprintf(path, sizeof path, "%s/frames", dir);
+    if ((rc = pfsph_mkdirs(path, err))) return rc;
+    if (o && o->scene_text) {
+        snprintf(path, sizeof path, "%s/scene.json", dir);
+        if ((rc = pfsph_write_file_atomic(path, o->scene_text, strlen(o->scene_text), err))) return rc;
+    }
+    pfsph_sim *sim = NULL;
+    if ((rc = pfsph_sim_create(&sim, s, err))) return rc;
+
+    snprintf(path, sizeof path, "%s/stats.csv", dir);
+    FILE *csv = fopen(path, "w");
+    if (!csv) {
+        pfsph_fail(err, PFSPH_EIO, "%s: cannot write: %s", path, strerror(errno));
+        pfsph_sim_destroy(sim);
+        return PFSPH_EIO;
+    }
+    fprintf(csv, "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s\n",
+            s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "");
+    int nframes = (int)floor(end * s->fps + 1e-9);
+    int frame = 0, written = 0;
+    rc = write_frame(s, dir, 0, sim, err);
+    if (!rc) written++;
+    csv_row(csv, 0, sim);
+    for (frame = 1; frame <= nframes && !rc; frame++) {
+        rc = pfsph_sim_advance(sim, frame / s->fps, err);
+        if (rc) break;
+        double t0 = omp_get_wtime();
+        if (frame % s->output.frame_interval == 0) {
+            rc = write_frame(s, dir, frame / s->output.frame_interval, sim, err);
+            if (!rc) written++;
+        }
+        csv_row(csv, frame, sim);
+        pfsph_sim_add_stage_time(sim, PFSPH_STAGE_OUTPUT, omp_get_wtime() - t0);
+        if (o && o->progress) {
+            double wall = omp_get_wtime() - w0;
+            pfsph_progress p = {frame, nframes, pfsph_sim_time(sim), end, pfsph_sim_steps(sim), wall,
+                                wall > 0 ? (double)pfsph_sim_steps(sim) / wall : 0,
+                                pfsph_sim_ctx(sim)->fluid->n};
+            o->progress(&p, o->user);
+        }
+    }
+    fclose(csv);
+    pfsph_error e2;
+    const char *status = rc == PFSPH_OK ? "finished" : rc == PFSPH_EUNSTABLE ? "unstable" : "failed";
+    int rc2 = write_summary(dir, s, sim, written, omp_get_wtime() - w0, status, rc ? err->msg : NULL, &e2);
+    if (!rc && s->diffuse.enabled) {
+        char png[PFSPH_PATH_LEN + 64];
+        snprintf(path, sizeof path, "%s/stats.csv", dir);
+        snprintf(png, sizeof png, "%s/diffuse_counts.png", dir);
+        rc2 = rc2 ? rc2 : pfsph_diffuse_plot(path, png, &e2);
+    }
+    pfsph_sim_destroy(sim);
+    if (!rc && rc2) {
+        *err = e2;
+        rc = rc2;
+    }
+    return rc;
+}

@@ -1,0 +1,1080 @@
+/* Scene loader: JSON text -> a fully validated pfsph_scene (docs/scene-format.md). Everything a
+ * run needs is checked here, before any particle exists, so a bad scene fails in milliseconds
+ * with "<file>: <JSON path>: <reason>" instead of minutes into a run. */
+#include "pfsph/scene.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/json_util.h"
+
+/* ---------------------------------------------------------------------------------------- */
+/* Limits of the accepted ranges (documented in docs/scene-format.md). */
+#define COORD_MAX 1e6     /* m */
+#define VEL_MAX 1e3       /* m/s */
+#define GRAVITY_MAX 1e3   /* m/s^2 */
+#define SEED_MAX 9007199254740992.0 /* 2^53: integers a JSON double holds exactly */
+
+static const float palette[][3] = {
+    {0.20f, 0.40f, 0.90f}, {0.90f, 0.50f, 0.15f}, {0.20f, 0.75f, 0.35f}, {0.85f, 0.20f, 0.25f},
+    {0.60f, 0.30f, 0.80f}, {0.95f, 0.85f, 0.20f}, {0.20f, 0.80f, 0.80f}, {0.80f, 0.50f, 0.60f},
+};
+static const float solid_grey[3] = {0.60f, 0.60f, 0.62f};
+
+typedef struct parser {
+    pfsph_scene *s;
+    pfsph_jctx ctx;
+} parser;
+
+#define TRY(expr)                                                                          \
+    do {                                                                                   \
+        int rc_ = (expr);                                                                  \
+        if (rc_) return rc_;                                                               \
+    } while (0)
+
+static const char *const axis_names[] = {"x", "y", "z", NULL};
+static const char *const kind_names[] = {"fluid", "gas", "solid", NULL};
+static const char *const solver_names[] = {"wcsph", "pcisph", NULL}; /* enum order */
+
+static void path_key(char *out, size_t cap, const char *path, const char *key)
+{
+    snprintf(out, cap, "%s.%s", path, key);
+}
+
+static void path_index(char *out, size_t cap, const char *path, int i)
+{
+    snprintf(out, cap, "%s[%d]", path, i);
+}
+
+static const cJSON *get(const cJSON *obj, const char *key)
+{
+    return cJSON_GetObjectItemCaseSensitive(obj, key);
+}
+
+static int require(parser *p, const cJSON *obj, const char *path, const char *key)
+{
+    if (get(obj, key)) return PFSPH_OK;
+    char kp[512];
+    path_key(kp, sizeof kp, path, key);
+    return pfsph__json_fail(&p->ctx, kp, "missing required key \"%s\"", key);
+}
+
+/* A vector with as many components as the scene has dimensions; z = 0 in 2D. */
+static int vecd(parser *p, const cJSON *obj, const char *path, const char *key, double lo,
+                double hi, double *out)
+{
+    if (!get(obj, key)) return PFSPH_OK;
+    TRY(pfsph__json_vec(obj, path, key, p->s->dim, lo, hi, out, &p->ctx));
+    if (p->s->dim == 2) out[2] = 0.0;
+    return PFSPH_OK;
+}
+
+/* A string that must be one of names (NULL-terminated); *out becomes its index. */
+static int json_enum(parser *p, const cJSON *obj, const char *path, const char *key,
+                     const char *const *names, int *out)
+{
+    const cJSON *v = get(obj, key);
+    if (!v) return PFSPH_OK;
+    char kp[512];
+    path_key(kp, sizeof kp, path, key);
+    char list[256] = "";
+    size_t n = 0;
+    for (int i = 0; names[i]; i++) {
+        int w = snprintf(list + n, sizeof list - n, "%s\"%s\"", i ? ", " : "", names[i]);
+        if (w > 0 && (size_t)w < sizeof list - n) n += (size_t)w;
+    }
+    if (!cJSON_IsString(v) || !v->valuestring)
+        return pfsph__json_fail(&p->ctx, kp, "expected a string, one of %s", list);
+    for (int i = 0; names[i]; i++)
+        if (strcmp(v->valuestring, names[i]) == 0) {
+            *out = i;
+            return PFSPH_OK;
+        }
+    return pfsph__json_fail(&p->ctx, kp, "unknown value \"%.60s\" (expected one of %s)",
+                            v->valuestring, list);
+}
+
+/* A number that must be strictly positive (the helpers check closed ranges only). */
+static int positive(parser *p, const cJSON *obj, const char *path, const char *key, double hi,
+                    double *out)
+{
+    double v = *out;
+    TRY(pfsph__json_number(obj, path, key, -HUGE_VAL, hi, &v, &p->ctx));
+    if (!(v > 0.0)) {
+        char kp[512];
+        path_key(kp, sizeof kp, path, key);
+        return pfsph__json_fail(&p->ctx, kp, "value %g is out of range: must be > 0 and <= %g",
+                                v, hi);
+    }
+    *out = v;
+    return PFSPH_OK;
+}
+
+/* An array (possibly absent); error when it is not an array or has more than max entries. */
+static int array_of(parser *p, const cJSON *root, const char *path, const char *key, int max,
+                    const cJSON **out)
+{
+    const cJSON *v = get(root, key);
+    *out = NULL;
+    if (!v) return PFSPH_OK;
+    char kp[512];
+    path_key(kp, sizeof kp, path, key);
+    if (!cJSON_IsArray(v))
+        return pfsph__json_fail(&p->ctx, kp, "expected an array, got %s",
+                                cJSON_IsObject(v) ? "an object" : "a single value");
+    int n = cJSON_GetArraySize(v);
+    if (n > max)
+        return pfsph__json_fail(&p->ctx, kp, "too many entries (%d, at most %d)", n, max);
+    *out = v;
+    return PFSPH_OK;
+}
+
+static int axis_index(const char *path, parser *p, const cJSON *obj, int *axis)
+{
+    return json_enum(p, obj, path, "axis", axis_names, axis);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Geometry used by the validation: bounding boxes and overlaps of blocks and solids. */
+
+typedef struct geo {
+    int shape, dim, axis;
+    double min[3], max[3], center[3], radius, height;
+} geo;
+
+static geo geo_of(int dim, int shape, const double *min, const double *max, const double *center,
+                  double radius, double height, int axis)
+{
+    geo g;
+    memset(&g, 0, sizeof g);
+    g.shape = shape;
+    g.dim = dim;
+    g.axis = axis;
+    g.radius = radius;
+    g.height = height;
+    for (int k = 0; k < 3; k++) {
+        g.center[k] = center[k];
+        g.min[k] = min[k];
+        g.max[k] = max[k];
+    }
+    /* A 2D cylinder is a disc: the same thing as a 2D sphere. */
+    if (dim == 2 && shape == PFSPH_SHAPE_CYLINDER) g.shape = PFSPH_SHAPE_SPHERE;
+    if (g.shape == PFSPH_SHAPE_SPHERE) {
+        for (int k = 0; k < dim; k++) {
+            g.min[k] = center[k] - radius;
+            g.max[k] = center[k] + radius;
+        }
+    } else if (g.shape == PFSPH_SHAPE_CYLINDER) {
+        for (int k = 0; k < 3; k++) {
+            double e = k == axis ? 0.5 * height : radius;
+            g.min[k] = center[k] - e;
+            g.max[k] = center[k] + e;
+        }
+    }
+    if (dim == 2) g.min[2] = g.max[2] = 0.0;
+    return g;
+}
+
+/* Is point x inside g shrunk by d on every side? */
+static bool geo_inside(const geo *g, const double *x, double d)
+{
+    if (g->shape == PFSPH_SHAPE_SPHERE) {
+        double r2 = 0;
+        for (int k = 0; k < g->dim; k++) r2 += (x[k] - g->center[k]) * (x[k] - g->center[k]);
+        return g->radius > d && r2 < (g->radius - d) * (g->radius - d);
+    }
+    if (g->shape == PFSPH_SHAPE_CYLINDER) {
+        double r2 = 0;
+        for (int k = 0; k < 3; k++) {
+            double e = x[k] - g->center[k];
+            if (k == g->axis) {
+                if (fabs(e) >= 0.5 * g->height - d) return false;
+            } else {
+                r2 += e * e;
+            }
+        }
+        return g->radius > d && r2 < (g->radius - d) * (g->radius - d);
+    }
+    for (int k = 0; k < g->dim; k++)
+        if (x[k] <= g->min[k] + d || x[k] >= g->max[k] - d) return false;
+    return true;
+}
+
+/* Distance from point c to the box [lo, hi] (0 inside). */
+static double point_box_distance(int dim, const double *c, const double *lo, const double *hi)
+{
+    double d2 = 0;
+    for (int k = 0; k < dim; k++) {
+        double e = c[k] < lo[k] ? lo[k] - c[k] : (c[k] > hi[k] ? c[k] - hi[k] : 0.0);
+        d2 += e * e;
+    }
+    return sqrt(d2);
+}
+
+/* Do a and b overlap by more than half a particle spacing? Both shapes are shrunk by a quarter
+ * spacing and tested for intersection: for two boxes this is "overlap > s/2 along every axis",
+ * for two spheres "r1 + r2 - distance > s/2". Cylinders (3D) are sampled on a fine lattice over
+ * the common bounding box, which is exact to a small fraction of the spacing. */
+static bool geo_overlap(const geo *a, const geo *b, double spacing)
+{
+    const int dim = a->dim;
+    const double d = 0.25 * spacing;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int k = 0; k < dim; k++) {
+        lo[k] = fmax(a->min[k], b->min[k]) + d;
+        hi[k] = fmin(a->max[k], b->max[k]) - d;
+        if (!(lo[k] < hi[k])) return false;
+    }
+    if (a->shape == PFSPH_SHAPE_BOX && b->shape == PFSPH_SHAPE_BOX) return true;
+    if (a->shape == PFSPH_SHAPE_SPHERE && b->shape == PFSPH_SHAPE_SPHERE) {
+        double r2 = 0;
+        for (int k = 0; k < dim; k++)
+            r2 += (a->center[k] - b->center[k]) * (a->center[k] - b->center[k]);
+        return sqrt(r2) < a->radius + b->radius - 2.0 * d;
+    }
+    if ((a->shape == PFSPH_SHAPE_BOX && b->shape == PFSPH_SHAPE_SPHERE) ||
+        (a->shape == PFSPH_SHAPE_SPHERE && b->shape == PFSPH_SHAPE_BOX)) {
+        const geo *bx = a->shape == PFSPH_SHAPE_BOX ? a : b;
+        const geo *sp = a->shape == PFSPH_SHAPE_BOX ? b : a;
+        double blo[3], bhi[3];
+        for (int k = 0; k < dim; k++) {
+            blo[k] = bx->min[k] + d;
+            bhi[k] = bx->max[k] - d;
+        }
+        return point_box_distance(dim, sp->center, blo, bhi) < sp->radius - d;
+    }
+    /* Sampled test; at most 64 samples per axis of the common box, never coarser than an
+     * eighth of a spacing in practice for blocks that touch. */
+    int n[3] = {1, 1, 1};
+    for (int k = 0; k < dim; k++) {
+        double cells = (hi[k] - lo[k]) / (0.125 * spacing);
+        n[k] = cells < 1 ? 1 : (cells > 64 ? 64 : (int)ceil(cells));
+    }
+    double x[3] = {0, 0, 0};
+    for (int i = 0; i <= n[0]; i++)
+        for (int j = 0; j <= n[1]; j++)
+            for (int l = 0; l <= (dim == 3 ? n[2] : 0); l++) {
+                int idx[3] = {i, j, l};
+                for (int k = 0; k < dim; k++)
+                    x[k] = lo[k] + (hi[k] - lo[k]) * (double)idx[k] / (double)n[k];
+                if (geo_inside(a, x, d) && geo_inside(b, x, d)) return true;
+            }
+    return false;
+}
+
+static void fmt_vec(char *out, size_t cap, int dim, const double *v)
+{
+    if (dim == 2) snprintf(out, cap, "[%g, %g]", v[0], v[1]);
+    else snprintf(out, cap, "[%g, %g, %g]", v[0], v[1], v[2]);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Sections. */
+
+static int parse_domain(parser *p, const cJSON *root)
+{
+    pfsph_scene *s = p->s;
+    TRY(require(p, root, "$", "domain"));
+    const cJSON *d = get(root, "domain");
+    static const char *const keys[] = {"min", "max", NULL};
+    TRY(pfsph__json_check_keys(d, "$.domain", keys, &p->ctx));
+    TRY(require(p, d, "$.domain", "min"));
+    TRY(require(p, d, "$.domain", "max"));
+    TRY(vecd(p, d, "$.domain", "min", -COORD_MAX, COORD_MAX, s->domain_min));
+    TRY(vecd(p, d, "$.domain", "max", -COORD_MAX, COORD_MAX, s->domain_max));
+    for (int k = 0; k < s->dim; k++)
+        if (!(s->domain_min[k] < s->domain_max[k]))
+            return pfsph__json_fail(&p->ctx, "$.domain",
+                                    "min[%d] = %g must be less than max[%d] = %g", k,
+                                    s->domain_min[k], k, s->domain_max[k]);
+    return PFSPH_OK;
+}
+
+static int parse_solver(parser *p, const cJSON *root)
+{
+    pfsph_scene *s = p->s;
+    const cJSON *o = get(root, "solver");
+    if (!o) return PFSPH_OK;
+    static const char *const keys[] = {"type", "tolerance", "min_iterations", "max_iterations",
+                                       "sound_speed", "gamma", NULL};
+    const char *P = "$.solver";
+    TRY(pfsph__json_check_keys(o, P, keys, &p->ctx));
+    TRY(json_enum(p, o, P, "type", solver_names, &s->solver));
+    TRY(pfsph__json_number(o, P, "tolerance", 1e-5, 0.1, &s->pcisph_tolerance, &p->ctx));
+    TRY(pfsph__json_int(o, P, "min_iterations", 1, 1000, &s->pcisph_min_iter, &p->ctx));
+    TRY(pfsph__json_int(o, P, "max_iterations", 1, 10000, &s->pcisph_max_iter, &p->ctx));
+    if (s->pcisph_min_iter > s->pcisph_max_iter)
+        return pfsph__json_fail(&p->ctx, "$.solver.min_iterations",
+                                "min_iterations (%d) is greater than max_iterations (%d)",
+                                s->pcisph_min_iter, s->pcisph_max_iter);
+    TRY(pfsph__json_number(o, P, "sound_speed", 0.0, 1e5, &s->sound_speed, &p->ctx));
+    TRY(pfsph__json_number(o, P, "gamma", 1.0, 10.0, &s->gamma, &p->ctx));
+    return PFSPH_OK;
+}
+
+static int parse_time(parser *p, const cJSON *root)
+{
+    pfsph_scene *s = p->s;
+    const cJSON *o = get(root, "time");
+    if (!o) return PFSPH_OK;
+    static const char *const keys[] = {"end", "fps", "cfl", "dt_min", "dt_max", NULL};
+    const char *P = "$.time";
+    TRY(pfsph__json_check_keys(o, P, keys, &p->ctx));
+    TRY(positive(p, o, P, "end", 1e6, &s->end_time));
+    TRY(positive(p, o, P, "fps", 1e4, &s->fps));
+    TRY(positive(p, o, P, "cfl", 1.0, &s->cfl));
+    TRY(positive(p, o, P, "dt_min", 1.0, &s->dt_min));
+    TRY(positive(p, o, P, "dt_max", 1.0, &s->dt_max));
+    if (s->dt_min > s->dt_max)
+        return pfsph__json_fail(&p->ctx, "$.time.dt_min",
+                                "dt_min (%g s) is greater than dt_max (%g s)", s->dt_min,
+                                s->dt_max);
+    return PFSPH_OK;
+}
+
+static int parse_phases(parser *p, const cJSON *root)
+{
+    pfsph_scene *s = p->s;
+    const cJSON *arr;
+    TRY(array_of(p, root, "$", "phases", PFSPH_MAX_PHASES, &arr));
+    if (!arr || cJSON_GetArraySize(arr) == 0) {
+        /* No phases: one water phase, so that the smallest scenes stay small. */
+        s->nphases = 1;
+        pfsph_phase *ph = &s->phases[0];
+        memset(ph, 0, sizeof *ph);
+        strcpy(ph->name, "water");
+        ph->kind = PFSPH_PHASE_FLUID;
+        ph->rest_density = 1000.0;
+        ph->viscosity = 1e-3;
+        memcpy(ph->color, palette[0], sizeof ph->color);
+        return PFSPH_OK;
+    }
+    static const char *const keys[] = {"name", "kind", "rest_density", "viscosity", "color",
+                                       "comment", NULL};
+    int i = 0;
+    for (const cJSON *e = arr->child; e; e = e->next, i++) {
+        char P[128];
+        path_index(P, sizeof P, "$.phases", i);
+        TRY(pfsph__json_check_keys(e, P, keys, &p->ctx));
+        pfsph_phase *ph = &s->phases[i];
+        memset(ph, 0, sizeof *ph);
+        TRY(require(p, e, P, "name"));
+        TRY(pfsph__json_string(e, P, "name", ph->name, sizeof ph->name, &p->ctx));
+        char kp[160];
+        path_key(kp, sizeof kp, P, "name");
+        if (!ph->name[0]) return pfsph__json_fail(&p->ctx, kp, "a phase name must not be empty");
+        for (int j = 0; j < i; j++)
+            if (strcmp(s->phases[j].name, ph->name) == 0)
+                return pfsph__json_fail(
+                    &p->ctx, kp, "duplicate phase name \"%s\" (also $.phases[%d])", ph->name, j);
+        ph->kind = PFSPH_PHASE_FLUID;
+        TRY(json_enum(p, e, P, "kind", kind_names, &ph->kind));
+        /* Defaults by kind: water for liquids and walls, air for gas; viscosity see docs. */
+        ph->rest_density = ph->kind == PFSPH_PHASE_GAS ? 1.2 : 1000.0;
+        ph->viscosity = ph->kind == PFSPH_PHASE_SOLID ? 0.0 : 1e-3;
+        if (ph->kind == PFSPH_PHASE_SOLID) memcpy(ph->color, solid_grey, sizeof ph->color);
+        else memcpy(ph->color, palette[i % 8], sizeof ph->color);
+        TRY(pfsph__json_number(e, P, "rest_density", 0.01, 1e5, &ph->rest_density, &p->ctx));
+        TRY(pfsph__json_number(e, P, "viscosity", 0.0, 100.0, &ph->viscosity, &p->ctx));
+        double c[3] = {ph->color[0], ph->color[1], ph->color[2]};
+        TRY(pfsph__json_vec(e, P, "color", 3, 0.0, 1.0, c, &p->ctx));
+        for (int k = 0; k < 3; k++) ph->color[k] = (float)c[k];
+    }
+    s->nphases = i;
+    return PFSPH_OK;
+}
+
+/* Phase named under "phase" in obj, which must be of a solid kind (want_solid) or not. When
+ * absent, *out keeps the default set by the caller (-1: none available). */
+static int phase_ref(parser *p, const cJSON *obj, const char *path, bool want_solid, int *out)
+{
+    const cJSON *v = get(obj, "phase");
+    char kp[160];
+    path_key(kp, sizeof kp, path, "phase");
+    if (!v) return PFSPH_OK;
+    if (!cJSON_IsString(v) || !v->valuestring)
+        return pfsph__json_fail(&p->ctx, kp, "expected a phase name (string)");
+    int idx = pfsph_scene_phase_index(p->s, v->valuestring);
+    if (idx < 0) {
+        char list[400] = "";
+        size_t n = 0;
+        for (int i = 0; i < p->s->nphases; i++) {
+            int w = snprintf(list + n, sizeof list - n, "%s\"%s\"", i ? ", " : "",
+                             p->s->phases[i].name);
+            if (w > 0 && (size_t)w < sizeof list - n) n += (size_t)w;
+        }
+        return pfsph__json_fail(&p->ctx, kp, "unknown phase \"%.64s\" (phases: %s)",
+                                v->valuestring, list);
+    }
+    int kind = p->s->phases[idx].kind;
+    if (want_solid && kind != PFSPH_PHASE_SOLID)
+        return pfsph__json_fail(&p->ctx, kp,
+                                "phase \"%s\" is a %s phase; solids need a phase of kind \"solid\"",
+                                p->s->phases[idx].name, kind_names[kind]);
+    if (!want_solid && kind == PFSPH_PHASE_SOLID)
+        return pfsph__json_fail(&p->ctx, kp,
+                                "phase \"%s\" is a solid phase; fluid blocks need a phase of kind "
+                                "\"fluid\" or \"gas\"",
+                                p->s->phases[idx].name);
+    *out = idx;
+    return PFSPH_OK;
+}
+
+/* Shape-specific geometry keys shared by fluid blocks and solids. */
+static int parse_geometry(parser *p, const cJSON *e, const char *P, int shape, double *min,
+                          double *max, double *center, double *radius, double *height, int *axis)
+{
+    pfsph_scene *s = p->s;
+    if (shape == PFSPH_SHAPE_BOX || shape == PFSPH_SHAPE_CONTAINER) {
+        TRY(require(p, e, P, "min"));
+        TRY(require(p, e, P, "max"));
+        TRY(vecd(p, e, P, "min", -COORD_MAX, COORD_MAX, min));
+        TRY(vecd(p, e, P, "max", -COORD_MAX, COORD_MAX, max));
+        for (int k = 0; k < s->dim; k++)
+            if (!(min[k] < max[k])) {
+                char kp[160];
+                path_key(kp, sizeof kp, P, "max");
+                return pfsph__json_fail(&p->ctx, kp,
+                                        "max[%d] = %g must be greater than min[%d] = %g", k, max[k],
+                                        k, min[k]);
+            }
+        return PFSPH_OK;
+    }
+    TRY(require(p, e, P, "center"));
+    TRY(require(p, e, P, "radius"));
+    TRY(vecd(p, e, P, "center", -COORD_MAX, COORD_MAX, center));
+    TRY(positive(p, e, P, "radius", COORD_MAX, radius));
+    if (shape != PFSPH_SHAPE_CYLINDER) return PFSPH_OK;
+    char kp[160];
+    if (s->dim == 2) {
+        /* A 2D cylinder is its cross-section, a disc in the xy plane. */
+        *axis = 2;
+        TRY(axis_index(P, p, e, axis));
+        path_key(kp, sizeof kp, P, "axis");
+        if (*axis != 2)
+            return pfsph__json_fail(&p->ctx, kp, "in 2D a cylinder's axis must be \"z\" (it is a "
+                                                 "disc in the xy plane)");
+        if (get(e, "height")) {
+            path_key(kp, sizeof kp, P, "height");
+            return pfsph__json_fail(&p->ctx, kp, "not used in 2D (a 2D cylinder is a disc)");
+        }
+        *height = 0.0;
+        return PFSPH_OK;
+    }
+    *axis = 1;
+    TRY(axis_index(P, p, e, axis));
+    TRY(require(p, e, P, "height"));
+    TRY(positive(p, e, P, "height", COORD_MAX, height));
+    return PFSPH_OK;
+}
+
+static const char *const solid_shapes[] = {"box", "sphere", "cylinder", "container", "plane",
+                                           NULL}; /* enum pfsph_shape order */
+static const char *const block_shapes[] = {"box", "sphere", "cylinder", NULL};
+
+static int parse_solids(parser *p, const cJSON *root)
+{
+    pfsph_scene *s = p->s;
+    const cJSON *arr;
+    TRY(array_of(p, root, "$", "solids", PFSPH_MAX_SOLIDS, &arr));
+    if (!arr) return PFSPH_OK;
+    /* Default phase of a solid: the first solid phase, else one named "solid" made on demand. */
+    int def = -1;
+    for (int i = 0; i < s->nphases; i++)
+        if (s->phases[i].kind == PFSPH_PHASE_SOLID) { def = i; break; }
+    int i = 0;
+    for (const cJSON *e = arr->child; e; e = e->next, i++) {
+        char P[128];
+        path_index(P, sizeof P, "$.solids", i);
+        if (!cJSON_IsObject(e))
+            return pfsph__json_fail(&p->ctx, P, "expected an object");
+        TRY(require(p, e, P, "shape"));
+        pfsph_solid *so = &s->solids[i];
+        memset(so, 0, sizeof *so);
+        TRY(json_enum(p, e, P, "shape", solid_shapes, &so->shape));
+        static const char *const k_box[] = {"shape", "phase", "layers", "min", "max", "comment",
+                                            NULL};
+        static const char *const k_cont[] = {"shape", "phase", "layers", "min", "max",
+                                             "open_top", "comment", NULL};
+        static const char *const k_sph[] = {"shape", "phase", "layers", "center", "radius",
+                                            "comment", NULL};
+        static const char *const k_cyl[] = {"shape", "phase", "layers", "center", "radius",
+                                            "height", "axis", "comment", NULL};
+        static const char *const k_plane[] = {"shape", "phase", "layers", "point", "normal",
+                                              "comment", NULL};
+        const char *const *keys = so->shape == PFSPH_SHAPE_BOX        ? k_box
+                                  : so->shape == PFSPH_SHAPE_CONTAINER ? k_cont
+                                  : so->shape == PFSPH_SHAPE_SPHERE    ? k_sph
+                                  : so->shape == PFSPH_SHAPE_CYLINDER  ? k_cyl
+                                                                       : k_plane;
+        TRY(pfsph__json_check_keys(e, P, keys, &p->ctx));
+        so->layers = 2;
+        TRY(pfsph__json_int(e, P, "layers", 1, 10, &so->layers, &p->ctx));
+        TRY(pfsph__json_bool(e, P, "open_top", &so->open_top, &p->ctx));
+        if (so->shape == PFSPH_SHAPE_PLANE) {
+            TRY(require(p, e, P, "point"));
+            TRY(require(p, e, P, "normal"));
+            TRY(vecd(p, e, P, "point", -COORD_MAX, COORD_MAX, so->center));
+            TRY(vecd(p, e, P, "normal", -COORD_MAX, COORD_MAX, so->normal));
+            double n2 = 0;
+            for (int k = 0; k < s->dim; k++) n2 += so->normal[k] * so->normal[k];
+            char kp[160];
+            path_key(kp, sizeof kp, P, "normal");
+            if (!(n2 > 1e-24)) return pfsph__json_fail(&p->ctx, kp, "the normal must not be zero");
+            for (int k = 0; k < 3; k++) so->normal[k] /= sqrt(n2);
+            /* Bounding box for the domain check: the point itself. */
+            for (int k = 0; k < 3; k++) so->min[k] = so->max[k] = so->center[k];
+        } else {
+            TRY(parse_geometry(p, e, P, so->shape, so->min, so->max, so->center, &so->radius,
+                               &so->height, &so->axis));
+        }
+        /* Phase. */
+        if (get(e, "phase")) {
+            TRY(phase_ref(p, e, P, true, &so->phase));
+        } else {
+            if (def < 0) {
+                int idx = pfsph_scene_phase_index(s, "solid");
+                if (idx >= 0) {
+                    char kp[160];
+                    path_key(kp, sizeof kp, P, "phase");
+                    return pfsph__json_fail(&p->ctx, kp,
+                                            "no phase given and the default solid phase \"solid\" "
+                                            "cannot be made: the name is taken by a %s phase",
+                                            kind_names[s->phases[idx].kind]);
+                }
+                if (s->nphases >= PFSPH_MAX_PHASES)
+                    return pfsph__json_fail(&p->ctx, "$.phases",
+                                            "too many phases: %d, and solids without a phase need "
+                                            "one more, \"solid\" (at most %d in all)",
+                                            s->nphases, PFSPH_MAX_PHASES);
+                def = s->nphases++;
+                pfsph_phase *ph = &s->phases[def];
+                memset(ph, 0, sizeof *ph);
+                strcpy(ph->name, "solid");
+                ph->kind = PFSPH_PHASE_SOLID;
+                ph->rest_density = 1000.0;
+                ph->viscosity = 0.0;
+                memcpy(ph->color, solid_grey, sizeof ph->color);
+            }
+            so->phase = def;
+        }
+        /* A solid wholly outside the domain is certainly a mistake. */
+        geo g = geo_of(s->dim, so->shape == PFSPH_SHAPE_CONTAINER ? PFSPH_SHAPE_BOX : so->shape,
+                       so->min, so->max, so->center, so->radius, so->height, so->axis);
+        for (int k = 0; k < s->dim; k++)
+            if (g.max[k] < s->domain_min[k] || g.min[k] > s->domain_max[k]) {
+                char a[96], b[96];
+                fmt_vec(a, sizeof a, s->dim, s->domain_min);
+                fmt_vec(b, sizeof b, s->dim, s->domain_max);
+                return pfsph__json_fail(&p->ctx, P, "solid lies outside the domain %s .. %s", a, b);
+            }
+    }
+    s->nsolids = i;
+    return PFSPH_OK;
+}
+
+static int parse_fluid(parser *p, const cJSON *root)
+{
+    pfsph_scene *s = p->s;
+    const cJSON *arr;
+    TRY(array_of(p, root, "$", "fluid", PFSPH_MAX_BLOCKS, &arr));
+    if (!arr || cJSON_GetArraySize(arr) == 0)
+        return pfsph__json_fail(&p->ctx, "$.fluid",
+                                "a scene needs at least one fluid block (\"fluid\": [ {...} ])");
+    int def = -1;
+    for (int i = 0; i < s->nphases; i++)
+        if (s->phases[i].kind != PFSPH_PHASE_SOLID) { def = i; break; }
+    int i = 0;
+    for (const cJSON *e = arr->child; e; e = e->next, i++) {
+        char P[128];
+        path_index(P, sizeof P, "$.fluid", i);
+        if (!cJSON_IsObject(e)) return pfsph__json_fail(&p->ctx, P, "expected an object");
+        TRY(require(p, e, P, "shape"));
+        pfsph_block *b = &s->blocks[i];
+        memset(b, 0, sizeof *b);
+        TRY(json_enum(p, e, P, "shape", block_shapes, &b->shape));
+        static const char *const k_box[] = {"shape", "phase", "velocity", "min", "max",
+                                            "comment", NULL};
+        static const char *const k_sph[] = {"shape", "phase", "velocity", "center", "radius",
+                                            "comment", NULL};
+        static const char *const k_cyl[] = {"shape", "phase", "velocity", "center", "radius",
+                                            "height", "axis", "comment", NULL};
+        const char *const *keys = b->shape == PFSPH_SHAPE_BOX      ? k_box
+                                  : b->shape == PFSPH_SHAPE_SPHERE ? k_sph
+                                                                   : k_cyl;
+        TRY(pfsph__json_check_keys(e, P, keys, &p->ctx));
+        TRY(parse_geometry(p, e, P, b->shape, b->min, b->max, b->center, &b->radius, &b->height,
+                           &b->axis));
+        TRY(vecd(p, e, P, "velocity", -VEL_MAX, VEL_MAX, b->velocity));
+        b->phase = def;
+        TRY(phase_ref(p, e, P, false, &b->phase));
+        if (b->phase < 0) {
+            char kp[160];
+            path_key(kp, sizeof kp, P, "phase");
+            return pfsph__json_fail(&p->ctx, kp, "no fluid or gas phase is defined in $.phases");
+        }
+        /* Spheres and cylinders also get their bounding box in min/max (used by samplers and
+         * the checks below). */
+        geo g = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
+        if (b->shape != PFSPH_SHAPE_BOX)
+            for (int k = 0; k < 3; k++) { b->min[k] = g.min[k]; b->max[k] = g.max[k]; }
+    }
+    s->nblocks = i;
+    return PFSPH_OK;
+}
+
+/* Checks across blocks and solids, once all of them are known. */
+static int check_blocks(parser *p)
+{
+    pfsph_scene *s = p->s;
+    const double sp = 2.0 * s->particle_radius;
+    const double tiny = 1e-9 * sp;
+    geo gs[PFSPH_MAX_BLOCKS];
+    for (int i = 0; i < s->nblocks; i++) {
+        const pfsph_block *b = &s->blocks[i];
+        char P[128], kp[160];
+        path_index(P, sizeof P, "$.fluid", i);
+        gs[i] = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
+        /* Empty: fewer than one particle along some axis. */
+        if (b->shape == PFSPH_SHAPE_BOX) {
+            for (int k = 0; k < s->dim; k++)
+                if (b->max[k] - b->min[k] < sp - tiny) {
+                    path_key(kp, sizeof kp, P, "max");
+                    return pfsph__json_fail(
+                        &p->ctx, kp,
+                        "block is %g m wide along %s, less than one particle "
+                        "spacing (%g m = 2 x particle_radius): it would hold no "
+                        "particle",
+                        b->max[k] - b->min[k], axis_names[k], sp);
+                }
+        } else {
+            if (b->radius < sp - tiny) {
+                path_key(kp, sizeof kp, P, "radius");
+                return pfsph__json_fail(&p->ctx, kp,
+                                        "radius %g m is less than one particle spacing (%g m = 2 x "
+                                        "particle_radius): too small to sample",
+                                        b->radius, sp);
+            }
+            if (b->shape == PFSPH_SHAPE_CYLINDER && s->dim == 3 && b->height < sp - tiny) {
+                path_key(kp, sizeof kp, P, "height");
+                return pfsph__json_fail(&p->ctx, kp,
+                                        "height %g m is less than one particle spacing (%g m)",
+                                        b->height, sp);
+            }
+        }
+        /* Inside the domain. */
+        for (int k = 0; k < s->dim; k++) {
+            double scale = fmax(1.0, fabs(s->domain_max[k] - s->domain_min[k]));
+            if (gs[i].min[k] < s->domain_min[k] - 1e-9 * scale ||
+                gs[i].max[k] > s->domain_max[k] + 1e-9 * scale) {
+                char a[96], c[96], lo[96], hi[96];
+                fmt_vec(a, sizeof a, s->dim, s->domain_min);
+                fmt_vec(c, sizeof c, s->dim, s->domain_max);
+                fmt_vec(lo, sizeof lo, s->dim, gs[i].min);
+                fmt_vec(hi, sizeof hi, s->dim, gs[i].max);
+                const char *key = b->shape != PFSPH_SHAPE_BOX
+                                      ? "center"
+                                      : (gs[i].min[k] < s->domain_min[k] ? "min" : "max");
+                path_key(kp, sizeof kp, P, key);
+                return pfsph__json_fail(
+                    &p->ctx, kp, "block %s .. %s extends outside the domain %s .. %s along %s", lo,
+                    hi, a, c, axis_names[k]);
+            }
+        }
+        /* Overlaps with earlier blocks. */
+        for (int j = 0; j < i; j++)
+            if (geo_overlap(&gs[j], &gs[i], sp))
+                return pfsph__json_fail(&p->ctx, P,
+                                        "overlaps $.fluid[%d] by more than half a particle spacing "
+                                        "(%g m); particles there would be created twice",
+                                        j, 0.5 * sp);
+        /* Solids: obstacles must not start inside fluid; container walls must not cut blocks. */
+        for (int j = 0; j < s->nsolids; j++) {
+            const pfsph_solid *so = &s->solids[j];
+            if (so->shape == PFSPH_SHAPE_PLANE) continue;
+            if (so->shape == PFSPH_SHAPE_CONTAINER) {
+                /* Partly inside the container's inner box but not wholly: crosses a wall. */
+                bool touches = true, inside = true;
+                for (int k = 0; k < s->dim; k++) {
+                    double lo = fmax(gs[i].min[k], so->min[k]), hi = fmin(gs[i].max[k], so->max[k]);
+                    if (hi - lo <= 0.5 * sp) touches = false;
+                    if (gs[i].min[k] < so->min[k] - 0.5 * sp) inside = false;
+                    bool top = so->open_top && k == 1;
+                    if (!top && gs[i].max[k] > so->max[k] + 0.5 * sp) inside = false;
+                }
+                if (touches && !inside)
+                    return pfsph__json_fail(&p->ctx, P,
+                                            "block crosses the walls of the container $.solids[%d]",
+                                            j);
+                continue;
+            }
+            geo g = geo_of(s->dim, so->shape, so->min, so->max, so->center, so->radius,
+                           so->height, so->axis);
+            if (geo_overlap(&g, &gs[i], sp))
+                return pfsph__json_fail(
+                    &p->ctx, P,
+                    "overlaps the solid $.solids[%d]; fluid particles would start "
+                    "inside it",
+                    j);
+        }
+    }
+    return PFSPH_OK;
+}
+
+static int parse_output(parser *p, const cJSON *root)
+{
+    pfsph_output *o = &p->s->output;
+    const cJSON *v = get(root, "output");
+    if (!v) return PFSPH_OK;
+    static const char *const keys[] = {"directory", "formats", "fields", "boundary",
+                                       "frame_interval", NULL};
+    const char *P = "$.output";
+    TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
+    TRY(pfsph__json_string(v, P, "directory", o->dir, sizeof o->dir, &p->ctx));
+    if (get(v, "directory") && !o->dir[0])
+        return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
+    TRY(pfsph__json_bool(v, P, "boundary", &o->write_boundary, &p->ctx));
+    TRY(pfsph__json_int(v, P, "frame_interval", 1, 1000000, &o->frame_interval, &p->ctx));
+    const cJSON *f = get(v, "formats");
+    if (f) {
+        static const char *const names[] = {"vtp", "ply", NULL};
+        if (!cJSON_IsArray(f))
+            return pfsph__json_fail(&p->ctx, "$.output.formats",
+                                    "expected an array of strings (\"vtp\", \"ply\")");
+        o->vtp = o->ply = false;
+        int i = 0;
+        for (const cJSON *e = f->child; e; e = e->next, i++) {
+            char ep[64];
+            path_index(ep, sizeof ep, "$.output.formats", i);
+            int idx = -1;
+            for (int k = 0; names[k] && cJSON_IsString(e); k++)
+                if (strcmp(e->valuestring, names[k]) == 0) idx = k;
+            if (idx < 0)
+                return pfsph__json_fail(&p->ctx, ep,
+                                        "unknown format (expected \"vtp\" or \"ply\")");
+            if (idx == 0) o->vtp = true;
+            else o->ply = true;
+        }
+    }
+    const cJSON *fl = get(v, "fields");
+    if (fl) {
+        static const char *const names[] = {"id", "speed", "accel", NULL};
+        static const unsigned bits[] = {PFSPH_OUT_ID, PFSPH_OUT_SPEED, PFSPH_OUT_ACCEL};
+        if (!cJSON_IsArray(fl))
+            return pfsph__json_fail(&p->ctx, "$.output.fields",
+                                    "expected an array of strings (\"id\", \"speed\", \"accel\")");
+        o->fields = 0;
+        int i = 0;
+        for (const cJSON *e = fl->child; e; e = e->next, i++) {
+            char ep[64];
+            path_index(ep, sizeof ep, "$.output.fields", i);
+            int idx = -1;
+            for (int k = 0; names[k] && cJSON_IsString(e); k++)
+                if (strcmp(e->valuestring, names[k]) == 0) idx = k;
+            if (idx < 0)
+                return pfsph__json_fail(&p->ctx, ep,
+                                        "unknown field (expected \"id\", \"speed\" or \"accel\")");
+            o->fields |= bits[idx];
+        }
+    }
+    return PFSPH_OK;
+}
+
+static int parse_camera(parser *p, const cJSON *root)
+{
+    pfsph_camera *c = &p->s->camera;
+    const cJSON *v = get(root, "camera");
+    if (!v) return PFSPH_OK;
+    static const char *const keys[] = {"eye", "target", "up", "fov", "width", "height",
+                                       "color_by", NULL};
+    const char *P = "$.camera";
+    TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
+    c->set = true;
+    /* The camera always lives in 3D: a 2D scene lies in the plane z = 0. */
+    TRY(pfsph__json_vec(v, P, "eye", 3, -COORD_MAX, COORD_MAX, c->eye, &p->ctx));
+    TRY(pfsph__json_vec(v, P, "target", 3, -COORD_MAX, COORD_MAX, c->target, &p->ctx));
+    TRY(pfsph__json_vec(v, P, "up", 3, -1e3, 1e3, c->up, &p->ctx));
+    TRY(pfsph__json_number(v, P, "fov", 1.0, 179.0, &c->fov_deg, &p->ctx));
+    TRY(pfsph__json_int(v, P, "width", 16, 16384, &c->width, &p->ctx));
+    TRY(pfsph__json_int(v, P, "height", 16, 16384, &c->height, &p->ctx));
+    int cb = 0;
+    static const char *const colors[] = {"phase", "speed", "density", "pressure", NULL};
+    TRY(json_enum(p, v, P, "color_by", colors, &cb));
+    snprintf(c->color_by, sizeof c->color_by, "%s", colors[cb]);
+    double d[3], u2 = 0, d2 = 0, cr2 = 0;
+    for (int k = 0; k < 3; k++) {
+        d[k] = c->target[k] - c->eye[k];
+        d2 += d[k] * d[k];
+        u2 += c->up[k] * c->up[k];
+    }
+    if (!(d2 > 0)) return pfsph__json_fail(&p->ctx, "$.camera.target", "target equals eye");
+    double cr[3] = {d[1] * c->up[2] - d[2] * c->up[1], d[2] * c->up[0] - d[0] * c->up[2],
+                    d[0] * c->up[1] - d[1] * c->up[0]};
+    for (int k = 0; k < 3; k++) cr2 += cr[k] * cr[k];
+    if (!(u2 > 0) || !(cr2 > 1e-12 * d2 * u2))
+        return pfsph__json_fail(&p->ctx, "$.camera.up",
+                                "up must be non-zero and not parallel to the view direction");
+    return PFSPH_OK;
+}
+
+/* A camera framing the domain, used when the scene names none (and as defaults for the keys a
+ * "camera" object leaves out). */
+static void auto_camera(pfsph_scene *s)
+{
+    pfsph_camera *c = &s->camera;
+    double ext = 0;
+    for (int k = 0; k < s->dim; k++) {
+        c->target[k] = 0.5 * (s->domain_min[k] + s->domain_max[k]);
+        ext = fmax(ext, s->domain_max[k] - s->domain_min[k]);
+    }
+    if (s->dim == 2) {
+        c->target[2] = 0;
+        c->eye[0] = c->target[0];
+        c->eye[1] = c->target[1];
+        c->eye[2] = 1.6 * ext;
+    } else {
+        c->eye[0] = c->target[0] + 0.35 * ext;
+        c->eye[1] = c->target[1] + 0.45 * ext;
+        c->eye[2] = c->target[2] + 1.4 * ext;
+    }
+}
+
+/* File name without directory and ".json": default scene name and output directory. */
+static void source_stem(const char *source, char *out, size_t cap)
+{
+    const char *b = source ? strrchr(source, '/') : NULL;
+    b = b ? b + 1 : (source ? source : "");
+    size_t n = strlen(b);
+    if (n > 5 && strcmp(b + n - 5, ".json") == 0) n -= 5;
+    size_t m = 0;
+    for (size_t i = 0; i < n && m + 1 < cap; i++) {
+        char ch = b[i];
+        bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                  (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' || ch == '.';
+        if (ok) out[m++] = ch;
+    }
+    out[m] = 0;
+    if (!m) snprintf(out, cap, "scene");
+}
+
+/* ---------------------------------------------------------------------------------------- */
+
+void pfsph_scene_defaults(pfsph_scene *s)
+{
+    memset(s, 0, sizeof *s);
+    snprintf(s->source, sizeof s->source, "<scene>");
+    snprintf(s->name, sizeof s->name, "scene");
+    s->dim = 3;
+    s->particle_radius = 0.01;
+    s->support_factor = 2.0;
+    s->gravity[1] = -9.81;
+    s->solver = PFSPH_SOLVER_PCISPH;
+    s->cfl = 0.4;
+    s->dt_min = 1e-6;
+    s->dt_max = 0.005;
+    s->end_time = 1.0;
+    s->fps = 25.0;
+    s->seed = 1;
+    s->threads = 0;
+    s->sound_speed = 0.0;
+    s->gamma = 7.0;
+    s->pcisph_tolerance = 0.005;
+    s->pcisph_min_iter = 3;
+    s->pcisph_max_iter = 50;
+    pfsph_pairwise_defaults(&s->pairwise);
+    pfsph_diffuse_defaults(&s->diffuse);
+    snprintf(s->output.dir, sizeof s->output.dir, "runs/scene");
+    s->output.vtp = true;
+    s->output.ply = false;
+    s->output.write_boundary = true;
+    s->output.fields = 0;
+    s->output.frame_interval = 1;
+    s->camera.set = false;
+    s->camera.up[1] = 1.0;
+    s->camera.eye[2] = 1.0;
+    s->camera.fov_deg = 40.0;
+    s->camera.width = 960;
+    s->camera.height = 540;
+    snprintf(s->camera.color_by, sizeof s->camera.color_by, "phase");
+}
+
+int pfsph_scene_phase_index(const pfsph_scene *s, const char *name)
+{
+    if (!s || !name) return -1;
+    for (int i = 0; i < s->nphases; i++)
+        if (strcmp(s->phases[i].name, name) == 0) return i;
+    return -1;
+}
+
+static int parse_root(parser *p, const cJSON *root)
+{
+    pfsph_scene *s = p->s;
+    static const char *const keys[] = {"name", "dimension", "particle_radius", "support_factor",
+                                       "gravity", "domain", "solver", "time", "seed", "threads",
+                                       "phases", "fluid", "solids", "pairwise", "diffuse",
+                                       "output", "camera", "comment", NULL};
+    if (!cJSON_IsObject(root))
+        return pfsph__json_fail(&p->ctx, "$", "a scene must be a JSON object { ... }");
+    TRY(pfsph__json_check_keys(root, "$", keys, &p->ctx));
+    /* Dimension first: it decides how many components every vector has. */
+    const cJSON *dv = get(root, "dimension");
+    if (dv && (!cJSON_IsNumber(dv) || (dv->valuedouble != 2.0 && dv->valuedouble != 3.0)))
+        return pfsph__json_fail(&p->ctx, "$.dimension", "must be 2 or 3");
+    TRY(pfsph__json_int(root, "$", "dimension", 2, 3, &s->dim, &p->ctx));
+    if (s->dim == 2) s->gravity[2] = 0;
+    const cJSON *nv = get(root, "name");
+    TRY(pfsph__json_string(root, "$", "name", s->name, sizeof s->name, &p->ctx));
+    if (nv && !s->name[0]) return pfsph__json_fail(&p->ctx, "$.name", "must not be empty");
+    TRY(pfsph__json_number(root, "$", "particle_radius", 1e-5, 10.0, &s->particle_radius,
+                           &p->ctx));
+    TRY(pfsph__json_number(root, "$", "support_factor", 1.0, 4.0, &s->support_factor, &p->ctx));
+    TRY(vecd(p, root, "$", "gravity", -GRAVITY_MAX, GRAVITY_MAX, s->gravity));
+    double seed = (double)s->seed;
+    TRY(pfsph__json_number(root, "$", "seed", 0.0, SEED_MAX, &seed, &p->ctx));
+    if (seed != floor(seed))
+        return pfsph__json_fail(&p->ctx, "$.seed", "expected an integer, got %g", seed);
+    s->seed = (uint64_t)seed;
+    TRY(pfsph__json_int(root, "$", "threads", 0, 4096, &s->threads, &p->ctx));
+    TRY(parse_domain(p, root));
+    TRY(parse_solver(p, root));
+    TRY(parse_time(p, root));
+    TRY(parse_phases(p, root));
+    TRY(parse_solids(p, root));
+    TRY(parse_fluid(p, root));
+    TRY(check_blocks(p));
+    /* Sub-parsers of other modules see every phase, the default solid phase included. */
+    const cJSON *pw = get(root, "pairwise");
+    if (pw) {
+        if (!cJSON_IsObject(pw))
+            return pfsph__json_fail(&p->ctx, "$.pairwise", "expected an object");
+        TRY(pfsph__scene_parse_pairwise(pw, "$.pairwise", s, &p->ctx));
+    }
+    const cJSON *df = get(root, "diffuse");
+    if (df) {
+        if (!cJSON_IsObject(df))
+            return pfsph__json_fail(&p->ctx, "$.diffuse", "expected an object");
+        TRY(pfsph__scene_parse_diffuse(df, "$.diffuse", s, &p->ctx));
+    }
+    auto_camera(s);
+    TRY(parse_output(p, root));
+    TRY(parse_camera(p, root));
+    return PFSPH_OK;
+}
+
+/* Line and column (1-based) of position pos in text. */
+static void line_col(const char *text, const char *pos, int *line, int *col)
+{
+    *line = 1;
+    *col = 1;
+    for (const char *c = text; *c && c < pos; c++) {
+        if (*c == '\n') { (*line)++; *col = 1; }
+        else (*col)++;
+    }
+}
+
+int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pfsph_error *err)
+{
+    if (!source) source = "<scene>";
+    pfsph_jctx ctx = {source, err};
+    if (!out || !json) return pfsph__json_fail(&ctx, "$", "no scene text");
+    /* Parse into a scratch scene so that *out is untouched on error. */
+    pfsph_scene *s = malloc(sizeof *s);
+    if (!s) return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", source);
+    pfsph_scene_defaults(s);
+    snprintf(s->source, sizeof s->source, "%s", source);
+    char stem[PFSPH_NAME_LEN];
+    source_stem(source, stem, sizeof stem);
+    snprintf(s->name, sizeof s->name, "%s", stem);
+    snprintf(s->output.dir, sizeof s->output.dir, "runs/%s", stem);
+
+    const char *p0 = json;
+    while (*p0 == ' ' || *p0 == '\t' || *p0 == '\n' || *p0 == '\r') p0++;
+    if (!*p0) {
+        free(s);
+        return pfsph__json_fail(&ctx, "$", "invalid JSON: the text is empty");
+    }
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithOpts(json, &end, 1);
+    if (!root) {
+        int line, col;
+        const char *pos = end ? end : json;
+        line_col(json, pos, &line, &col);
+        char near[24];
+        size_t n = 0;
+        for (const char *c = pos; *c && n < 16; c++)
+            near[n++] = (*c == '\n' || *c == '\t' || *c == '\r') ? ' ' : *c;
+        near[n] = 0;
+        free(s);
+        if (!*pos)
+            return pfsph__json_fail(&ctx, "$",
+                                    "invalid JSON: unexpected end of text at line %d, column %d "
+                                    "(missing '}' or ']'?)",
+                                    line, col);
+        return pfsph__json_fail(&ctx, "$", "invalid JSON at line %d, column %d, near \"%s\"", line,
+                                col, near);
+    }
+    parser p = {s, ctx};
+    int rc = parse_root(&p, root);
+    cJSON_Delete(root);
+    if (rc == PFSPH_OK) {
+        memcpy(out, s, sizeof *s);
+        if (err) { err->code = PFSPH_OK; err->msg[0] = 0; }
+    }
+    free(s);
+    return rc;
+}
+
+int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err)
+{
+    if (!path) return pfsph_fail(err, PFSPH_EIO, "no scene file given");
+    FILE *f = fopen(path, "rb");
+    if (!f) return pfsph_fail(err, PFSPH_EIO, "%s: cannot open: %s", path, strerror(errno));
+    /* Scenes are small; a limit keeps a wrong argument (a frame file, /dev/zero) harmless. */
+    const size_t cap = (size_t)16 << 20;
+    size_t n = 0, size = 4096;
+    char *buf = malloc(size);
+    if (!buf) {
+        fclose(f);
+        return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
+    }
+    for (;;) {
+        if (n + 1 >= size) {
+            if (size >= cap) {
+                free(buf);
+                fclose(f);
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "%s: $: file is larger than %zu MiB; not a scene", path,
+                                  cap >> 20);
+            }
+            char *nb = realloc(buf, size * 2);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
+            }
+            buf = nb;
+            size *= 2;
+        }
+        size_t r = fread(buf + n, 1, size - n - 1, f);
+        n += r;
+        if (r == 0) break;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        free(buf);
+        return pfsph_fail(err, PFSPH_EIO, "%s: read error", path);
+    }
+    buf[n] = 0;
+    if (strlen(buf) != n) {
+        free(buf);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: $: file contains a NUL byte; not a JSON scene",
+                          path);
+    }
+    int rc = pfsph_scene_parse(s, buf, path, err);
+    free(buf);
+    return rc;
+}

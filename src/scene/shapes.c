@@ -1,0 +1,302 @@
+/* Particle sampling of fluid blocks and solids. Fluid sits on a lattice of spacing d; solids
+ * are sampled with the same spacing so that Akinci volumes come out close to d^dim. */
+#include "shapes.h"
+
+#include <math.h>
+
+static const double PI = 3.14159265358979323846;
+
+static int emit(pfsph_particles *ps, long *count, double x, double y, double z,
+                const double *v, int phase)
+{
+    (*count)++;
+    if (!ps) return 0;
+    pfsph_real p[3] = {(pfsph_real)x, (pfsph_real)y, (pfsph_real)z};
+    pfsph_real vv[3] = {0, 0, 0};
+    if (v) for (int a = 0; a < 3; a++) vv[a] = (pfsph_real)v[a];
+    return pfsph_particles_push(ps, p, vv, (uint8_t)phase) < 0 ? -1 : 0;
+}
+
+static int inside_block(const pfsph_block *b, int dim, const double p[3])
+{
+    double r2 = 0;
+    switch (b->shape) {
+    case PFSPH_SHAPE_BOX:
+        for (int a = 0; a < dim; a++)
+            if (p[a] < b->min[a] || p[a] > b->max[a]) return 0;
+        return 1;
+    case PFSPH_SHAPE_SPHERE:
+        for (int a = 0; a < dim; a++) r2 += (p[a] - b->center[a]) * (p[a] - b->center[a]);
+        return r2 <= b->radius * b->radius;
+    case PFSPH_SHAPE_CYLINDER:
+        if (dim == 2) {
+            for (int a = 0; a < 2; a++) r2 += (p[a] - b->center[a]) * (p[a] - b->center[a]);
+            return r2 <= b->radius * b->radius;
+        }
+        for (int a = 0; a < 3; a++)
+            if (a != b->axis) r2 += (p[a] - b->center[a]) * (p[a] - b->center[a]);
+        return r2 <= b->radius * b->radius && fabs(p[b->axis] - b->center[b->axis]) <= 0.5 * b->height;
+    default:
+        return 0;
+    }
+}
+
+long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d,
+                         pfsph_particles *ps)
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    int dim = s->dim;
+    for (int a = 0; a < dim; a++) {
+        if (b->shape == PFSPH_SHAPE_BOX) {
+            lo[a] = b->min[a];
+            hi[a] = b->max[a];
+        } else {
+            double ext = b->radius;
+            if (b->shape == PFSPH_SHAPE_CYLINDER && dim == 3 && a == b->axis) ext = 0.5 * b->height;
+            lo[a] = b->center[a] - ext;
+            hi[a] = b->center[a] + ext;
+        }
+    }
+    long n[3] = {1, 1, 1};
+    for (int a = 0; a < dim; a++) n[a] = (long)floor((hi[a] - lo[a]) / d + 1e-9);
+    long count = 0;
+    for (long k = 0; k < n[2]; k++)
+        for (long j = 0; j < n[1]; j++)
+            for (long i = 0; i < n[0]; i++) {
+                /* lattice centred in the block so that a block of width w*d holds w cells */
+                double p[3] = {lo[0] + (hi[0] - lo[0] - (n[0] - 1) * d) * 0.5 + i * d,
+                               lo[1] + (hi[1] - lo[1] - (n[1] - 1) * d) * 0.5 + j * d,
+                               dim == 3 ? lo[2] + (hi[2] - lo[2] - (n[2] - 1) * d) * 0.5 + k * d : 0};
+                if (b->shape != PFSPH_SHAPE_BOX && !inside_block(b, dim, p)) continue;
+                if (emit(ps, &count, p[0], p[1], p[2], b->velocity, b->phase)) return -1;
+            }
+    return count;
+}
+
+/* Orthonormal basis (t1, t2) perpendicular to unit n. */
+static void basis(const double n[3], double t1[3], double t2[3])
+{
+    double a[3] = {1, 0, 0};
+    if (fabs(n[0]) > 0.9) a[0] = 0, a[1] = 1;
+    t1[0] = a[1] * n[2] - a[2] * n[1];
+    t1[1] = a[2] * n[0] - a[0] * n[2];
+    t1[2] = a[0] * n[1] - a[1] * n[0];
+    double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+    for (int i = 0; i < 3; i++) t1[i] /= l;
+    t2[0] = n[1] * t1[2] - n[2] * t1[1];
+    t2[1] = n[2] * t1[0] - n[0] * t1[2];
+    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+}
+
+/* Points on a sphere of radius r (3D: Fibonacci lattice, 2D: circle) at spacing ~d. */
+static int sample_sphere_layer(pfsph_particles *ps, long *count, const double c[3], double r,
+                               double d, int dim, int phase)
+{
+    if (r <= 0) return 0;
+    if (dim == 2) {
+        long m = (long)ceil(2 * PI * r / d);
+        if (m < 3) m = 3;
+        for (long i = 0; i < m; i++) {
+            double t = 2 * PI * (double)i / (double)m;
+            if (emit(ps, count, c[0] + r * cos(t), c[1] + r * sin(t), 0, NULL, phase)) return -1;
+        }
+        return 0;
+    }
+    long m = (long)ceil(4 * PI * r * r / (d * d));
+    if (m < 4) m = 4;
+    const double ga = PI * (3 - sqrt(5.0));
+    for (long i = 0; i < m; i++) {
+        double y = 1 - 2 * ((double)i + 0.5) / (double)m, rr = sqrt(1 - y * y), t = ga * (double)i;
+        if (emit(ps, count, c[0] + r * rr * cos(t), c[1] + r * y, c[2] + r * rr * sin(t), NULL, phase))
+            return -1;
+    }
+    return 0;
+}
+
+long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
+                         pfsph_particles *ps)
+{
+    const int dim = s->dim, L = o->layers < 1 ? 1 : o->layers;
+    long count = 0;
+    switch (o->shape) {
+    case PFSPH_SHAPE_CONTAINER:
+    case PFSPH_SHAPE_BOX: {
+        /* lattice cells of spacing d aligned with the box faces; a container keeps the L
+         * layers outside its faces, a box the L layers inside. */
+        int container = o->shape == PFSPH_SHAPE_CONTAINER;
+        long lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, n[3] = {1, 1, 1};
+        for (int a = 0; a < dim; a++) {
+            n[a] = (long)floor((o->max[a] - o->min[a]) / d + 0.5);
+            if (n[a] < 1) n[a] = 1;
+            lo[a] = container ? -L : 0;
+            hi[a] = container ? n[a] + L : n[a];
+        }
+        for (long k = lo[2]; k < (dim == 3 ? hi[2] : 1); k++)
+            for (long j = lo[1]; j < hi[1]; j++)
+                for (long i = lo[0]; i < hi[0]; i++) {
+                    long idx[3] = {i, j, k};
+                    int in_shell = 0;
+                    long depth = L; /* distance in cells from the surface */
+                    for (int a = 0; a < dim; a++) {
+                        long dd = idx[a] < n[a] - 1 - idx[a] ? idx[a] : n[a] - 1 - idx[a];
+                        if (container) {
+                            if (idx[a] < 0 || idx[a] >= n[a]) in_shell = 1;
+                        } else if (dd < depth)
+                            depth = dd;
+                    }
+                    if (container) {
+                        if (!in_shell) continue;
+                        if (o->open_top && j >= n[1]) continue;
+                    } else if (depth >= L)
+                        continue;
+                    double p[3] = {0, 0, 0};
+                    for (int a = 0; a < dim; a++) {
+                        double w = (o->max[a] - o->min[a]) / (double)n[a];
+                        p[a] = o->min[a] + ((double)idx[a] + 0.5) * w;
+                    }
+                    if (emit(ps, &count, p[0], p[1], p[2], NULL, o->phase)) return -1;
+                }
+        return count;
+    }
+    case PFSPH_SHAPE_SPHERE:
+        for (int l = 0; l < L; l++)
+            if (sample_sphere_layer(ps, &count, o->center, o->radius - (l + 0.5) * d, d, dim, o->phase))
+                return -1;
+        return count;
+    case PFSPH_SHAPE_CYLINDER: {
+        if (dim == 2) {
+            for (int l = 0; l < L; l++)
+                if (sample_sphere_layer(ps, &count, o->center, o->radius - (l + 0.5) * d, d, 2, o->phase))
+                    return -1;
+            return count;
+        }
+        int ax = o->axis, u = (ax + 1) % 3, v = (ax + 2) % 3;
+        long nh = (long)floor(o->height / d + 0.5);
+        if (nh < 1) nh = 1;
+        double dh = o->height / (double)nh;
+        for (long k = 0; k < nh; k++) {
+            double t = -0.5 * o->height + (k + 0.5) * dh;
+            long kd = k < nh - 1 - k ? k : nh - 1 - k; /* layers from the caps */
+            for (int l = 0; l < L; l++) {
+                double r = o->radius - (l + 0.5) * d;
+                if (r <= 0) break;
+                long m = (long)ceil(2 * PI * r / d);
+                for (long i = 0; i < m; i++) {
+                    double th = 2 * PI * (double)i / (double)m + 0.5 * (double)(k & 1) * 2 * PI / (double)m;
+                    double p[3];
+                    p[ax] = o->center[ax] + t;
+                    p[u] = o->center[u] + r * cos(th);
+                    p[v] = o->center[v] + r * sin(th);
+                    if (emit(ps, &count, p[0], p[1], p[2], NULL, o->phase)) return -1;
+                }
+            }
+            if (kd < L) {
+                /* caps: fill the disc inside the lateral layers with rings */
+                for (double r = o->radius - (L + 0.5) * d; r > 0.25 * d; r -= d) {
+                    long m = (long)ceil(2 * PI * r / d);
+                    for (long i = 0; i < m; i++) {
+                        double th = 2 * PI * (double)i / (double)m;
+                        double p[3];
+                        p[ax] = o->center[ax] + t;
+                        p[u] = o->center[u] + r * cos(th);
+                        p[v] = o->center[v] + r * sin(th);
+                        if (emit(ps, &count, p[0], p[1], p[2], NULL, o->phase)) return -1;
+                    }
+                }
+                double p[3];
+                p[ax] = o->center[ax] + t;
+                p[u] = o->center[u];
+                p[v] = o->center[v];
+                if (emit(ps, &count, p[0], p[1], p[2], NULL, o->phase)) return -1;
+            }
+        }
+        return count;
+    }
+    case PFSPH_SHAPE_PLANE: {
+        double nrm[3] = {o->normal[0], o->normal[1], dim == 3 ? o->normal[2] : 0};
+        double ln = sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+        for (int a = 0; a < 3; a++) nrm[a] /= ln;
+        double t1[3], t2[3];
+        if (dim == 2) {
+            t1[0] = -nrm[1], t1[1] = nrm[0], t1[2] = 0;
+            t2[0] = t2[1] = t2[2] = 0;
+        } else
+            basis(nrm, t1, t2);
+        /* extent: the domain's diagonal around the plane point, clipped to the domain */
+        double diag = 0;
+        for (int a = 0; a < dim; a++)
+            diag += (s->domain_max[a] - s->domain_min[a]) * (s->domain_max[a] - s->domain_min[a]);
+        diag = sqrt(diag);
+        long m = (long)ceil(diag / d);
+        long m2 = dim == 3 ? m : 0;
+        for (int l = 0; l < L; l++)
+            for (long j = -m2; j <= m2; j++)
+                for (long i = -m; i <= m; i++) {
+                    double p[3];
+                    for (int a = 0; a < 3; a++)
+                        p[a] = o->center[a] + ((double)i * t1[a] + (double)j * t2[a]) * d -
+                               (l + 0.5) * d * nrm[a];
+                    int in = 1;
+                    for (int a = 0; a < dim; a++)
+                        if (p[a] < s->domain_min[a] - L * d || p[a] > s->domain_max[a] + L * d) in = 0;
+                    if (!in) continue;
+                    if (dim == 2) p[2] = 0;
+                    if (emit(ps, &count, p[0], p[1], p[2], NULL, o->phase)) return -1;
+                }
+        return count;
+    }
+    default:
+        return 0;
+    }
+}
+
+double pfsph__solid_distance(const pfsph_solid *o, int dim, const double p[3])
+{
+    switch (o->shape) {
+    case PFSPH_SHAPE_CONTAINER: {
+        double m = INFINITY;
+        for (int a = 0; a < dim; a++) {
+            double lo = p[a] - o->min[a], hi = o->max[a] - p[a];
+            if (lo < m) m = lo;
+            if (!(a == 1 && o->open_top) && hi < m) m = hi;
+        }
+        return m;
+    }
+    case PFSPH_SHAPE_BOX: {
+        double out = 0, in = -INFINITY;
+        for (int a = 0; a < dim; a++) {
+            double c = 0.5 * (o->min[a] + o->max[a]), e = 0.5 * (o->max[a] - o->min[a]);
+            double q = fabs(p[a] - c) - e;
+            if (q > 0) out += q * q;
+            if (q > in) in = q;
+        }
+        return out > 0 ? sqrt(out) : in;
+    }
+    case PFSPH_SHAPE_SPHERE: {
+        double r2 = 0;
+        for (int a = 0; a < dim; a++) r2 += (p[a] - o->center[a]) * (p[a] - o->center[a]);
+        return sqrt(r2) - o->radius;
+    }
+    case PFSPH_SHAPE_CYLINDER: {
+        double r2 = 0;
+        if (dim == 2) {
+            for (int a = 0; a < 2; a++) r2 += (p[a] - o->center[a]) * (p[a] - o->center[a]);
+            return sqrt(r2) - o->radius;
+        }
+        for (int a = 0; a < 3; a++)
+            if (a != o->axis) r2 += (p[a] - o->center[a]) * (p[a] - o->center[a]);
+        double dr = sqrt(r2) - o->radius, dz = fabs(p[o->axis] - o->center[o->axis]) - 0.5 * o->height;
+        if (dr > 0 && dz > 0) return sqrt(dr * dr + dz * dz);
+        return dr > dz ? dr : dz;
+    }
+    case PFSPH_SHAPE_PLANE: {
+        double ln = 0, s = 0;
+        for (int a = 0; a < dim; a++) ln += o->normal[a] * o->normal[a];
+        ln = sqrt(ln);
+        for (int a = 0; a < dim; a++) s += (p[a] - o->center[a]) * o->normal[a] / ln;
+        return s;
+    }
+    default:
+        return INFINITY;
+    }
+}

@@ -1,0 +1,19 @@
+/* Internal: sampling scene shapes with particles, and signed distances to solids. */
+#ifndef PFSPH_SHAPES_H
+#define PFSPH_SHAPES_H
+
+#include "pfsph/particles.h"
+#include "pfsph/scene.h"
+
+/* Append the fluid particles of a block on a lattice of spacing d (cell centres from the
+ * block's min corner / bounding box). ps may be NULL to only count. Returns the count or -1. */
+long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d,
+                         pfsph_particles *ps);
+/* Append the boundary particles of a solid (its `layers` layers at spacing d, the first layer
+ * centred d/2 inside the solid surface). ps may be NULL to only count. */
+long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
+                         pfsph_particles *ps);
+/* Signed distance from p to the solid's surface, positive on the fluid side. */
+double pfsph__solid_distance(const pfsph_solid *o, int dim, const double p[3]);
+
+#endif

@@ -1,0 +1,314 @@
+/* PNG previews: a hand-made run directory (scene.json + frames written with the frame writers)
+ * is rendered; the images must have the requested size, show particles where they project and
+ * leave the corners as background. */
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "pfsph/io.h"
+#include "pfsph/render.h"
+#include "testutil.h"
+
+typedef struct img {
+    int w, h;
+    unsigned char *rgb;
+} img;
+
+static img load_png(const char *path)
+{
+    img m = {0};
+    FILE *f = fopen(path, "rb");
+    if (!f) fail_msg("cannot open %s", path);
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png_create_info_struct(png);
+    if (setjmp(png_jmpbuf(png))) fail_msg("libpng failed on %s", path);
+    png_init_io(png, f);
+    png_read_info(png, info);
+    assert_int_equal(png_get_color_type(png, info), PNG_COLOR_TYPE_RGB);
+    assert_int_equal(png_get_bit_depth(png, info), 8);
+    m.w = (int)png_get_image_width(png, info);
+    m.h = (int)png_get_image_height(png, info);
+    m.rgb = malloc((size_t)m.w * m.h * 3);
+    for (int y = 0; y < m.h; y++) png_read_row(png, m.rgb + (size_t)y * m.w * 3, NULL);
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    return m;
+}
+
+static const unsigned char *px(const img *m, int x, int y)
+{
+    assert_true(x >= 0 && y >= 0 && x < m->w && y < m->h);
+    return m->rgb + 3 * ((size_t)y * m->w + x);
+}
+
+static int is_background_top(const unsigned char *p)
+{
+    /* The renderer's background at the top row: (0.945, 0.950, 0.965). */
+    return abs(p[0] - 241) <= 2 && abs(p[1] - 242) <= 2 && abs(p[2] - 246) <= 2;
+}
+
+static int bluish(const unsigned char *p) { return p[2] > p[0] + 40; }
+
+static void write_or_fail(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o)
+{
+    pfsph_error err;
+    if (pfsph_write_vtp(path, ps, o, &err) != PFSPH_OK) fail_msg("%s", err.msg);
+}
+
+static void block(pfsph_particles *ps, double x0, double y0, double z0, int nx, int ny, int nz,
+                  double dx, uint8_t phase, double vx)
+{
+    for (int k = 0; k < nz; k++)
+        for (int j = 0; j < ny; j++)
+            for (int i = 0; i < nx; i++) {
+                pfsph_real x[3] = {(pfsph_real)(x0 + i * dx), (pfsph_real)(y0 + j * dx),
+                                   (pfsph_real)(z0 + k * dx)};
+                pfsph_real v[3] = {(pfsph_real)(vx * i), 0, 0};
+                long id = pfsph_particles_push(ps, x, v, phase);
+                assert_true(id >= 0);
+                ps->rho[id] = (pfsph_real)(1000 + j);
+            }
+}
+
+static const char *make_run(const char *name, const char *scene_json)
+{
+    static char run[512];
+    snprintf(run, sizeof run, "%s/%s", tu_tmpdir(), name);
+    assert_int_equal(mkdir(run, 0755), 0);
+    char p[600];
+    snprintf(p, sizeof p, "%s/frames", run);
+    assert_int_equal(mkdir(p, 0755), 0);
+    snprintf(p, sizeof p, "%s/scene.json", run);
+    assert_int_equal(tu_write_file(p, scene_json), 0);
+    return run;
+}
+
+static const char SCENE_2D[] =
+    "{\n"
+    "  \"name\": \"render test 2d\", \"dimension\": 2, \"particle_radius\": 0.01,\n"
+    "  \"gravity\": [0, -9.81],\n"
+    "  \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},\n"
+    "  \"time\": {\"end\": 0.1, \"fps\": 10},\n"
+    "  \"phases\": [\n"
+    "    {\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": 1e-3,\n"
+    "     \"color\": [0.1, 0.3, 0.9]},\n"
+    "    {\"name\": \"wall\", \"kind\": \"solid\"}\n"
+    "  ],\n"
+    "  \"fluid\": [{\"shape\": \"box\", \"min\": [0.1, 0.1], \"max\": [0.4, 0.4]}],\n"
+    "  \"solids\": [{\"shape\": \"container\", \"min\": [0.02, 0.02], \"max\": [0.98, 0.98],\n"
+    "              \"layers\": 1, \"phase\": \"wall\"}]\n"
+    "}\n";
+
+/* Output pixel of a world point for the 2D view: the domain [0,1]^2 fills 94 % of the shorter
+ * image side, centred. */
+static void to_px(int w, int h, double x, double y, int *ix, int *iy)
+{
+    double s = 0.94 * (w < h ? w : h);
+    *ix = (int)(0.5 * w + (x - 0.5) * s);
+    *iy = (int)(0.5 * h - (y - 0.5) * s);
+}
+
+static void test_render_2d(void **state)
+{
+    (void)state;
+    const char *run = make_run("run2d", SCENE_2D);
+    char p[700];
+    pfsph_particles fl, bd, df;
+    pfsph_io_opts o = {.dim = 2, .write_speed = true};
+    /* Frame 0: a block in the lower left; frame 1: the block moved right; boundary only at
+     * frame 0 (frame 1 must reuse it); diffuse particles at frame 1. */
+    for (int f = 0; f < 2; f++) {
+        assert_int_equal(pfsph_particles_init(&fl, 64), PFSPH_OK);
+        block(&fl, 0.1 + 0.4 * f, 0.1, 0, 16, 16, 1, 0.02, 0, 0.1);
+        o.time = 0.1 * f;
+        snprintf(p, sizeof p, "%s/frames/fluid_%05d.vtp", run, f);
+        write_or_fail(p, &fl, &o);
+        pfsph_particles_free(&fl);
+    }
+    assert_int_equal(pfsph_particles_init(&bd, 64), PFSPH_OK);
+    block(&bd, 0.02, 0.02, 0, 49, 1, 1, 0.02, 1, 0);  /* floor */
+    block(&bd, 0.02, 0.04, 0, 1, 48, 1, 0.02, 1, 0);  /* left wall */
+    block(&bd, 0.98, 0.04, 0, 1, 48, 1, 0.02, 1, 0);  /* right wall */
+    o.aux_name = "volume";
+    snprintf(p, sizeof p, "%s/frames/boundary_00000.vtp", run);
+    write_or_fail(p, &bd, &o);
+    pfsph_particles_free(&bd);
+    assert_int_equal(pfsph_particles_init(&df, 8), PFSPH_OK);
+    block(&df, 0.7, 0.8, 0, 3, 1, 1, 0.05, 2, 0);
+    o.aux_name = "lifetime";
+    snprintf(p, sizeof p, "%s/frames/diffuse_00001.vtp", run);
+    write_or_fail(p, &df, &o);
+    pfsph_particles_free(&df);
+
+    pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1,
+                            .quiet = true};
+    pfsph_error err = {0};
+    int count = -1;
+    int rc = pfsph_render_run(run, &ro, &count, &err);
+    if (rc) fail_msg("%s", err.msg);
+    assert_int_equal(count, 2);
+    for (int f = 0; f < 2; f++) {
+        snprintf(p, sizeof p, "%s/png/frame_%05d.png", run, f);
+        img m = load_png(p);
+        assert_int_equal(m.w, 320);
+        assert_int_equal(m.h, 180);
+        int ix, iy;
+        /* A particle near the middle of the fluid block: water colour (blue). */
+        to_px(m.w, m.h, 0.26 + 0.4 * f, 0.26, &ix, &iy);
+        const unsigned char *c = px(&m, ix, iy);
+        assert_false(is_background_top(c));
+        assert_true(bluish(c));
+        /* Where the block was in frame 0 is empty in frame 1. */
+        to_px(m.w, m.h, 0.26, 0.26, &ix, &iy);
+        if (f == 1) assert_false(bluish(px(&m, ix, iy)));
+        /* Floor (from boundary_00000 in both frames): grey, not blue. */
+        to_px(m.w, m.h, 0.8, 0.02, &ix, &iy);
+        c = px(&m, ix, iy);
+        assert_true(c[0] < 235 && abs(c[0] - c[2]) < 30);
+        /* Corners are background. */
+        assert_true(is_background_top(px(&m, 0, 0)));
+        assert_true(is_background_top(px(&m, m.w - 1, 0)));
+        free(m.rgb);
+    }
+    /* A frame range renders only that frame; colour by speed works. */
+    ro.first = ro.last = 1;
+    ro.color_by = "speed";
+    assert_int_equal(pfsph_render_run(run, &ro, &count, &err), PFSPH_OK);
+    assert_int_equal(count, 1);
+    /* Unknown colouring is an input error. */
+    ro.color_by = "temperature";
+    assert_int_equal(pfsph_render_run(run, &ro, &count, &err), PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "temperature"));
+}
+
+static const char SCENE_3D[] =
+    "{\n"
+    "  \"name\": \"render test 3d\", \"dimension\": 3, \"particle_radius\": 0.02,\n"
+    "  \"gravity\": [0, -9.81, 0],\n"
+    "  \"domain\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]},\n"
+    "  \"time\": {\"end\": 0.1, \"fps\": 10},\n"
+    "  \"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"color\": [0.1, 0.3, 0.9]}],\n"
+    "  \"fluid\": [{\"shape\": \"box\", \"min\": [0.3, 0.3, 0.3], \"max\": [0.7, 0.7, 0.7]}]\n"
+    "  %s\n"
+    "}\n";
+
+/* use_ply: the frame exists only as .ply (runs that write PLY alone render too). */
+static void run_3d(const char *name, const char *camera, int use_ply)
+{
+    char json[2048];
+    snprintf(json, sizeof json, SCENE_3D, camera);
+    const char *run = make_run(name, json);
+    pfsph_particles fl;
+    assert_int_equal(pfsph_particles_init(&fl, 1000), PFSPH_OK);
+    block(&fl, 0.32, 0.32, 0.32, 10, 10, 10, 0.04, 0, 0);
+    char p[700];
+    snprintf(p, sizeof p, "%s/frames/fluid_00000.%s", run, use_ply ? "ply" : "vtp");
+    pfsph_io_opts o = {.dim = 3};
+    pfsph_error werr;
+    if ((use_ply ? pfsph_write_ply : pfsph_write_vtp)(p, &fl, &o, &werr)) fail_msg("%s", werr.msg);
+    pfsph_particles_free(&fl);
+    pfsph_render_opts ro = {.width = 200, .height = 150, .last = -1, .quiet = true};
+    pfsph_error err = {0};
+    int count = 0;
+    if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
+    assert_int_equal(count, 1);
+    snprintf(p, sizeof p, "%s/png/frame_00000.png", run);
+    img m = load_png(p);
+    assert_int_equal(m.w, 200);
+    assert_int_equal(m.h, 150);
+    /* Both cameras look at the centre of the cube of particles. */
+    const unsigned char *c = px(&m, 100, 75);
+    assert_true(bluish(c));
+    assert_true(is_background_top(px(&m, 0, 0)));
+    assert_true(is_background_top(px(&m, m.w - 1, 0)));
+    /* Shading: the sphere surfaces are not one flat colour. */
+    int lo = 255, hi = 0;
+    for (int y = 50; y < 100; y++)
+        for (int x = 75; x < 125; x++) {
+            int b = px(&m, x, y)[2];
+            lo = b < lo ? b : lo;
+            hi = b > hi ? b : hi;
+        }
+    assert_true(hi - lo > 30);
+    free(m.rgb);
+}
+
+static void test_render_3d_default_camera(void **state)
+{
+    (void)state;
+    run_3d("run3d_auto", "", 0);
+}
+
+static void test_render_3d_scene_camera(void **state)
+{
+    (void)state;
+    run_3d("run3d_cam", ", \"camera\": {\"eye\": [0.5, 1.5, 2.5], \"target\": [0.5, 0.5, 0.5], "
+                        "\"up\": [0, 1, 0], \"fov\": 35, \"width\": 64, \"height\": 64}",
+           1);
+}
+
+static void test_render_errors(void **state)
+{
+    (void)state;
+    pfsph_render_opts ro = {.last = -1, .quiet = true};
+    pfsph_error err = {0};
+    int count = 7;
+    char run[512];
+    snprintf(run, sizeof run, "%s/missing", tu_tmpdir());
+    assert_int_not_equal(pfsph_render_run(run, &ro, &count, &err), PFSPH_OK);
+    assert_int_equal(count, 0);
+    assert_non_null(strstr(err.msg, "missing"));
+    /* A run without frames. */
+    const char *r = make_run("noframes", SCENE_2D);
+    assert_int_equal(pfsph_render_run(r, &ro, &count, &err), PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "frames"));
+    /* A corrupt frame is reported with its file name. */
+    char p[700];
+    snprintf(p, sizeof p, "%s/frames/fluid_00000.vtp", r);
+    assert_int_equal(tu_write_file(p, "<VTKFile>garbage"), 0);
+    assert_int_not_equal(pfsph_render_run(r, &ro, &count, &err), PFSPH_OK);
+    assert_non_null(strstr(err.msg, "fluid_00000.vtp"));
+}
+
+static void test_render_video(void **state)
+{
+    (void)state;
+    char out[256];
+    if (tu_run("command -v ffmpeg", out, sizeof out) != 0) skip();
+    const char *run = make_run("video", SCENE_2D);
+    char p[700];
+    pfsph_io_opts o = {.dim = 2};
+    for (int f = 0; f < 3; f++) {
+        pfsph_particles fl;
+        assert_int_equal(pfsph_particles_init(&fl, 64), PFSPH_OK);
+        block(&fl, 0.1 + 0.1 * f, 0.1, 0, 8, 8, 1, 0.02, 0, 0);
+        snprintf(p, sizeof p, "%s/frames/fluid_%05d.vtp", run, f);
+        write_or_fail(p, &fl, &o);
+        pfsph_particles_free(&fl);
+    }
+    pfsph_render_opts ro = {.width = 96, .height = 64, .video = true, .last = -1, .quiet = true};
+    pfsph_error err = {0};
+    int count = 0;
+    if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
+    assert_int_equal(count, 3);
+    snprintf(p, sizeof p, "%s/frames.mp4", run);
+    struct stat st;
+    assert_int_equal(stat(p, &st), 0);
+    assert_true(st.st_size > 100);
+}
+
+int main(int argc, char **argv)
+{
+    tu_init(argc, argv);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_render_2d),
+        cmocka_unit_test(test_render_3d_default_camera),
+        cmocka_unit_test(test_render_3d_scene_camera),
+        cmocka_unit_test(test_render_errors),
+        cmocka_unit_test(test_render_video),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
