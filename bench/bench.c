@@ -24,18 +24,20 @@ static void usage(void)
 
 /* Mean number of neighbours j != i within h of each fluid particle: fluid ones through the
  * fluid grid, boundary ones through the boundary grid. Uses the grid of the last step. */
-static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_nb)
+static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_nb,
+                             double *fluid_cand)
 {
     const pfsph_particles *f = c->fluid, *b = c->boundary;
     const double h2 = (double)c->h * (double)c->h;
-    long long nf = 0, nb = 0;
+    long long nf = 0, nb = 0, nc = 0;
     const long n = (long)f->n;
-#pragma omp parallel for reduction(+ : nf, nb) schedule(static)
+#pragma omp parallel for reduction(+ : nf, nb, nc) schedule(static)
     for (long i = 0; i < n; i++) {
         pfsph_ranges r;
         pfsph_grid_ranges(c->grid, f->x[i], f->y[i], f->z[i], &r);
         for (int k = 0; k < r.n; k++)
             for (uint32_t j = r.b[k]; j < r.e[k]; j++) {
+                nc++;
                 if ((long)j == i) continue;
                 double dx = f->x[i] - f->x[j], dy = f->y[i] - f->y[j], dz = f->z[i] - f->z[j];
                 if (dx * dx + dy * dy + dz * dz < h2) nf++;
@@ -52,6 +54,7 @@ static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_n
     }
     *fluid_nb = n > 0 ? (double)nf / (double)n : 0;
     *bnd_nb = n > 0 ? (double)nb / (double)n : 0;
+    *fluid_cand = n > 0 ? (double)nc / (double)n : 0;
 }
 
 int main(int argc, char **argv)
@@ -172,9 +175,11 @@ int main(int argc, char **argv)
     printf("  wall time           %.3f s (%.2f ms/step)\n", wall, done ? 1e3 * wall / (double)done : 0);
     printf("  throughput          %.4g fluid particle-steps/s\n", rate);
 
-    double nbf = 0, nbb = 0;
-    count_neighbours(ctx, &nbf, &nbb);
+    double nbf = 0, nbb = 0, ncand = 0;
+    count_neighbours(ctx, &nbf, &nbb, &ncand);
     printf("  neighbours within h %.1f fluid + %.1f boundary per fluid particle\n", nbf, nbb);
+    printf("  grid candidates     %.1f fluid particles tested per fluid particle (cell %.4g m)\n",
+           ncand, (double)ctx->grid->cell);
     const double avg_it = done ? (double)iters / (double)done : 0;
     if (pcisph) printf("  PCISPH iterations   %.2f per step (average)\n", avg_it);
 
@@ -197,10 +202,10 @@ int main(int argc, char **argv)
 
     /* One line for grep. */
     printf("BENCH solver=%s pairwise=%d threads=%d fluid=%zu boundary=%zu steps=%ld wall_s=%.3f "
-           "psteps_per_s=%.4g iters=%.2f nb_fluid=%.1f nb_bnd=%.1f bytes_per_particle=%.0f "
+           "psteps_per_s=%.4g iters=%.2f nb_fluid=%.1f nb_bnd=%.1f cand=%.1f bytes_per_particle=%.0f "
            "status=%s\n",
            pcisph ? "pcisph" : "wcsph", pairwise, threads > 0 ? threads : omp_get_max_threads(),
-           n_fluid0, n_bnd, done, wall, rate, avg_it, nbf, nbb, bpp,
+           n_fluid0, n_bnd, done, wall, rate, avg_it, nbf, nbb, ncand, bpp,
            rc == PFSPH_OK ? "ok" : "failed");
     pfsph_sim_destroy(sim);
     return rc == PFSPH_OK ? 0 : 3;
