@@ -223,7 +223,7 @@ static void test_default_scene(void **state)
     if (rc) fail_msg("%s", err.msg);
     const pfsph_scene *s = &g_scene;
     assert_int_equal(s->dim, 3);
-    assert_int_equal(s->solver, PFSPH_SOLVER_PCISPH);
+    assert_int_equal(s->solver, PFSPH_SOLVER_WCSPH); /* the solver whose hydrostatic pressure is validated */
     assert_string_equal(s->output.dir, "pfsph_default_run");
     assert_true(s->output.vtp && s->output.ply);
     assert_true(s->fps == 25 && s->end_time >= 1.0 && s->end_time <= 1.5);
