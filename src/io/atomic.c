@@ -4,6 +4,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -171,6 +172,27 @@ int pfsph__enc_init(pfsph__enc *e, pfsph__afile *a, pfsph_error *err)
     e->buf = malloc(e->cap);
     if (!e->buf) return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", a->path);
     return PFSPH_OK;
+}
+
+int pfsph__enc_open(pfsph__enc *e, pfsph__afile *a, const char *path, pfsph_error *err)
+{
+    int rc = pfsph__afile_open(a, path, err);
+    if (rc != PFSPH_OK) return rc;
+    rc = pfsph__enc_init(e, a, err);
+    if (rc != PFSPH_OK) pfsph__afile_abort(a);
+    return rc;
+}
+
+void pfsph__enc_printf(pfsph__enc *e, const char *fmt, ...)
+{
+    char line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    int len = vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (len < 0) return;
+    if ((size_t)len >= sizeof line) len = (int)sizeof line - 1;
+    pfsph__enc_put_text(e, line, (size_t)len);
 }
 
 int pfsph__enc_flush(pfsph__enc *e)

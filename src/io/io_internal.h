@@ -73,6 +73,14 @@ typedef struct pfsph__enc {
 } pfsph__enc;
 
 int pfsph__enc_init(pfsph__enc *e, pfsph__afile *a, pfsph_error *err);
+/* Open the atomic file and the buffer in front of it; on failure nothing is left behind. */
+int pfsph__enc_open(pfsph__enc *e, pfsph__afile *a, const char *path, pfsph_error *err);
+/* printf-style header text (at most 1 KiB per call). */
+void pfsph__enc_printf(pfsph__enc *e, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 int pfsph__enc_flush(pfsph__enc *e);
 void pfsph__enc_free(pfsph__enc *e);
 

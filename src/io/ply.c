@@ -21,32 +21,20 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
     }
     const size_t n = ps->n, rs = sizeof(pfsph_real);
     pfsph__afile af;
-    int rc = pfsph__afile_open(&af, path, err);
-    if (rc != PFSPH_OK) return rc;
     pfsph__enc e;
-    rc = pfsph__enc_init(&e, &af, err);
-    if (rc != PFSPH_OK) {
-        pfsph__afile_abort(&af);
-        return rc;
-    }
-    char line[256];
-#define EMIT(...)                                                                          \
-    do {                                                                                   \
-        int len_ = snprintf(line, sizeof line, __VA_ARGS__);                               \
-        pfsph__enc_put_text(&e, line, (size_t)len_);                                       \
-    } while (0)
-    EMIT("ply\nformat binary_little_endian 1.0\ncomment pfsph %s\n", PFSPH_VERSION);
+    int rc = pfsph__enc_open(&e, &af, path, err);
+    if (rc != PFSPH_OK) return rc;
+    pfsph__enc_printf(&e, "ply\nformat binary_little_endian 1.0\ncomment pfsph %s\n", PFSPH_VERSION);
     /* %.17g round-trips every double exactly. */
-    EMIT("comment time %.17g\n", o->time);
-    EMIT("element vertex %zu\n", n);
+    pfsph__enc_printf(&e, "comment time %.17g\n", o->time);
+    pfsph__enc_printf(&e, "element vertex %zu\n", n);
     static const char *const names[] = {"x", "y", "z", "vx", "vy", "vz", "density", "pressure"};
-    for (int k = 0; k < 8; k++) EMIT("property %s %s\n", REAL_PLY, names[k]);
-    EMIT("property uchar phase\n");
-    if (o->write_id) EMIT("property uint id\n");
-    if (o->write_speed) EMIT("property %s speed\n", REAL_PLY);
-    if (o->aux_name) EMIT("property %s %s\n", REAL_PLY, o->aux_name);
-    EMIT("end_header\n");
-#undef EMIT
+    for (int k = 0; k < 8; k++) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, names[k]);
+    pfsph__enc_printf(&e, "property uchar phase\n");
+    if (o->write_id) pfsph__enc_printf(&e, "property uint id\n");
+    if (o->write_speed) pfsph__enc_printf(&e, "property %s speed\n", REAL_PLY);
+    if (o->aux_name) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, o->aux_name);
+    pfsph__enc_printf(&e, "end_header\n");
     const pfsph_real zero = 0;
     const bool d2 = o->dim == 2;
     for (size_t i = 0; i < n; i++) {

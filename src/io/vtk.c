@@ -87,50 +87,39 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
     arr[na++] = (vtp_array){A_OFFS, "offsets", itype, 1, is * n};
 
     pfsph__afile af;
-    int rc = pfsph__afile_open(&af, path, err);
-    if (rc != PFSPH_OK) return rc;
     pfsph__enc e;
-    rc = pfsph__enc_init(&e, &af, err);
-    if (rc != PFSPH_OK) {
-        pfsph__afile_abort(&af);
-        return rc;
-    }
+    int rc = pfsph__enc_open(&e, &af, path, err);
+    if (rc != PFSPH_OK) return rc;
 
     /* XML header: every array's offset is the running sum of (8-byte header + data). */
-    char line[512];
-#define EMIT(...)                                                                          \
-    do {                                                                                   \
-        int len_ = snprintf(line, sizeof line, __VA_ARGS__);                               \
-        pfsph__enc_put_text(&e, line, (size_t)len_);                                       \
-    } while (0)
     uint64_t off = 0;
-    EMIT("<?xml version=\"1.0\"?>\n");
-    EMIT("<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+    pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n");
+    pfsph__enc_printf(&e, "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
          "header_type=\"UInt64\">\n  <PolyData>\n");
     for (int k = 0; k < na; k++) {
         const vtp_array *a = &arr[k];
         switch (a->kind) {
-        case A_TIME: EMIT("    <FieldData>\n"); break;
+        case A_TIME: pfsph__enc_printf(&e, "    <FieldData>\n"); break;
         case A_VEL:
-            EMIT("    <Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
+            pfsph__enc_printf(&e, "    <Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
                  "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n", n, n);
-            EMIT("      <PointData Scalars=\"density\" Vectors=\"velocity\">\n");
+            pfsph__enc_printf(&e, "      <PointData Scalars=\"density\" Vectors=\"velocity\">\n");
             break;
-        case A_POINTS: EMIT("      </PointData>\n      <Points>\n"); break;
-        case A_CONN: EMIT("      </Points>\n      <Verts>\n"); break;
+        case A_POINTS: pfsph__enc_printf(&e, "      </PointData>\n      <Points>\n"); break;
+        case A_CONN: pfsph__enc_printf(&e, "      </Points>\n      <Verts>\n"); break;
         default: break;
         }
         if (a->kind == A_TIME)
-            EMIT("      <DataArray type=\"%s\" Name=\"%s\" NumberOfTuples=\"1\" "
+            pfsph__enc_printf(&e, "      <DataArray type=\"%s\" Name=\"%s\" NumberOfTuples=\"1\" "
                  "format=\"appended\" offset=\"%" PRIu64 "\"/>\n    </FieldData>\n",
                  a->type, a->name, off);
         else
-            EMIT("        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" "
+            pfsph__enc_printf(&e, "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" "
                  "format=\"appended\" offset=\"%" PRIu64 "\"/>\n",
                  a->type, a->name, a->ncomp, off);
         off += 8 + a->nbytes;
     }
-    EMIT("      </Verts>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _");
+    pfsph__enc_printf(&e, "      </Verts>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _");
 
     /* Appended blocks, in the header's order. */
     const pfsph_real zero = 0;
@@ -187,8 +176,7 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
             break;
         }
     }
-    EMIT("\n  </AppendedData>\n</VTKFile>\n");
-#undef EMIT
+    pfsph__enc_printf(&e, "\n  </AppendedData>\n</VTKFile>\n");
     rc = pfsph__enc_flush(&e);
     pfsph__enc_free(&e);
     if (rc != PFSPH_OK) {
