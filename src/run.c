@@ -75,13 +75,9 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
     fprintf(f, "%d,%.9g,%.6g,%llu,%zu,%zu,%.6g,%.6g,%.6g,%.9g,%d", frame, pfsph_sim_time(sim), st->dt,
             (unsigned long long)pfsph_sim_steps(sim), c->fluid->n, pfsph_sim_removed(sim), st->vmax,
             st->density_err_avg, st->density_err_max, st->ekin, st->iterations);
-    const pfsph_particles *d = pfsph_sim_diffuse(sim);
     if (c->scene->diffuse.enabled) {
-        size_t cnt[3] = {0, 0, 0};
-        if (d) {
-            for (size_t i = 0; i < d->n; i++)
-                if (d->phase[i] < 3) cnt[d->phase[i]]++;
-        }
+        size_t cnt[3];
+        pfsph_sim_diffuse_counts(sim, cnt);
         fprintf(f, ",%zu,%zu,%zu", cnt[0], cnt[1], cnt[2]);
     }
     fputc('\n', f);

@@ -41,6 +41,7 @@ struct pfsph_sim {
 };
 
 static double now(void) { return omp_get_wtime(); }
+static double max_speed(const pfsph_particles *f, size_t *worst);
 
 /* Largest radius any stage queries: h, or k*h with pairwise forces. */
 static pfsph_real query_radius(const pfsph_scene *s, pfsph_real h)
@@ -231,6 +232,8 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     sim->amax = g;
     sim->amax_np = g;
+    size_t worst0;
+    sim->stats.vmax = max_speed(&sim->fluid, &worst0);
     sim->vbound = s->solver == PFSPH_SOLVER_WCSPH ? sim->sound_speed : 20 * sim->sound_speed;
 
     if (s->pairwise.enabled && (rc = pfsph_pairwise_create(&sim->pw, c, err))) goto fail;
@@ -396,6 +399,7 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     const pfsph_scene *s = &sim->scene;
     double t0 = now(), t1;
 
+    const size_t removed_before = sim->removed;
     pfsph_grid_sort(&sim->grid, f, &sim->removed);
     size_t n = f->n;
     t1 = now();
@@ -409,13 +413,16 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     sim->stage_s[PFSPH_STAGE_DENSITY] += t1 - t0;
     t0 = t1;
 
-    size_t worst;
-    double vmax = max_speed(f, &worst);
-    if (!isfinite(vmax)) return blowup(sim, "grid", worst, "non-finite velocity or position", vmax, err);
+    /* the last step's integration measured vmax (and stopped on non-finite values); only a
+     * removal in the sort can lower it */
+    size_t worst = 0;
+    double vmax = sim->removed != removed_before ? max_speed(f, &worst) : sim->stats.vmax;
     int collapsed;
     double dt = choose_dt(sim, vmax, t_limit, &collapsed);
-    if (collapsed)
+    if (collapsed) {
+        vmax = max_speed(f, &worst);
         return blowup(sim, "timestep", worst, "time step fell below time.dt_min; speed", vmax, err);
+    }
     c->dt = dt;
     c->time = sim->time;
     c->step = sim->step;
@@ -454,8 +461,9 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     const pfsph_real fdt = (pfsph_real)dt;
     double amax2 = 0, anp2 = 0;
     pfsph_real *ek = sim->scr[SCR_ERR];
-    double emax = 0;
-#pragma omp parallel for schedule(static) reduction(max : amax2, anp2, emax)
+    double emax = 0, v2max = 0;
+    int bad = 0;
+#pragma omp parallel for schedule(static) reduction(max : amax2, anp2, emax, v2max) reduction(| : bad)
     for (size_t i = 0; i < n; i++) {
         double b2 = (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i];
         if (b2 > anp2) anp2 = b2;
@@ -472,19 +480,25 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
         if (e > emax) emax = e;
         ek[i] = (pfsph_real)0.5 * c->mass[f->phase[i]] *
                 (f->vx[i] * f->vx[i] + f->vy[i] * f->vy[i] + f->vz[i] * f->vz[i]);
+        double v2 = (double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] + (double)f->vz[i] * f->vz[i];
+        if (!isfinite(v2) || !isfinite(f->x[i] + f->y[i] + f->z[i])) bad = 1;
+        else if (v2 > v2max) v2max = v2;
     }
     sim->amax = sqrt(amax2);
     sim->amax_np = sqrt(anp2);
     sim->stats.ekin = pfsph__sum(ek, n);
     sim->stats.density_err_max = emax;
     sim->stats.dt = dt;
-    vmax = max_speed(f, &worst);
+    vmax = bad ? NAN : sqrt(v2max);
     sim->stats.vmax = vmax;
     t1 = now();
     sim->stage_s[PFSPH_STAGE_INTEGRATE] += t1 - t0;
     t0 = t1;
-    if (!isfinite(vmax)) return blowup(sim, "integrate", worst, "non-finite velocity or position", vmax, err);
-    if (vmax > sim->vbound) return blowup(sim, "integrate", worst, "speed [m/s]", vmax, err);
+    if (bad || vmax > sim->vbound) {
+        vmax = max_speed(f, &worst); /* rare: find the particle to name */
+        if (!isfinite(vmax)) return blowup(sim, "integrate", worst, "non-finite velocity or position", vmax, err);
+        return blowup(sim, "integrate", worst, "speed [m/s]", vmax, err);
+    }
 
     if (sim->df) {
         pfsph_diffuse_step(sim->df, c);
@@ -513,6 +527,12 @@ const pfsph_ctx *pfsph_sim_ctx(const pfsph_sim *sim) { return &sim->ctx; }
 const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim) { return &sim->stats; }
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim) { return sim->stage_s; }
 size_t pfsph_sim_removed(const pfsph_sim *sim) { return sim->removed; }
+void pfsph_sim_diffuse_counts(const pfsph_sim *sim, size_t counts[3])
+{
+    counts[0] = counts[1] = counts[2] = 0;
+    if (sim->df) pfsph_diffuse_counts(sim->df, counts);
+}
+
 const pfsph_particles *pfsph_sim_diffuse(const pfsph_sim *sim)
 {
     return sim->df ? pfsph_diffuse_particles(sim->df) : NULL;

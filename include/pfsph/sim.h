@@ -70,6 +70,8 @@ void pfsph_sim_add_stage_time(pfsph_sim *sim, int stage, double seconds);
 double pfsph_sim_sound_speed(const pfsph_sim *sim);
 /* Diffuse particles (NULL when off). */
 const pfsph_particles *pfsph_sim_diffuse(const pfsph_sim *sim);
+/* Live diffuse particles per type (spray, foam, bubble); zeros when off. */
+void pfsph_sim_diffuse_counts(const pfsph_sim *sim, size_t counts[3]);
 /* Number of particles and bytes a scene would need, without allocating them. */
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
                          size_t *bytes, pfsph_error *err);
