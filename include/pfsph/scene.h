@@ -67,7 +67,7 @@ typedef struct pfsph_output {
     int frame_interval;       /* write every n-th frame (1 = every frame) */
 } pfsph_output;
 
-enum { PFSPH_OUT_ID = 1u << 0, PFSPH_OUT_SPEED = 1u << 1, PFSPH_OUT_ACCEL = 1u << 2 };
+enum { PFSPH_OUT_ID = 1u << 0, PFSPH_OUT_SPEED = 1u << 1 };
 
 typedef struct pfsph_camera {
     bool set;

@@ -761,11 +761,11 @@ static int parse_output(parser *p, const cJSON *root)
     }
     const cJSON *fl = get(v, "fields");
     if (fl) {
-        static const char *const names[] = {"id", "speed", "accel", NULL};
-        static const unsigned bits[] = {PFSPH_OUT_ID, PFSPH_OUT_SPEED, PFSPH_OUT_ACCEL};
+        static const char *const names[] = {"id", "speed", NULL};
+        static const unsigned bits[] = {PFSPH_OUT_ID, PFSPH_OUT_SPEED};
         if (!cJSON_IsArray(fl))
             return pfsph__json_fail(&p->ctx, "$.output.fields",
-                                    "expected an array of strings (\"id\", \"speed\", \"accel\")");
+                                    "expected an array of strings (\"id\", \"speed\")");
         o->fields = 0;
         int i = 0;
         for (const cJSON *e = fl->child; e; e = e->next, i++) {
@@ -776,7 +776,7 @@ static int parse_output(parser *p, const cJSON *root)
                 if (strcmp(e->valuestring, names[k]) == 0) idx = k;
             if (idx < 0)
                 return pfsph__json_fail(&p->ctx, ep,
-                                        "unknown field (expected \"id\", \"speed\" or \"accel\")");
+                                        "unknown field (expected \"id\" or \"speed\")");
             o->fields |= bits[idx];
         }
     }

@@ -54,7 +54,7 @@ static void test_full_scene(void **state)
         "\"open_top\":true,\"layers\":3,\"phase\":\"wall\"},"
         "{\"shape\":\"plane\",\"point\":[0,-0.9,0],\"normal\":[0,2,0]},"
         "{\"shape\":\"cylinder\",\"center\":[1,2,1],\"radius\":0.1,\"height\":0.5,\"axis\":\"x\"}],"
-        "\"output\":{\"directory\":\"out/x\",\"formats\":[\"ply\"],\"fields\":[\"id\",\"accel\"],"
+        "\"output\":{\"directory\":\"out/x\",\"formats\":[\"ply\"],\"fields\":[\"id\",\"speed\"],"
         "\"boundary\":false,\"frame_interval\":2},"
         "\"camera\":{\"eye\":[0,1,5],\"target\":[0,1,0],\"up\":[0,1,0],\"fov\":50,"
         "\"width\":640,\"height\":480,\"color_by\":\"speed\"}}";
@@ -109,7 +109,7 @@ static void test_full_scene(void **state)
     assert_false(s->output.vtp);
     assert_true(s->output.ply);
     assert_false(s->output.write_boundary);
-    assert_int_equal(s->output.fields, PFSPH_OUT_ID | PFSPH_OUT_ACCEL);
+    assert_int_equal(s->output.fields, PFSPH_OUT_ID | PFSPH_OUT_SPEED);
     assert_int_equal(s->output.frame_interval, 2);
     assert_true(s->camera.set);
     assert_true(s->camera.eye[2] == 5 && s->camera.fov_deg == 50);
