@@ -10,6 +10,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "pfsph/checkpoint.h"
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
 
@@ -84,9 +85,16 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
     fflush(f);
 }
 
+typedef struct run_info {
+    int resumed_from;  /* checkpoint frame, -1: fresh run */
+    int ckpt_frame;    /* last checkpoint written by this process, -1: none */
+    size_t ckpt_bytes;
+    double ckpt_s;     /* seconds to encode and write it */
+} run_info;
+
 static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim *sim,
                          int frames, double wall, const char *status, const char *message,
-                         pfsph_error *err)
+                         const run_info *info, pfsph_error *err)
 {
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "program", "pfsph");
@@ -113,6 +121,13 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
         for (int k = 0; k < PFSPH_NSTAGES; k++) cJSON_AddNumberToObject(st, pfsph_stage_names[k], ss[k]);
     }
     cJSON_AddNumberToObject(j, "frames", frames);
+    if (info->resumed_from >= 0) cJSON_AddNumberToObject(j, "resumed_from_frame", info->resumed_from);
+    if (info->ckpt_frame >= 0) {
+        cJSON *ck = cJSON_AddObjectToObject(j, "last_checkpoint");
+        cJSON_AddNumberToObject(ck, "frame", info->ckpt_frame);
+        cJSON_AddNumberToObject(ck, "bytes", (double)info->ckpt_bytes);
+        cJSON_AddNumberToObject(ck, "seconds", info->ckpt_s);
+    }
     cJSON_AddNumberToObject(j, "wall_seconds", wall);
     char *text = cJSON_Print(j);
     cJSON_Delete(j);
@@ -121,6 +136,52 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
     snprintf(path, sizeof path, "%s/summary.json", dir);
     int rc = pfsph_write_file_atomic(path, text, strlen(text), err);
     free(text);
+    return rc;
+}
+
+/* Keep the header and the rows of frames <= last of stats.csv (a resume rewrites the rest);
+ * atomic. A missing file gets the header only. */
+static int truncate_csv(const char *path, const char *header, int last, pfsph_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    char *out = NULL;
+    size_t len = 0, cap = 0;
+    int rc = PFSPH_OK;
+    if (!f) {
+        if (errno != ENOENT) return pfsph_fail(err, PFSPH_EIO, "%s: cannot read: %s", path, strerror(errno));
+        return pfsph_write_file_atomic(path, header, strlen(header), err);
+    }
+    char line[4096];
+    int first = 1;
+    while (fgets(line, sizeof line, f)) {
+        size_t n = strlen(line);
+        if (n == 0 || line[n - 1] != '\n') break; /* a row cut short by a kill: drop it and the rest */
+        int keep = first;
+        if (!first) {
+            char *e;
+            long fr = strtol(line, &e, 10);
+            keep = e != line && *e == ',' && fr >= 0 && fr <= last;
+            if (!keep) break; /* rows are in frame order */
+        }
+        first = 0;
+        if (len + n + 1 > cap) {
+            cap = (len + n + 1) * 2;
+            char *q = realloc(out, cap);
+            if (!q) {
+                rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+                break;
+            }
+            out = q;
+        }
+        memcpy(out + len, line, n);
+        len += n;
+    }
+    fclose(f);
+    if (!rc) {
+        if (len == 0) rc = pfsph_write_file_atomic(path, header, strlen(header), err);
+        else rc = pfsph_write_file_atomic(path, out, len, err);
+    }
+    free(out);
     return rc;
 }
 
@@ -134,36 +195,88 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     if ((rc = pfsph_mkdirs(dir, err))) return rc;
     snprintf(path, sizeof path, "%s/frames", dir);
     if ((rc = pfsph_mkdirs(path, err))) return rc;
-    if (o && o->scene_text) {
+    if (o && o->scene_text && !(o->resume)) {
         snprintf(path, sizeof path, "%s/scene.json", dir);
         if ((rc = pfsph_write_file_atomic(path, o->scene_text, strlen(o->scene_text), err))) return rc;
     }
     pfsph_sim *sim = NULL;
     if ((rc = pfsph_sim_create(&sim, s, err))) return rc;
 
+    int frame0 = 0;
+    bool resume = o && o->resume;
+    if (resume) {
+        pfsph_checkpoint_info ci;
+        rc = pfsph_checkpoint_resume(dir, sim, &ci, o->message, o->user, err);
+        frame0 = ci.frame;
+        if (!rc && frame0 >= 0 && ci.threads != omp_get_max_threads() && o->message) {
+            char msg[256];
+            snprintf(msg, sizeof msg, "the checkpoint of frame %d was written with %d threads, this run has %d: "
+                     "frames will not be bit-identical to an uninterrupted run (use --threads %d)",
+                     frame0, ci.threads, omp_get_max_threads(), ci.threads);
+            o->message(msg, o->user);
+        }
+        if (!rc && frame0 < 0) {
+            /* killed before its first checkpoint: start again */
+            if (o->message) {
+                char msg[PFSPH_PATH_LEN + 128];
+                snprintf(msg, sizeof msg, "%s/checkpoints: no checkpoint yet; starting again from frame 0", dir);
+                o->message(msg, o->user);
+            }
+            resume = false;
+            frame0 = 0;
+        }
+    } else {
+        rc = pfsph_checkpoint_clear(dir, err);
+    }
+    if (rc) {
+        pfsph_sim_destroy(sim);
+        return rc;
+    }
+
+    char header[256];
+    snprintf(header, sizeof header,
+             "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s\n",
+             s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "");
     snprintf(path, sizeof path, "%s/stats.csv", dir);
-    FILE *csv = fopen(path, "w");
+    if (resume && (rc = truncate_csv(path, header, frame0, err))) {
+        pfsph_sim_destroy(sim);
+        return rc;
+    }
+    FILE *csv = fopen(path, resume ? "a" : "w");
     if (!csv) {
         pfsph_fail(err, PFSPH_EIO, "%s: cannot write: %s", path, strerror(errno));
         pfsph_sim_destroy(sim);
         return PFSPH_EIO;
     }
-    fprintf(csv, "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s\n",
-            s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "");
     int nframes = (int)floor(end * s->fps + 1e-9);
-    int frame = 0, written = 0;
-    rc = write_frame(s, dir, 0, sim, err);
-    if (!rc) written++;
-    csv_row(csv, 0, sim);
-    for (frame = 1; frame <= nframes && !rc; frame++) {
+    const int fi = s->output.frame_interval, ci = s->output.checkpoint_interval;
+    int frame = frame0, written = 0;
+    if (!resume) {
+        fputs(header, csv);
+        rc = write_frame(s, dir, 0, sim, err);
+        if (!rc) written++;
+        csv_row(csv, 0, sim);
+    } else {
+        written = frame0 / fi + 1; /* on disk from before */
+    }
+    int ckpt_frame = -1;
+    size_t ckpt_bytes = 0;
+    double ckpt_s = 0;
+    for (frame = frame0 + 1; frame <= nframes && !rc; frame++) {
         rc = pfsph_sim_advance(sim, frame / s->fps, err);
         if (rc) break;
         double t0 = omp_get_wtime();
-        if (frame % s->output.frame_interval == 0) {
-            rc = write_frame(s, dir, frame / s->output.frame_interval, sim, err);
+        if (frame % fi == 0) {
+            rc = write_frame(s, dir, frame / fi, sim, err);
             if (!rc) written++;
         }
         csv_row(csv, frame, sim);
+        if (!rc && ci > 0 && frame % ci == 0) {
+            double c0 = omp_get_wtime();
+            rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &ckpt_bytes, err);
+            ckpt_s = omp_get_wtime() - c0;
+            ckpt_frame = frame;
+        }
         pfsph_sim_add_stage_time(sim, PFSPH_STAGE_OUTPUT, omp_get_wtime() - t0);
         if (o && o->progress) {
             double wall = omp_get_wtime() - w0;
@@ -176,7 +289,8 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     fclose(csv);
     pfsph_error e2;
     const char *status = rc == PFSPH_OK ? "finished" : rc == PFSPH_EUNSTABLE ? "unstable" : "failed";
-    int rc2 = write_summary(dir, s, sim, written, omp_get_wtime() - w0, status, rc ? err->msg : NULL, &e2);
+    run_info info = {resume ? frame0 : -1, ckpt_frame, ckpt_bytes, ckpt_s};
+    int rc2 = write_summary(dir, s, sim, written, omp_get_wtime() - w0, status, rc ? err->msg : NULL, &info, &e2);
     if (!rc && s->diffuse.enabled) {
         char png[PFSPH_PATH_LEN + 64];
         snprintf(path, sizeof path, "%s/stats.csv", dir);

@@ -25,6 +25,7 @@ struct pfsph_sim {
     pfsph_particles fluid, boundary;
     pfsph_grid grid, bgrid;
     pfsph_real *scr[SCR_N]; /* per-step scratch, one value per fluid particle */
+    size_t scr_cap;         /* entries in each scratch array */
     double B, gamma;        /* Tait: p = B rho0 ((rho/rho0)^gamma - 1), B = c^2 / gamma */
     double sound_speed;
     double proto;           /* PCISPH prototype gradient sum */
@@ -127,10 +128,14 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
 
 static int alloc_scratch(pfsph_sim *sim, size_t n)
 {
+    if (!n) n = 1;
     for (int k = 0; k < SCR_N; k++) {
-        sim->scr[k] = calloc(n ? n : 1, sizeof(pfsph_real));
-        if (!sim->scr[k]) return PFSPH_ENOMEM;
+        pfsph_real *q = realloc(sim->scr[k], n * sizeof(pfsph_real));
+        if (!q) return PFSPH_ENOMEM;
+        memset(q, 0, n * sizeof(pfsph_real));
+        sim->scr[k] = q;
     }
+    sim->scr_cap = n;
     pfsph_ctx *c = &sim->ctx;
     c->ax = sim->scr[SCR_AX];
     c->ay = sim->scr[SCR_AY];
@@ -551,4 +556,71 @@ double pfsph_sim_sound_speed(const pfsph_sim *sim) { return sim->sound_speed; }
 void pfsph_sim_add_stage_time(pfsph_sim *sim, int stage, double seconds)
 {
     if (stage >= 0 && stage < PFSPH_NSTAGES) sim->stage_s[stage] += seconds;
+}
+
+void pfsph_sim_get_state(const pfsph_sim *sim, pfsph_sim_state *st)
+{
+    memset(st, 0, sizeof(*st));
+    st->time = sim->time;
+    st->step = sim->step;
+    st->amax = sim->amax;
+    st->amax_np = sim->amax_np;
+    st->removed = sim->removed;
+    st->stats = sim->stats;
+    memcpy(st->stage_s, sim->stage_s, sizeof st->stage_s);
+}
+
+void pfsph_sim_diffuse_totals(const pfsph_sim *sim, uint64_t *created, uint64_t *refused)
+{
+    uint64_t c = 0, r = 0;
+    if (sim->df) pfsph_diffuse_totals(sim->df, &c, &r);
+    if (created) *created = c;
+    if (refused) *refused = r;
+}
+
+int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_particles *fluid,
+                      const pfsph_particles *diffuse, uint64_t created, uint64_t refused,
+                      pfsph_error *err)
+{
+    const pfsph_scene *s = &sim->scene;
+    for (size_t i = 0; i < fluid->n; i++)
+        if (fluid->phase[i] >= s->nphases || s->phases[fluid->phase[i]].kind == PFSPH_PHASE_SOLID)
+            return pfsph_fail(err, PFSPH_EINPUT, "restore: fluid particle %zu has phase %d, not a fluid phase of the scene",
+                              i, fluid->phase[i]);
+    if (sim->df && !diffuse)
+        return pfsph_fail(err, PFSPH_EINPUT, "restore: the scene has diffuse particles on but the state has none");
+    if (!sim->df && diffuse && diffuse->n)
+        return pfsph_fail(err, PFSPH_EINPUT, "restore: the state has diffuse particles but the scene has diffuse off");
+    if (!(st->time >= 0) || !isfinite(st->time))
+        return pfsph_fail(err, PFSPH_EINPUT, "restore: bad time %g", st->time);
+    pfsph_particles *f = &sim->fluid;
+    if (fluid->n > f->cap && pfsph_particles_reserve(f, fluid->n) != PFSPH_OK)
+        return pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory for %zu fluid particles", fluid->n);
+    if (fluid->n > sim->scr_cap && alloc_scratch(sim, fluid->n) != PFSPH_OK)
+        return pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory for %zu fluid particles", fluid->n);
+    if (sim->df) {
+        int rc = pfsph_diffuse_import(sim->df, diffuse, created, refused);
+        if (rc == PFSPH_ENOMEM) return pfsph_fail(err, rc, "restore: out of memory for %zu diffuse particles", diffuse->n);
+        if (rc) return pfsph_fail(err, rc, "restore: %zu diffuse particles exceed diffuse.max_particles or carry an unknown type",
+                                  diffuse->n);
+    }
+    for (int k = 0; k < PFSPH_NFIELDS; k++)
+        if (fluid->n) memcpy(f->f[k], fluid->f[k], fluid->n * sizeof(pfsph_real));
+    if (fluid->n) {
+        memcpy(f->phase, fluid->phase, fluid->n);
+        memcpy(f->id, fluid->id, fluid->n * sizeof(uint32_t));
+    }
+    f->n = fluid->n;
+    f->next_id = fluid->next_id;
+    sim->time = st->time;
+    sim->step = st->step;
+    sim->amax = st->amax;
+    sim->amax_np = st->amax_np;
+    sim->removed = st->removed;
+    sim->stats = st->stats;
+    memcpy(sim->stage_s, st->stage_s, sizeof sim->stage_s);
+    sim->ctx.time = st->time;
+    sim->ctx.step = st->step;
+    sim->ctx.dt = st->stats.dt;
+    return PFSPH_OK;
 }

@@ -71,6 +71,12 @@ void pfsph_diffuse_counts(const pfsph_diffuse *d, size_t counts[3]);
 /* Total created and refused (cap reached) since creation. */
 void pfsph_diffuse_totals(const pfsph_diffuse *d, uint64_t *created, uint64_t *refused);
 
+/* Replace the live set and the totals (checkpoint restore, docs/checkpoints.md): every field of
+ * ps is copied, ids and next_id included. Returns PFSPH_OK, PFSPH_ENOMEM, or PFSPH_EINPUT when
+ * ps holds more than max_particles or an unknown type. */
+int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created,
+                         uint64_t refused);
+
 /* Insert a diffuse particle (tests, restarts). Returns its index or -1 (cap or ENOMEM). */
 long pfsph_diffuse_add(pfsph_diffuse *d, const pfsph_real x[3], const pfsph_real v[3], int type,
                        pfsph_real lifetime);

@@ -3,6 +3,9 @@
 #ifndef PFSPH_RUN_H
 #define PFSPH_RUN_H
 
+#include <stdbool.h>
+
+#include "pfsph/checkpoint.h"
 #include "pfsph/scene.h"
 
 typedef struct pfsph_progress {
@@ -22,9 +25,15 @@ typedef struct pfsph_run_opts {
     const char *scene_text; /* the scene file's text, saved as RUN/scene.json (NULL: none) */
     pfsph_progress_fn progress;
     void *user;
+    /* Continue the run in out_dir from its newest valid checkpoint (docs/checkpoints.md):
+     * frames after it are rewritten, stats.csv rows after it dropped, then rows appended. The
+     * scene must be the one of the checkpoint (scene hash). */
+    bool resume;
+    pfsph_message_fn message; /* warnings (a checkpoint skipped); may be NULL; gets `user` */
 } pfsph_run_opts;
 
-/* Run the scene. Returns PFSPH_OK, PFSPH_EIO (output directory), PFSPH_EUNSTABLE (blow-up;
+/* Run the scene, writing a checkpoint every scene->output.checkpoint_interval frames into
+ * RUN/checkpoints (a fresh run first deletes old ones there). Returns PFSPH_OK, PFSPH_EIO (output directory), PFSPH_EUNSTABLE (blow-up;
  * frames written so far are kept) or PFSPH_ENOMEM. */
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err);
 

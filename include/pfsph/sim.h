@@ -72,6 +72,29 @@ double pfsph_sim_sound_speed(const pfsph_sim *sim);
 const pfsph_particles *pfsph_sim_diffuse(const pfsph_sim *sim);
 /* Live diffuse particles per type (spray, foam, bubble); zeros when off. */
 void pfsph_sim_diffuse_counts(const pfsph_sim *sim, size_t counts[3]);
+/* The clock and counters of a simulation besides its particle sets: what a checkpoint saves
+ * (docs/checkpoints.md). The sound speed, the boundary and the grids are rebuilt from the scene. */
+typedef struct pfsph_sim_state {
+    double time;
+    uint64_t step;
+    double amax;            /* largest acceleration of the last step (next step's dt) */
+    double amax_np;         /* largest non-pressure acceleration of the last step */
+    size_t removed;         /* fluid particles removed so far */
+    pfsph_step_stats stats; /* stats.vmax feeds the next step's dt */
+    double stage_s[PFSPH_NSTAGES];
+} pfsph_sim_state;
+
+void pfsph_sim_get_state(const pfsph_sim *sim, pfsph_sim_state *st);
+/* Diffuse totals (zeros when off). */
+void pfsph_sim_diffuse_totals(const pfsph_sim *sim, uint64_t *created, uint64_t *refused);
+/* Put a saved state into a simulation created from the same scene: st, every field of the fluid
+ * set (ids, phases, next_id included, in the given order) and, when diffuse is on, the diffuse
+ * set and totals (diffuse must then be non-NULL). On error the simulation is unchanged except
+ * after PFSPH_ENOMEM. */
+int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_particles *fluid,
+                      const pfsph_particles *diffuse, uint64_t created, uint64_t refused,
+                      pfsph_error *err);
+
 /* Number of particles and bytes a scene would need, without allocating them. */
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
                          size_t *bytes, pfsph_error *err);

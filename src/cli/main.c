@@ -15,12 +15,14 @@
 
 static const char *USAGE =
     "usage: pfsph run [SCENE] [-o DIR] [--threads N] [--end T] [--render] [--quiet]\n"
+    "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH]\n"
     "       pfsph --version\n"
     "Without SCENE, `pfsph run` runs the embedded default scene (a small 3D dam break) into\n"
-    "./pfsph_default_run and renders PNG previews.\n";
+    "./pfsph_default_run and renders PNG previews. --resume continues a run from the newest\n"
+    "valid checkpoint in RUN_DIR/checkpoints, with RUN_DIR/scene.json.\n";
 
 static int exit_code(int rc)
 {
@@ -144,9 +146,15 @@ static void show_progress(const pfsph_progress *p, void *user)
     fflush(stderr);
 }
 
+static void show_message(const char *msg, void *user)
+{
+    (void)user;
+    fprintf(stderr, "pfsph: warning: %s\n", msg);
+}
+
 static int cmd_run(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out = NULL;
+    const char *scene_path = NULL, *out = NULL, *resume = NULL;
     double end = -1;
     int threads = 0, render = 0, quiet = 0;
     for (int i = 0; i < argc; i++) {
@@ -164,6 +172,9 @@ static int cmd_run(int argc, char **argv)
             if (++i >= argc) return usage_error("%s needs a time in seconds", a);
             end = strtod(argv[i], &e);
             if (*e || !(end >= 0)) return usage_error("--end: '%s' is not a time >= 0", argv[i]);
+        } else if (!strcmp(a, "--resume")) {
+            if (++i >= argc) return usage_error("%s needs a run directory", a);
+            resume = argv[i];
         } else if (!strcmp(a, "--render")) {
             render = 1;
         } else if (!strcmp(a, "--quiet")) {
@@ -175,6 +186,15 @@ static int cmd_run(int argc, char **argv)
         } else {
             return usage_error("unexpected argument '%s'", a);
         }
+    }
+    char resume_scene[4096];
+    if (resume) {
+        if (scene_path) return usage_error("--resume takes the scene from RUN_DIR/scene.json, not '%s'", scene_path);
+        if (out) return usage_error("--resume writes into RUN_DIR; drop '%s'", out);
+        if ((size_t)snprintf(resume_scene, sizeof resume_scene, "%s/scene.json", resume) >= sizeof resume_scene)
+            return usage_error("--resume: path too long: '%s'", resume);
+        scene_path = resume_scene;
+        out = resume;
     }
     static pfsph_scene s;
     char *text = NULL;
@@ -188,9 +208,11 @@ static int cmd_run(int argc, char **argv)
     if (threads > 0) omp_set_num_threads(threads);
     else if (s.threads > 0) omp_set_num_threads(s.threads);
     progress_state ps = {isatty(2), quiet};
-    pfsph_run_opts o = {.out_dir = out, .end_time = end, .scene_text = text, .progress = show_progress, .user = &ps};
+    pfsph_run_opts o = {.out_dir = out, .end_time = end, .scene_text = text, .progress = show_progress, .user = &ps,
+                        .resume = resume != NULL, .message = show_message};
     const char *dir = out ? out : s.output.dir;
-    if (!quiet) fprintf(stderr, "pfsph %s: %s -> %s (%d threads)\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads());
+    if (!quiet) fprintf(stderr, "pfsph %s: %s -> %s (%d threads)%s\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads(),
+                        resume ? ", resuming" : "");
     pfsph_error err = {0};
     rc = pfsph_run(&s, &o, &err);
     free(text);

@@ -533,3 +533,23 @@ void pfsph_diffuse_step(pfsph_diffuse *d, const pfsph_ctx *ctx)
     compact(d);
     generate(d, ctx);
 }
+
+int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created,
+                         uint64_t refused)
+{
+    if ((long)ps->n > d->p.max_particles) return PFSPH_EINPUT;
+    for (size_t i = 0; i < ps->n; i++)
+        if (ps->phase[i] >= PFSPH_DIFFUSE_NTYPES) return PFSPH_EINPUT;
+    if (ps->n > d->ps.cap && pfsph_particles_reserve(&d->ps, ps->n) != PFSPH_OK) return PFSPH_ENOMEM;
+    for (int k = 0; k < PFSPH_NFIELDS; k++)
+        if (ps->n) memcpy(d->ps.f[k], ps->f[k], ps->n * sizeof(pfsph_real));
+    if (ps->n) {
+        memcpy(d->ps.phase, ps->phase, ps->n);
+        memcpy(d->ps.id, ps->id, ps->n * sizeof(uint32_t));
+    }
+    d->ps.n = ps->n;
+    d->ps.next_id = ps->next_id;
+    d->created = created;
+    d->refused = refused;
+    return PFSPH_OK;
+}

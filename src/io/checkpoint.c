@@ -1,0 +1,638 @@
+/* Checkpoint files (docs/checkpoints.md): a 40-byte header (magic, version, precision, scene
+ * hash, payload length, payload CRC32, header CRC32) followed by the payload (frame, clock,
+ * counters, the fluid set and the diffuse set), all little-endian. */
+#include "pfsph/checkpoint.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include "io/io_internal.h"
+#include "pfsph/io.h"
+#include "pfsph/run.h"
+
+static const unsigned char MAGIC[8] = {'P', 'F', 'S', 'P', 'H', 'C', 'K', 'P'};
+enum { HEADER_LEN = 40 };
+
+/* ---- scene hash ---- */
+
+typedef struct hasher {
+    uint64_t h;
+} hasher;
+
+static void h_bytes(hasher *s, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) {
+        s->h ^= b[i];
+        s->h *= 1099511628211ull;
+    }
+}
+static void h_u64(hasher *s, uint64_t v)
+{
+    unsigned char b[8];
+    pfsph__put_le(b, &v, 8);
+    h_bytes(s, b, 8);
+}
+static void h_int(hasher *s, long long v) { h_u64(s, (uint64_t)v); }
+static void h_f64(hasher *s, double v)
+{
+    uint64_t u;
+    if (v == 0) v = 0; /* -0 == 0 */
+    memcpy(&u, &v, 8);
+    h_u64(s, u);
+}
+static void h_vec(hasher *s, const double *v, int n)
+{
+    for (int i = 0; i < n; i++) h_f64(s, v[i]);
+}
+static void h_str(hasher *s, const char *str)
+{
+    size_t n = strnlen(str, PFSPH_NAME_LEN);
+    h_u64(s, n);
+    h_bytes(s, str, n);
+}
+
+uint64_t pfsph_scene_hash(const pfsph_scene *s)
+{
+    hasher H = {14695981039346656037ull};
+    hasher *h = &H;
+    h_int(h, (long long)sizeof(pfsph_real));
+    h_int(h, s->dim);
+    h_f64(h, s->particle_radius);
+    h_f64(h, s->support_factor);
+    h_vec(h, s->gravity, 3);
+    h_vec(h, s->domain_min, 3);
+    h_vec(h, s->domain_max, 3);
+    h_int(h, s->solver);
+    h_f64(h, s->cfl);
+    h_f64(h, s->dt_min);
+    h_f64(h, s->dt_max);
+    h_f64(h, s->fps);
+    h_u64(h, s->seed);
+    h_f64(h, s->sound_speed);
+    h_f64(h, s->gamma);
+    h_f64(h, s->pcisph_tolerance);
+    h_int(h, s->pcisph_min_iter);
+    h_int(h, s->pcisph_max_iter);
+    h_int(h, s->nphases);
+    for (int i = 0; i < s->nphases && i < PFSPH_MAX_PHASES; i++) {
+        const pfsph_phase *p = &s->phases[i];
+        h_str(h, p->name);
+        h_int(h, p->kind);
+        h_f64(h, p->rest_density);
+        h_f64(h, p->viscosity);
+    }
+    h_int(h, s->nblocks);
+    for (int i = 0; i < s->nblocks && i < PFSPH_MAX_BLOCKS; i++) {
+        const pfsph_block *b = &s->blocks[i];
+        h_int(h, b->shape);
+        h_int(h, b->phase);
+        h_vec(h, b->min, 3);
+        h_vec(h, b->max, 3);
+        h_vec(h, b->center, 3);
+        h_f64(h, b->radius);
+        h_f64(h, b->height);
+        h_int(h, b->axis);
+        h_vec(h, b->velocity, 3);
+    }
+    h_int(h, s->nsolids);
+    for (int i = 0; i < s->nsolids && i < PFSPH_MAX_SOLIDS; i++) {
+        const pfsph_solid *b = &s->solids[i];
+        h_int(h, b->shape);
+        h_int(h, b->phase);
+        h_vec(h, b->min, 3);
+        h_vec(h, b->max, 3);
+        h_vec(h, b->center, 3);
+        h_vec(h, b->normal, 3);
+        h_f64(h, b->radius);
+        h_f64(h, b->height);
+        h_int(h, b->axis);
+        h_int(h, b->layers);
+        h_int(h, b->open_top);
+    }
+    /* pairwise: what the scene states (c is filled in by pfsph_pairwise_resolve, c_set is not) */
+    const pfsph_pairwise_params *pw = &s->pairwise;
+    h_int(h, pw->enabled);
+    if (pw->enabled) {
+        h_f64(h, pw->k);
+        h_int(h, pw->filter);
+        h_f64(h, pw->eta);
+        h_f64(h, pw->eps_min);
+        h_int(h, pw->center);
+        for (int a = 0; a < s->nphases && a < PFSPH_MAX_PHASES; a++)
+            for (int b = 0; b < s->nphases && b < PFSPH_MAX_PHASES; b++) {
+                h_int(h, pw->c_set[a][b]);
+                if (pw->c_set[a][b]) h_f64(h, pw->c[a][b]);
+                h_int(h, pw->sigma_set[a][b]);
+                if (pw->sigma_set[a][b]) h_f64(h, pw->sigma[a][b]);
+                h_int(h, pw->angle_set[a][b]);
+                if (pw->angle_set[a][b]) h_f64(h, pw->angle_deg[a][b]);
+            }
+    }
+    const pfsph_diffuse_params *d = &s->diffuse;
+    h_int(h, d->enabled);
+    if (d->enabled) {
+        h_int(h, d->max_particles);
+        h_f64(h, d->sampling_rate);
+        h_f64(h, d->phi_v_min);
+        h_f64(h, d->phi_v_max);
+        h_f64(h, d->phi_e_min);
+        h_f64(h, d->phi_e_max);
+        h_f64(h, d->energy_mass);
+        h_f64(h, d->emit_radius);
+        h_f64(h, d->emit_radius_scale);
+        h_f64(h, d->emit_height_scale);
+        h_f64(h, d->lifetime_min);
+        h_f64(h, d->lifetime_max);
+        h_int(h, d->foam_min_neighbors);
+        h_int(h, d->foam_max_neighbors);
+        for (int t = 0; t < PFSPH_DIFFUSE_NTYPES; t++) {
+            h_f64(h, d->type[t].k_ext);
+            h_f64(h, d->type[t].k_b);
+            h_f64(h, d->type[t].k_cp);
+            h_f64(h, d->type[t].k_t);
+        }
+    }
+    return H.h;
+}
+
+/* ---- encoding ---- */
+
+typedef struct wbuf {
+    unsigned char *p;
+    size_t len;
+} wbuf;
+
+static void w_raw(wbuf *w, const void *v, size_t n)
+{
+    pfsph__put_le(w->p + w->len, v, n);
+    w->len += n;
+}
+static void w_u8(wbuf *w, uint8_t v) { w->p[w->len++] = v; }
+static void w_u32(wbuf *w, uint32_t v) { w_raw(w, &v, 4); }
+static void w_i32(wbuf *w, int32_t v) { w_raw(w, &v, 4); }
+static void w_u64(wbuf *w, uint64_t v) { w_raw(w, &v, 8); }
+static void w_f64(wbuf *w, double v) { w_raw(w, &v, 8); }
+
+static size_t set_bytes(size_t n)
+{
+    return 8 + 4 + n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 1 + 4);
+}
+
+static void w_set(wbuf *w, const pfsph_particles *ps)
+{
+    w_u64(w, ps->n);
+    w_u32(w, ps->next_id);
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        if (pfsph__host_le()) {
+            if (ps->n) memcpy(w->p + w->len, ps->f[k], ps->n * sizeof(pfsph_real));
+            w->len += ps->n * sizeof(pfsph_real);
+        } else {
+            for (size_t i = 0; i < ps->n; i++) w_raw(w, &ps->f[k][i], sizeof(pfsph_real));
+        }
+    }
+    if (ps->n) memcpy(w->p + w->len, ps->phase, ps->n);
+    w->len += ps->n;
+    for (size_t i = 0; i < ps->n; i++) w_u32(w, ps->id[i]);
+}
+
+int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t *len,
+                            pfsph_error *err)
+{
+    *data = NULL;
+    *len = 0;
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    const pfsph_particles *df = pfsph_sim_diffuse(sim);
+    pfsph_sim_state st;
+    pfsph_sim_get_state(sim, &st);
+    size_t payload = 4 + 4 + 4 + 4 + 8 * 5 + 8 * 5 + 4 + 4 + 8 * PFSPH_NSTAGES + set_bytes(c->fluid->n) + 1;
+    if (df) payload += 16 + set_bytes(df->n);
+    size_t total = HEADER_LEN + payload;
+    unsigned char *buf = malloc(total);
+    if (!buf) return pfsph_fail(err, PFSPH_ENOMEM, "checkpoint: out of memory for %zu bytes", total);
+    wbuf w = {buf, HEADER_LEN};
+    w_i32(&w, frame);
+    w_i32(&w, omp_get_max_threads());
+    w_i32(&w, c->dim);
+    w_u32(&w, (uint32_t)c->scene->nphases);
+    w_f64(&w, st.time);
+    w_u64(&w, st.step);
+    w_f64(&w, st.amax);
+    w_f64(&w, st.amax_np);
+    w_u64(&w, st.removed);
+    w_f64(&w, st.stats.dt);
+    w_f64(&w, st.stats.vmax);
+    w_f64(&w, st.stats.density_err_avg);
+    w_f64(&w, st.stats.density_err_max);
+    w_f64(&w, st.stats.ekin);
+    w_i32(&w, st.stats.iterations);
+    w_u32(&w, PFSPH_NSTAGES);
+    for (int k = 0; k < PFSPH_NSTAGES; k++) w_f64(&w, st.stage_s[k]);
+    w_set(&w, c->fluid);
+    w_u8(&w, df != NULL);
+    if (df) {
+        uint64_t created, refused;
+        pfsph_sim_diffuse_totals(sim, &created, &refused);
+        w_u64(&w, created);
+        w_u64(&w, refused);
+        w_set(&w, df);
+    }
+    if (w.len != total) {
+        free(buf);
+        return pfsph_fail(err, PFSPH_EINPUT, "checkpoint: internal size mismatch (%zu != %zu)", w.len, total);
+    }
+    uint32_t pcrc = (uint32_t)crc32(0L, Z_NULL, 0);
+    /* zlib's crc32 takes uInt lengths: feed large payloads in pieces */
+    for (size_t off = HEADER_LEN; off < total;) {
+        size_t n = total - off > (1u << 30) ? (1u << 30) : total - off;
+        pcrc = (uint32_t)crc32(pcrc, buf + off, (uInt)n);
+        off += n;
+    }
+    w.len = 0;
+    memcpy(buf, MAGIC, 8);
+    w.len = 8;
+    w_u32(&w, PFSPH_CHECKPOINT_VERSION);
+    w_u32(&w, (uint32_t)sizeof(pfsph_real));
+    w_u64(&w, pfsph_scene_hash(c->scene));
+    w_u64(&w, payload);
+    w_u32(&w, pcrc);
+    uint32_t hcrc = (uint32_t)crc32(crc32(0L, Z_NULL, 0), buf, 36);
+    w_u32(&w, hcrc);
+    *data = buf;
+    *len = total;
+    return PFSPH_OK;
+}
+
+/* ---- decoding ---- */
+
+typedef struct rbuf {
+    const unsigned char *p;
+    size_t len, pos;
+    int bad;
+} rbuf;
+
+static int r_need(rbuf *r, size_t n)
+{
+    if (r->bad || n > r->len - r->pos) {
+        r->bad = 1;
+        return 0;
+    }
+    return 1;
+}
+static void r_raw(rbuf *r, void *v, size_t n)
+{
+    if (!r_need(r, n)) {
+        memset(v, 0, n);
+        return;
+    }
+    pfsph__get_le(v, r->p + r->pos, n);
+    r->pos += n;
+}
+static uint8_t r_u8(rbuf *r)
+{
+    uint8_t v = 0;
+    if (r_need(r, 1)) v = r->p[r->pos++];
+    return v;
+}
+static uint32_t r_u32(rbuf *r) { uint32_t v; r_raw(r, &v, 4); return v; }
+static int32_t r_i32(rbuf *r) { int32_t v; r_raw(r, &v, 4); return v; }
+static uint64_t r_u64(rbuf *r) { uint64_t v; r_raw(r, &v, 8); return v; }
+static double r_f64(rbuf *r) { double v; r_raw(r, &v, 8); return v; }
+
+/* Read a particle set; ps is initialised here (free with pfsph_particles_free). */
+static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *what, pfsph_error *err)
+{
+    memset(ps, 0, sizeof(*ps));
+    uint64_t n = r_u64(r);
+    uint32_t next_id = r_u32(r);
+    const size_t per = PFSPH_NFIELDS * sizeof(pfsph_real) + 1 + 4;
+    if (r->bad || n > (r->len - r->pos) / per)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle count %llu exceeds the file",
+                          name, what, (unsigned long long)n);
+    if (pfsph_particles_init(ps, (size_t)n ? (size_t)n : 1) != PFSPH_OK)
+        return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory for %llu %s particles", name,
+                          (unsigned long long)n, what);
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        if (pfsph__host_le()) {
+            memcpy(ps->f[k], r->p + r->pos, (size_t)n * sizeof(pfsph_real));
+            r->pos += (size_t)n * sizeof(pfsph_real);
+        } else {
+            for (size_t i = 0; i < n; i++) r_raw(r, &ps->f[k][i], sizeof(pfsph_real));
+        }
+    }
+    memcpy(ps->phase, r->p + r->pos, (size_t)n);
+    r->pos += (size_t)n;
+    for (size_t i = 0; i < n; i++) ps->id[i] = r_u32(r);
+    ps->n = (size_t)n;
+    ps->next_id = next_id;
+    for (size_t i = 0; i < ps->n; i++)
+        if (ps->id[i] >= next_id) {
+            pfsph_particles_free(ps);
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle id %u not below next id %u",
+                              name, what, ps->id[i], next_id);
+        }
+    return PFSPH_OK;
+}
+
+int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const char *name,
+                            pfsph_checkpoint_info *info, pfsph_error *err)
+{
+    const unsigned char *b = data;
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    if (len < HEADER_LEN)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: truncated checkpoint (%zu bytes, the header alone is %d)", name,
+                          len, HEADER_LEN);
+    if (memcmp(b, MAGIC, 8) != 0)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: not a pfsph checkpoint (bad magic)", name);
+    rbuf r = {b, len, 8, 0};
+    uint32_t version = r_u32(&r);
+    uint32_t real_size = r_u32(&r);
+    uint64_t hash = r_u64(&r);
+    uint64_t payload = r_u64(&r);
+    uint32_t pcrc = r_u32(&r);
+    uint32_t hcrc = r_u32(&r);
+    if ((uint32_t)crc32(crc32(0L, Z_NULL, 0), b, 36) != hcrc)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: header checksum mismatch", name);
+    if (version != PFSPH_CHECKPOINT_VERSION)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint format version %u, this pfsph reads version %u",
+                          name, version, PFSPH_CHECKPOINT_VERSION);
+    if (real_size != sizeof(pfsph_real))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint written in %s precision, this pfsph is built for %s",
+                          name, real_size == 8 ? "double" : "float", PFSPH_REAL_NAME);
+    if (payload != len - HEADER_LEN)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: %s checkpoint: %zu bytes, the header says %llu", name,
+                          len - HEADER_LEN < payload ? "truncated" : "corrupt", len,
+                          (unsigned long long)(payload + HEADER_LEN));
+    uint32_t crc = (uint32_t)crc32(0L, Z_NULL, 0);
+    for (size_t off = HEADER_LEN; off < len;) {
+        size_t n = len - off > (1u << 30) ? (1u << 30) : len - off;
+        crc = (uint32_t)crc32(crc, b + off, (uInt)n);
+        off += n;
+    }
+    if (crc != pcrc)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: checksum mismatch (CRC32 %08x, expected %08x)",
+                          name, crc, pcrc);
+    if (hash != pfsph_scene_hash(c->scene))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint belongs to another scene (scene hash %016llx, "
+                          "this scene %016llx)", name, (unsigned long long)hash,
+                          (unsigned long long)pfsph_scene_hash(c->scene));
+
+    int32_t fr = r_i32(&r);
+    int32_t threads = r_i32(&r);
+    int32_t dim = r_i32(&r);
+    uint32_t nph = r_u32(&r);
+    pfsph_sim_state st;
+    memset(&st, 0, sizeof st);
+    st.time = r_f64(&r);
+    st.step = r_u64(&r);
+    st.amax = r_f64(&r);
+    st.amax_np = r_f64(&r);
+    st.removed = (size_t)r_u64(&r);
+    st.stats.dt = r_f64(&r);
+    st.stats.vmax = r_f64(&r);
+    st.stats.density_err_avg = r_f64(&r);
+    st.stats.density_err_max = r_f64(&r);
+    st.stats.ekin = r_f64(&r);
+    st.stats.iterations = r_i32(&r);
+    uint32_t nst = r_u32(&r);
+    for (uint32_t k = 0; k < nst && !r.bad; k++) {
+        double v = r_f64(&r);
+        if (k < PFSPH_NSTAGES) st.stage_s[k] = v;
+    }
+    if (r.bad || fr < 0 || dim != c->dim || nph != (uint32_t)c->scene->nphases || nst > 64)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: bad frame, dimension or phase count", name);
+    pfsph_particles fluid, diff;
+    memset(&diff, 0, sizeof diff);
+    int rc = r_set(&r, &fluid, name, "fluid", err);
+    if (rc) return rc;
+    uint8_t has_d = r_u8(&r);
+    uint64_t created = 0, refused = 0;
+    if (has_d) {
+        created = r_u64(&r);
+        refused = r_u64(&r);
+        if ((rc = r_set(&r, &diff, name, "diffuse", err))) {
+            pfsph_particles_free(&fluid);
+            return rc;
+        }
+    }
+    if (r.bad || r.pos != r.len) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: payload length does not match its contents", name);
+    } else if ((has_d != 0) != (pfsph_sim_diffuse(sim) != NULL)) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint %s diffuse particles but the scene has them %s", name,
+                        has_d ? "has" : "has no", has_d ? "off" : "on");
+    } else {
+        rc = pfsph_sim_restore(sim, &st, &fluid, has_d ? &diff : NULL, created, refused, err);
+        if (rc) {
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg);
+            pfsph_fail(err, rc, "%s: %s", name, msg);
+        }
+    }
+    pfsph_particles_free(&fluid);
+    if (has_d) pfsph_particles_free(&diff);
+    if (!rc && info) {
+        info->frame = fr;
+        info->threads = threads;
+        info->time = st.time;
+        info->step = st.step;
+    }
+    return rc;
+}
+
+/* ---- files ---- */
+
+int pfsph_checkpoint_save(const char *path, const pfsph_sim *sim, int frame, size_t *bytes,
+                          pfsph_error *err)
+{
+    void *data;
+    size_t len;
+    int rc = pfsph_checkpoint_encode(sim, frame, &data, &len, err);
+    if (rc) return rc;
+    rc = pfsph_write_file_atomic(path, data, len, err);
+    free(data);
+    if (!rc && bytes) *bytes = len;
+    return rc;
+}
+
+int pfsph_checkpoint_load(const char *path, pfsph_sim *sim, pfsph_checkpoint_info *info,
+                          pfsph_error *err)
+{
+    unsigned char *data;
+    size_t len;
+    int rc = pfsph__read_file(path, &data, &len, err);
+    if (rc) return rc;
+    rc = pfsph_checkpoint_decode(sim, data, len, path, info, err);
+    free(data);
+    return rc;
+}
+
+void pfsph_checkpoint_path(char *buf, size_t cap, const char *run_dir, int frame)
+{
+    snprintf(buf, cap, "%s/checkpoints/ckpt_%05d.bin", run_dir, frame);
+}
+
+/* Frame of a checkpoint file name "ckpt_<digits>.bin", or -1. */
+static long name_frame(const char *name)
+{
+    if (strncmp(name, "ckpt_", 5) != 0) return -1;
+    const char *p = name + 5;
+    long v = 0;
+    int digits = 0;
+    while (*p >= '0' && *p <= '9') {
+        if (v > 100000000) return -1;
+        v = v * 10 + (*p++ - '0');
+        digits++;
+    }
+    if (!digits || strcmp(p, ".bin") != 0) return -1;
+    return v;
+}
+
+static int cmp_desc(const void *a, const void *b)
+{
+    long x = *(const long *)a, y = *(const long *)b;
+    return x < y ? 1 : x > y ? -1 : 0;
+}
+
+/* Frames of the checkpoints in RUN/checkpoints, newest first (malloc'ed; *n entries). */
+static int list_checkpoints(const char *run_dir, long **out, size_t *n, pfsph_error *err)
+{
+    char dir[PFSPH_PATH_LEN + 64];
+    snprintf(dir, sizeof dir, "%s/checkpoints", run_dir);
+    *out = NULL;
+    *n = 0;
+    DIR *d = opendir(dir);
+    if (!d) {
+        if (errno == ENOENT) return PFSPH_OK;
+        return pfsph_fail(err, PFSPH_EIO, "%s: cannot list: %s", dir, strerror(errno));
+    }
+    size_t cap = 0;
+    long *v = NULL;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        long f = name_frame(e->d_name);
+        if (f < 0) continue;
+        if (*n == cap) {
+            cap = cap ? 2 * cap : 16;
+            long *q = realloc(v, cap * sizeof(long));
+            if (!q) {
+                free(v);
+                closedir(d);
+                return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+            }
+            v = q;
+        }
+        v[(*n)++] = f;
+    }
+    closedir(d);
+    if (*n) qsort(v, *n, sizeof(long), cmp_desc);
+    *out = v;
+    return PFSPH_OK;
+}
+
+int pfsph_checkpoint_write_run(const char *run_dir, const pfsph_sim *sim, int frame, int keep,
+                               size_t *bytes, pfsph_error *err)
+{
+    char path[PFSPH_PATH_LEN + 64];
+    snprintf(path, sizeof path, "%s/checkpoints", run_dir);
+    int rc = pfsph_mkdirs(path, err);
+    if (rc) return rc;
+    pfsph_checkpoint_path(path, sizeof path, run_dir, frame);
+    if ((rc = pfsph_checkpoint_save(path, sim, frame, bytes, err))) return rc;
+    long *frames;
+    size_t n;
+    if (list_checkpoints(run_dir, &frames, &n, err) != PFSPH_OK) return PFSPH_OK; /* saved; pruning is best effort */
+    /* Keep the one just written and the keep - 1 newest older ones. Newer ones are stale: a
+     * resume starts from the newest valid checkpoint, so any newer one was rejected. */
+    size_t kept = 1;
+    for (size_t i = 0; i < n; i++) {
+        if (frames[i] == frame) continue;
+        if (frames[i] < frame && kept < (size_t)(keep > 1 ? keep : 1)) {
+            kept++;
+            continue;
+        }
+        pfsph_checkpoint_path(path, sizeof path, run_dir, (int)frames[i]);
+        unlink(path);
+    }
+    free(frames);
+    return PFSPH_OK;
+}
+
+int pfsph_checkpoint_clear(const char *run_dir, pfsph_error *err)
+{
+    long *frames;
+    size_t n;
+    int rc = list_checkpoints(run_dir, &frames, &n, err);
+    if (rc) return rc;
+    char path[PFSPH_PATH_LEN + 64];
+    for (size_t i = 0; i < n; i++) {
+        pfsph_checkpoint_path(path, sizeof path, run_dir, (int)frames[i]);
+        if (unlink(path) != 0 && errno != ENOENT) {
+            rc = pfsph_fail(err, PFSPH_EIO, "%s: cannot remove: %s", path, strerror(errno));
+            break;
+        }
+    }
+    free(frames);
+    return rc;
+}
+
+/* Remove temporaries "ckpt_*.bin.tmp.*" left by a writer that was killed (best effort). */
+static void remove_temporaries(const char *run_dir)
+{
+    char dir[PFSPH_PATH_LEN + 64], path[2 * PFSPH_PATH_LEN];
+    snprintf(dir, sizeof dir, "%s/checkpoints", run_dir);
+    DIR *d = opendir(dir);
+    if (!d) return;
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if (strncmp(e->d_name, "ckpt_", 5) == 0 && strstr(e->d_name, ".bin.tmp.")) {
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            unlink(path);
+        }
+    closedir(d);
+}
+
+int pfsph_checkpoint_resume(const char *run_dir, pfsph_sim *sim, pfsph_checkpoint_info *info,
+                            pfsph_message_fn warn, void *user, pfsph_error *err)
+{
+    long *frames;
+    size_t n;
+    remove_temporaries(run_dir);
+    int rc = list_checkpoints(run_dir, &frames, &n, err);
+    if (rc) return rc;
+    if (n == 0) {
+        memset(info, 0, sizeof(*info));
+        info->frame = -1;
+        return PFSPH_OK;
+    }
+    char path[PFSPH_PATH_LEN + 64];
+    for (size_t i = 0; i < n; i++) {
+        pfsph_checkpoint_path(path, sizeof path, run_dir, (int)frames[i]);
+        pfsph_error e = {0};
+        rc = pfsph_checkpoint_load(path, sim, info, &e);
+        if (rc == PFSPH_OK) {
+            free(frames);
+            return PFSPH_OK;
+        }
+        if (rc == PFSPH_ENOMEM) {
+            free(frames);
+            *err = e;
+            return rc;
+        }
+        if (warn) {
+            char msg[sizeof e.msg + 64];
+            snprintf(msg, sizeof msg, "%s; %s", e.msg,
+                     i + 1 < n ? "trying the previous checkpoint" : "no older checkpoint left");
+            warn(msg, user);
+        }
+    }
+    free(frames);
+    snprintf(path, sizeof path, "%s/checkpoints", run_dir);
+    return pfsph_fail(err, PFSPH_EINPUT, "%s: no valid checkpoint to resume from (all were rejected, see above)",
+                      path);
+}

@@ -1,0 +1,343 @@
+/* Checkpoints: a round trip restores every bit of the state (and the next step is then the same
+ * bit for bit); a flipped byte, a truncated file and a checkpoint of another scene are refused
+ * with a message naming the file; only the newest 2 are kept; resume falls back past a corrupt
+ * one. */
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "pfsph/checkpoint.h"
+#include "pfsph/sim.h"
+#include "testutil.h"
+
+/* 2D dam break, coarse, with diffuse particles generated early (low thresholds). */
+static const char *SCENE =
+    "{\"dimension\": 2, \"particle_radius\": 0.01, \"gravity\": [0, %s],"
+    " \"domain\": {\"min\": [-0.05, -0.05], \"max\": [1.05, 0.8]},"
+    " \"solver\": {\"type\": \"%s\"}, \"time\": {\"end\": 1, \"fps\": 25, \"dt_max\": 0.004},"
+    " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": 5e-4},"
+    "              {\"name\": \"wall\", \"kind\": \"solid\"}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.3, 0.5], \"phase\": \"water\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [1.0, 0.7], \"open_top\": true,"
+    "               \"layers\": 2, \"phase\": \"wall\"}],"
+    " \"diffuse\": {\"enabled\": true, \"sampling_rate\": 400, \"phi_v_min\": 0.05, \"phi_v_max\": 1,"
+    "               \"phi_e_min\": 0.1, \"phi_e_max\": 2, \"energy_mass\": 1.0,"
+    "               \"lifetime_min\": 0.5, \"lifetime_max\": 2}}";
+
+static pfsph_sim *make_sim(const char *gravity, const char *solver)
+{
+    char json[4096];
+    snprintf(json, sizeof json, SCENE, gravity, solver);
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    int rc = pfsph_scene_parse(&s, json, "ckpt-scene", &err);
+    if (rc) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    rc = pfsph_sim_create(&sim, &s, &err);
+    if (rc) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    return sim;
+}
+
+static void assert_same_set(const pfsph_particles *a, const pfsph_particles *b)
+{
+    assert_int_equal(a->n, b->n);
+    assert_int_equal(a->next_id, b->next_id);
+    for (int k = 0; k < PFSPH_NFIELDS; k++)
+        assert_memory_equal(a->f[k], b->f[k], a->n * sizeof(pfsph_real));
+    assert_memory_equal(a->phase, b->phase, a->n);
+    assert_memory_equal(a->id, b->id, a->n * sizeof(uint32_t));
+}
+
+static void assert_same_sim(const pfsph_sim *a, const pfsph_sim *b)
+{
+    pfsph_sim_state sa, sb;
+    pfsph_sim_get_state(a, &sa);
+    pfsph_sim_get_state(b, &sb);
+    assert_memory_equal(&sa.time, &sb.time, sizeof(double));
+    assert_int_equal(sa.step, sb.step);
+    assert_memory_equal(&sa.amax, &sb.amax, sizeof(double));
+    assert_memory_equal(&sa.amax_np, &sb.amax_np, sizeof(double));
+    assert_int_equal(sa.removed, sb.removed);
+    assert_memory_equal(&sa.stats.vmax, &sb.stats.vmax, sizeof(double));
+    assert_memory_equal(&sa.stats.dt, &sb.stats.dt, sizeof(double));
+    assert_memory_equal(&sa.stats.ekin, &sb.stats.ekin, sizeof(double));
+    assert_int_equal(sa.stats.iterations, sb.stats.iterations);
+    assert_same_set(pfsph_sim_ctx(a)->fluid, pfsph_sim_ctx(b)->fluid);
+    const pfsph_particles *da = pfsph_sim_diffuse(a), *db = pfsph_sim_diffuse(b);
+    assert_true((da == NULL) == (db == NULL));
+    if (da) assert_same_set(da, db);
+    uint64_t ca, ra, cb, rb;
+    pfsph_sim_diffuse_totals(a, &ca, &ra);
+    pfsph_sim_diffuse_totals(b, &cb, &rb);
+    assert_int_equal(ca, cb);
+    assert_int_equal(ra, rb);
+}
+
+static void roundtrip(const char *solver)
+{
+    pfsph_error err = {0};
+    pfsph_sim *a = make_sim("-9.81", solver);
+    assert_int_equal(pfsph_sim_advance(a, 0.2, &err), PFSPH_OK);
+    assert_true(pfsph_sim_diffuse(a)->n > 0); /* the diffuse set is exercised */
+    void *data;
+    size_t len;
+    assert_int_equal(pfsph_checkpoint_encode(a, 5, &data, &len, &err), PFSPH_OK);
+    pfsph_sim *b = make_sim("-9.81", solver);
+    pfsph_checkpoint_info info = {0};
+    int rc = pfsph_checkpoint_decode(b, data, len, "mem", &info, &err);
+    if (rc) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    assert_int_equal(info.frame, 5);
+    assert_int_equal(info.threads, omp_get_max_threads());
+    assert_true(info.time == pfsph_sim_time(a));
+    assert_int_equal(info.step, pfsph_sim_steps(a));
+    assert_same_sim(a, b);
+    /* continuing gives the same bits */
+    assert_int_equal(pfsph_sim_advance(a, 0.28, &err), PFSPH_OK);
+    assert_int_equal(pfsph_sim_advance(b, 0.28, &err), PFSPH_OK);
+    assert_same_sim(a, b);
+    free(data);
+    pfsph_sim_destroy(a);
+    pfsph_sim_destroy(b);
+}
+
+static void test_roundtrip_pcisph(void **st)
+{
+    (void)st;
+    roundtrip("pcisph");
+}
+
+static void test_roundtrip_wcsph(void **st)
+{
+    (void)st;
+    roundtrip("wcsph");
+}
+
+static unsigned char *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char *b = malloc((size_t)n + 1);
+    assert_int_equal(fread(b, 1, (size_t)n, f), (size_t)n);
+    fclose(f);
+    *len = (size_t)n;
+    return b;
+}
+
+static void spit(const char *path, const unsigned char *b, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(b, 1, len, f), len);
+    fclose(f);
+}
+
+/* Load must fail with PFSPH_EINPUT, a message naming the file and containing `what`, and leave
+ * the simulation as it was. */
+static void expect_reject(const char *path, const char *what)
+{
+    pfsph_sim *b = make_sim("-9.81", "pcisph");
+    pfsph_error err = {0};
+    pfsph_checkpoint_info info;
+    int rc = pfsph_checkpoint_load(path, b, &info, &err);
+    fprintf(stderr, "  rejected as expected: %s\n", err.msg);
+    assert_int_equal(rc, PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, path));
+    assert_non_null(strstr(err.msg, what));
+    assert_true(pfsph_sim_time(b) == 0.0);
+    assert_int_equal(pfsph_sim_steps(b), 0);
+    pfsph_sim_destroy(b);
+}
+
+static void test_corrupt_and_truncated(void **st)
+{
+    (void)st;
+    pfsph_error err = {0};
+    pfsph_sim *a = make_sim("-9.81", "pcisph");
+    assert_int_equal(pfsph_sim_advance(a, 0.1, &err), PFSPH_OK);
+    char path[512], bad[512];
+    snprintf(path, sizeof path, "%s/good.bin", tu_tmpdir());
+    size_t bytes = 0;
+    assert_int_equal(pfsph_checkpoint_save(path, a, 2, &bytes, &err), PFSPH_OK);
+    size_t len;
+    unsigned char *b = slurp(path, &len);
+    assert_int_equal(len, bytes);
+
+    /* payload byte flipped (in the middle of the particle arrays) */
+    snprintf(bad, sizeof bad, "%s/flipped.bin", tu_tmpdir());
+    b[len / 2] ^= 0x10;
+    spit(bad, b, len);
+    expect_reject(bad, "checksum");
+    b[len / 2] ^= 0x10;
+    /* header byte flipped (the step count's neighbour: the payload length) */
+    snprintf(bad, sizeof bad, "%s/flipped_header.bin", tu_tmpdir());
+    b[26] ^= 0x01;
+    spit(bad, b, len);
+    expect_reject(bad, "checksum");
+    b[26] ^= 0x01;
+    /* last byte flipped */
+    snprintf(bad, sizeof bad, "%s/flipped_last.bin", tu_tmpdir());
+    b[len - 1] ^= 0x80;
+    spit(bad, b, len);
+    expect_reject(bad, "checksum");
+    b[len - 1] ^= 0x80;
+    /* truncated: by one byte, in the middle, inside the header, empty */
+    snprintf(bad, sizeof bad, "%s/truncated.bin", tu_tmpdir());
+    const size_t cuts[] = {len - 1, len / 3, 20, 0};
+    for (size_t k = 0; k < sizeof cuts / sizeof cuts[0]; k++) {
+        spit(bad, b, cuts[k]);
+        expect_reject(bad, "truncated");
+    }
+    /* the intact file still loads */
+    pfsph_sim *c = make_sim("-9.81", "pcisph");
+    pfsph_checkpoint_info info;
+    assert_int_equal(pfsph_checkpoint_load(path, c, &info, &err), PFSPH_OK);
+    assert_int_equal(info.frame, 2);
+    assert_same_sim(a, c);
+    free(b);
+    pfsph_sim_destroy(a);
+    pfsph_sim_destroy(c);
+}
+
+static void test_other_scene(void **st)
+{
+    (void)st;
+    pfsph_error err = {0};
+    pfsph_sim *a = make_sim("-9.81", "pcisph");
+    char path[512];
+    snprintf(path, sizeof path, "%s/other.bin", tu_tmpdir());
+    assert_int_equal(pfsph_checkpoint_save(path, a, 0, NULL, &err), PFSPH_OK);
+    const char *variants[][2] = {{"-9.0", "pcisph"}, {"-9.81", "wcsph"}};
+    for (int v = 0; v < 2; v++) {
+        pfsph_sim *b = make_sim(variants[v][0], variants[v][1]);
+        int rc = pfsph_checkpoint_load(path, b, NULL, &err);
+        fprintf(stderr, "  rejected as expected: %s\n", err.msg);
+        assert_int_equal(rc, PFSPH_EINPUT);
+        assert_non_null(strstr(err.msg, path));
+        assert_non_null(strstr(err.msg, "another scene"));
+        pfsph_sim_destroy(b);
+    }
+    /* output settings and the end time are not part of the hash */
+    static pfsph_scene s1, s2;
+    char json[4096];
+    snprintf(json, sizeof json, SCENE, "-9.81", "pcisph");
+    assert_int_equal(pfsph_scene_parse(&s1, json, "a", &err), PFSPH_OK);
+    s2 = s1;
+    s2.end_time = 7;
+    s2.output.checkpoint_interval = 3;
+    s2.threads = 5;
+    assert_true(pfsph_scene_hash(&s1) == pfsph_scene_hash(&s2));
+    s2.seed = s1.seed + 1;
+    assert_true(pfsph_scene_hash(&s1) != pfsph_scene_hash(&s2));
+    pfsph_sim_destroy(a);
+}
+
+static void test_scene_key(void **st)
+{
+    (void)st;
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    char base[4096], json[4200];
+    snprintf(base, sizeof base, SCENE, "-9.81", "pcisph");
+    base[strlen(base) - 1] = 0; /* drop the closing brace */
+    snprintf(json, sizeof json, "%s}", base);
+    int rc = pfsph_scene_parse(&s, json, "k", &err);
+    if (rc) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    assert_int_equal(s.output.checkpoint_interval, 10);
+    snprintf(json, sizeof json, "%s, \"output\": {\"checkpoint_interval\": 0}}", base);
+    assert_int_equal(pfsph_scene_parse(&s, json, "k", &err), PFSPH_OK);
+    assert_int_equal(s.output.checkpoint_interval, 0);
+    snprintf(json, sizeof json, "%s, \"output\": {\"checkpoint_interval\": -1}}", base);
+    assert_int_equal(pfsph_scene_parse(&s, json, "k", &err), PFSPH_EINPUT);
+    fprintf(stderr, "  rejected as expected: %s\n", err.msg);
+    assert_non_null(strstr(err.msg, "$.output.checkpoint_interval"));
+}
+
+static int nwarn;
+static char lastwarn[1200];
+static void on_warn(const char *msg, void *user)
+{
+    (void)user;
+    nwarn++;
+    snprintf(lastwarn, sizeof lastwarn, "%s", msg);
+    fprintf(stderr, "  warning: %s\n", msg);
+}
+
+static void test_keep_and_fallback(void **st)
+{
+    (void)st;
+    pfsph_error err = {0};
+    const char *run = tu_tmpdir();
+    pfsph_sim *a = make_sim("-9.81", "pcisph");
+    pfsph_sim *ref = make_sim("-9.81", "pcisph");
+    for (int fr = 1; fr <= 3; fr++) {
+        assert_int_equal(pfsph_sim_advance(a, fr * 0.04, &err), PFSPH_OK);
+        assert_int_equal(pfsph_checkpoint_write_run(run, a, fr, PFSPH_CHECKPOINT_KEEP, NULL, &err), PFSPH_OK);
+        if (fr <= 2) assert_int_equal(pfsph_sim_advance(ref, fr * 0.04, &err), PFSPH_OK);
+    }
+    char p1[1100], p2[1100], p3[1100];
+    struct stat sb;
+    pfsph_checkpoint_path(p1, sizeof p1, run, 1);
+    pfsph_checkpoint_path(p2, sizeof p2, run, 2);
+    pfsph_checkpoint_path(p3, sizeof p3, run, 3);
+    assert_int_not_equal(stat(p1, &sb), 0); /* pruned */
+    assert_int_equal(stat(p2, &sb), 0);
+    assert_int_equal(stat(p3, &sb), 0);
+
+    /* newest intact: used, no warning */
+    pfsph_sim *b = make_sim("-9.81", "pcisph");
+    pfsph_checkpoint_info info;
+    nwarn = 0;
+    assert_int_equal(pfsph_checkpoint_resume(run, b, &info, on_warn, NULL, &err), PFSPH_OK);
+    assert_int_equal(info.frame, 3);
+    assert_int_equal(nwarn, 0);
+    assert_same_sim(a, b);
+    pfsph_sim_destroy(b);
+
+    /* newest truncated: reported, the previous one used */
+    size_t len;
+    unsigned char *buf = slurp(p3, &len);
+    spit(p3, buf, len - 7);
+    free(buf);
+    b = make_sim("-9.81", "pcisph");
+    nwarn = 0;
+    assert_int_equal(pfsph_checkpoint_resume(run, b, &info, on_warn, NULL, &err), PFSPH_OK);
+    assert_int_equal(info.frame, 2);
+    assert_int_equal(nwarn, 1);
+    assert_non_null(strstr(lastwarn, p3));
+    assert_same_sim(ref, b);
+    pfsph_sim_destroy(b);
+
+    /* both bad: an error naming the folder */
+    buf = slurp(p2, &len);
+    buf[len / 2] ^= 1;
+    spit(p2, buf, len);
+    free(buf);
+    b = make_sim("-9.81", "pcisph");
+    nwarn = 0;
+    assert_int_equal(pfsph_checkpoint_resume(run, b, &info, on_warn, NULL, &err), PFSPH_EINPUT);
+    assert_int_equal(nwarn, 2);
+    assert_non_null(strstr(err.msg, "checkpoints"));
+    pfsph_sim_destroy(b);
+    pfsph_sim_destroy(a);
+    pfsph_sim_destroy(ref);
+}
+
+int main(int argc, char **argv)
+{
+    tu_init(argc, argv);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_roundtrip_pcisph), cmocka_unit_test(test_roundtrip_wcsph),
+        cmocka_unit_test(test_corrupt_and_truncated), cmocka_unit_test(test_other_scene),
+        cmocka_unit_test(test_keep_and_fallback), cmocka_unit_test(test_scene_key),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
