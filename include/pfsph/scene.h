@@ -43,6 +43,7 @@ typedef struct pfsph_block {
     double height;         /* CYLINDER, along axis */
     int axis;              /* CYLINDER: 0 x, 1 y, 2 z */
     double velocity[3];    /* initial velocity, m/s */
+    double jitter;         /* random lattice displacement, fraction of the spacing (0: none) */
 } pfsph_block;
 
 /* A static solid sampled with boundary particles. */
@@ -65,6 +66,7 @@ typedef struct pfsph_output {
     bool write_boundary;      /* also write the boundary set */
     unsigned fields;          /* bitmask of extra fields, see PFSPH_OUT_* */
     int frame_interval;       /* write every n-th frame (1 = every frame) */
+    int checkpoint_interval;  /* checkpoint every n-th frame (0 = never); docs/checkpoints.md */
 } pfsph_output;
 
 enum { PFSPH_OUT_ID = 1u << 0, PFSPH_OUT_SPEED = 1u << 1 };

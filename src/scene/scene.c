@@ -596,12 +596,12 @@ static int parse_fluid(parser *p, const cJSON *root)
         pfsph_block *b = &s->blocks[i];
         memset(b, 0, sizeof *b);
         TRY(json_enum(p, e, P, "shape", block_shapes, &b->shape));
-        static const char *const k_box[] = {"shape", "phase", "velocity", "min", "max",
+        static const char *const k_box[] = {"shape", "phase", "velocity", "jitter", "min", "max",
                                             "comment", NULL};
-        static const char *const k_sph[] = {"shape", "phase", "velocity", "center", "radius",
-                                            "comment", NULL};
-        static const char *const k_cyl[] = {"shape", "phase", "velocity", "center", "radius",
-                                            "height", "axis", "comment", NULL};
+        static const char *const k_sph[] = {"shape", "phase", "velocity", "jitter", "center",
+                                            "radius", "comment", NULL};
+        static const char *const k_cyl[] = {"shape", "phase", "velocity", "jitter", "center",
+                                            "radius", "height", "axis", "comment", NULL};
         const char *const *keys = b->shape == PFSPH_SHAPE_BOX      ? k_box
                                   : b->shape == PFSPH_SHAPE_SPHERE ? k_sph
                                                                    : k_cyl;
@@ -609,6 +609,7 @@ static int parse_fluid(parser *p, const cJSON *root)
         TRY(parse_geometry(p, e, P, b->shape, b->min, b->max, b->center, &b->radius, &b->height,
                            &b->axis));
         TRY(vecd(p, e, P, "velocity", -VEL_MAX, VEL_MAX, b->velocity));
+        TRY(pfsph__json_number(e, P, "jitter", 0.0, 0.5, &b->jitter, &p->ctx));
         b->phase = def;
         TRY(phase_ref(p, e, P, false, &b->phase));
         if (b->phase < 0) {
@@ -730,7 +731,7 @@ static int parse_output(parser *p, const cJSON *root)
     const cJSON *v = get(root, "output");
     if (!v) return PFSPH_OK;
     static const char *const keys[] = {"directory", "formats", "fields", "boundary",
-                                       "frame_interval", NULL};
+                                       "frame_interval", "checkpoint_interval", NULL};
     const char *P = "$.output";
     TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
     TRY(pfsph__json_string(v, P, "directory", o->dir, sizeof o->dir, &p->ctx));
@@ -738,6 +739,7 @@ static int parse_output(parser *p, const cJSON *root)
         return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
     TRY(pfsph__json_bool(v, P, "boundary", &o->write_boundary, &p->ctx));
     TRY(pfsph__json_int(v, P, "frame_interval", 1, 1000000, &o->frame_interval, &p->ctx));
+    TRY(pfsph__json_int(v, P, "checkpoint_interval", 0, 1000000, &o->checkpoint_interval, &p->ctx));
     const cJSON *f = get(v, "formats");
     if (f) {
         static const char *const names[] = {"vtp", "ply", NULL};
@@ -892,6 +894,7 @@ void pfsph_scene_defaults(pfsph_scene *s)
     s->output.write_boundary = true;
     s->output.fields = 0;
     s->output.frame_interval = 1;
+    s->output.checkpoint_interval = 10;
     s->camera.set = false;
     s->camera.up[1] = 1.0;
     s->camera.eye[2] = 1.0;

@@ -4,6 +4,8 @@
 
 #include <math.h>
 
+#include "pfsph/rng.h"
+
 static const double PI = 3.14159265358979323846;
 
 static int emit(pfsph_particles *ps, long *count, double x, double y, double z,
@@ -68,6 +70,12 @@ long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d,
                                lo[1] + (hi[1] - lo[1] - (n[1] - 1) * d) * 0.5 + j * d,
                                dim == 3 ? lo[2] + (hi[2] - lo[2] - (n[2] - 1) * d) * 0.5 + k * d : 0};
                 if (b->shape != PFSPH_SHAPE_BOX && !inside_block(b, dim, p)) continue;
+                if (b->jitter > 0) { /* from the scene seed, the block and the lattice site */
+                    double u[4];
+                    pfsph_rng_uniform4(s->seed, (uint32_t)(i + n[0] * (j + n[1] * k)), 0,
+                                       0x4a170000u + (uint32_t)(b - s->blocks), u);
+                    for (int a = 0; a < dim; a++) p[a] += b->jitter * d * (2 * u[a] - 1);
+                }
                 if (emit(ps, &count, p[0], p[1], p[2], b->velocity, b->phase)) return -1;
             }
     return count;

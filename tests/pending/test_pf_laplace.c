@@ -1,7 +1,9 @@
 /* Laplace law in 2D with pairwise forces (PF Eqs. 3, 6, 13): drops of three radii relax without
  * gravity; the mechanical pressure inside (pressure virial + pair-force virial, NOTES item 6)
  * must be linear in 1/R with slope sigma, the surface tension the coefficients predict through
- * lambda (docs/pairwise.md). */
+ * lambda (docs/pairwise.md).
+ * Exploration knobs (pending test only): PF_SOLVER, PF_K, PF_NU, PF_JIT, PF_T, PF_PW (extra pairwise
+ * keys), PF_RADII ("r1,r2,r3" in m). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -65,11 +67,11 @@ static double drop_pressure(double R, double t_end, double *R_eff, double *lambd
     snprintf(json, sizeof json,
              "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
              " \"domain\": {\"min\": [-0.6, -0.6], \"max\": [0.6, 0.6]},"
-             " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"dt_max\": 0.002},"
-             " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.003}],"
-             " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0], \"radius\": %g}],"
-             " \"pairwise\": {\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %g}]}}",
-             R, SIGMA);
+             " \"solver\": {\"type\": \"%s\"}, \"time\": {\"dt_max\": 0.002},"
+             " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}],"
+             " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0], \"radius\": %g, \"jitter\": %s}],"
+             " \"pairwise\": {%s \"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %g}]}}",
+             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", getenv("PF_NU") ? getenv("PF_NU") : "0.003", R, getenv("PF_JIT") ? getenv("PF_JIT") : "0", getenv("PF_PW") ? getenv("PF_PW") : "", getenv("PF_K") ? getenv("PF_K") : "1.3867", SIGMA);
     pfsph_scene *s = malloc(sizeof *s);
     pfsph_error err = {0};
     int rc = pfsph_scene_parse(s, json, "laplace.json", &err);
@@ -106,12 +108,13 @@ static void test_laplace(void **state)
     (void)state;
     /* Small drops on purpose: tiny problems only lose time to thread synchronisation. */
     omp_set_num_threads(1);
-    const double radii[] = {0.15, 0.2, 0.25};
+    double radii[] = {0.15, 0.2, 0.25};
+    if (getenv("PF_RADII")) sscanf(getenv("PF_RADII"), "%lf,%lf,%lf", &radii[0], &radii[1], &radii[2]);
     const int nr = 3;
     double x[3], y[3], sig_pred = 0;
     for (int i = 0; i < nr; i++) {
         double Reff;
-        y[i] = drop_pressure(radii[i], 1.2, &Reff, &sig_pred);
+        y[i] = drop_pressure(radii[i], getenv("PF_T") ? atof(getenv("PF_T")) : 1.2, &Reff, &sig_pred);
         x[i] = 1.0 / Reff;
         print_message("R = %.4f m (%.0f spacings): P_inside = %.4f Pa, sigma/R = %.4f Pa\n", Reff,
                       Reff / 0.01, y[i], sig_pred * x[i]);

@@ -4,7 +4,10 @@
  * that no two particles come closer than half the spacing (no clustering, PF Section 3.2).
  * k = 1.7 rather than Eq. 5's 1.387: at h = 2 d in 2D the paper's k leaves about 24 pair
  * neighbours and the rectangle locks into a lattice (moment ratio stays ~0.28 with nu = 0.01,
- * ~0.27 with nu = 0.001); see docs/pairwise.md, "Lattice locking in 2D". */
+ * ~0.27 with nu = 0.001); see docs/pairwise.md, "Lattice locking in 2D".
+ * Exploration knobs (pending test only; defaults are the values above): PF_K, PF_NU, PF_SIG,
+ * PF_JIT (block jitter), PF_L (half width [m]), PF_T (end time [s]), PF_SEED, PF_SOLVER,
+ * PF_PW (extra keys for the pairwise block, e.g. '"eta": 0,'), PF_TH (threads). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -58,14 +61,18 @@ static shape_stats measure(const pfsph_ctx *c)
 static void test_rectangle_to_disc(void **state)
 {
     (void)state;
-    omp_set_num_threads(1); /* 450 particles: threads only add synchronisation */
-    const char *json =
-        "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
+    omp_set_num_threads(getenv("PF_TH") ? atoi(getenv("PF_TH")) : 1); /* 450 particles: threads only add synchronisation */
+    char json[2048];
+    const double L = getenv("PF_L") ? atof(getenv("PF_L")) : 0.15;
+    const char *ek = getenv("PF_K"), *ej = getenv("PF_JIT"), *en = getenv("PF_NU"), *es = getenv("PF_SIG");
+    snprintf(json, sizeof json,
+        "{\"dimension\": 2, \"seed\": %s, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
         " \"domain\": {\"min\": [-0.5, -0.5], \"max\": [0.5, 0.5]},"
-        " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"dt_max\": 0.002},"
-        " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.001}],"
-        " \"fluid\": [{\"shape\": \"box\", \"min\": [-0.15, -0.075], \"max\": [0.15, 0.075]}],"
-        " \"pairwise\": {\"k\": 1.7, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}}";
+        " \"solver\": {\"type\": \"%s\"}, \"time\": {\"dt_max\": 0.002},"
+        " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}],"
+        " \"fluid\": [{\"shape\": \"box\", \"min\": [-%g, -%g], \"max\": [%g, %g], \"jitter\": %s}],"
+        " \"pairwise\": {%s \"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %s}]}}",
+        getenv("PF_SEED") ? getenv("PF_SEED") : "1", getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", en ? en : "0.001", L, 0.5 * L, L, 0.5 * L, ej ? ej : "0", getenv("PF_PW") ? getenv("PF_PW") : "", ek ? ek : "1.7", es ? es : "4");
     pfsph_scene *s = malloc(sizeof *s);
     pfsph_error err = {0};
     int rc = pfsph_scene_parse(s, json, "rect.json", &err);
@@ -82,7 +89,8 @@ static void test_rectangle_to_disc(void **state)
                   st.polar);
     assert_true(st.ratio < 0.3);
     double dmin = st.dmin;
-    for (int k = 1; k <= 8; k++) {
+    const int nk = getenv("PF_T") ? (int)(4 * atof(getenv("PF_T"))) : 8;
+    for (int k = 1; k <= nk; k++) {
         rc = pfsph_sim_advance(sim, 0.25 * k, &err);
         if (rc) print_message("%s\n", err.msg);
         assert_int_equal(rc, PFSPH_OK);
