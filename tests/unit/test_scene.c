@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "pfsph/scene.h"
+#include "scene/shapes.h"
 #include "testutil.h"
 
 /* A minimal valid 3D scene body: domain plus one small fluid box. */
@@ -190,6 +191,45 @@ static void test_2d(void **state)
     assert_int_equal(s->phases[1].kind, PFSPH_PHASE_SOLID);
     assert_int_equal(s->solids[0].phase, 1);
     assert_int_equal(s->solids[1].phase, 1);
+}
+
+/* "jitter" displaces lattice sites by at most jitter * spacing per axis, deterministically from
+ * the seed; out-of-range values are errors. */
+static void test_block_jitter(void **state)
+{
+    (void)state;
+    pfsph_error err;
+    assert_int_equal(parse("{\"particle_radius\":0.01," DOM3 ",\"fluid\":[{\"shape\":\"box\","
+                           "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"jitter\":0.6}]}", &err),
+                     PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "$.fluid[0].jitter"));
+    static pfsph_scene a;
+    pfsph_particles p0, p1, p2;
+    const double d = 0.02;
+    for (int k = 0; k < 3; k++) {
+        expect_ok(k == 0 ? SCENE3("") : "{\"particle_radius\":0.01," DOM3 ",\"fluid\":[{\"shape\":\"box\","
+                          "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"jitter\":0.25}]}");
+        a = g_scene;
+        pfsph_particles *p = k == 0 ? &p0 : k == 1 ? &p1 : &p2;
+        assert_int_equal(pfsph_particles_init(p, 16), PFSPH_OK);
+        assert_true(pfsph__sample_block(&a, &a.blocks[0], d, p) > 0);
+    }
+    assert_int_equal(p0.n, p1.n);
+    assert_int_equal(p1.n, p2.n);
+    double moved = 0;
+    for (size_t i = 0; i < p0.n; i++) {
+        const pfsph_real *q0[3] = {p0.x, p0.y, p0.z}, *q1[3] = {p1.x, p1.y, p1.z}, *q2[3] = {p2.x, p2.y, p2.z};
+        for (int ax = 0; ax < 3; ax++) {
+            double off = fabs((double)q1[ax][i] - (double)q0[ax][i]);
+            assert_true(off <= 0.25 * d * (1 + 1e-5));
+            assert_true(q1[ax][i] == q2[ax][i]); /* same seed, same positions */
+            moved += off;
+        }
+    }
+    assert_true(moved > 0.05 * d * (double)p0.n); /* it did move them (mean |u| is 1/8 d) */
+    pfsph_particles_free(&p0);
+    pfsph_particles_free(&p1);
+    pfsph_particles_free(&p2);
 }
 
 static void test_touching_blocks_ok(void **state)
@@ -521,6 +561,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_2d),
         cmocka_unit_test(test_touching_blocks_ok),
+        cmocka_unit_test(test_block_jitter),
         cmocka_unit_test(test_error_leaves_scene_unchanged),
         cmocka_unit_test(test_default_scene),
         cmocka_unit_test(test_load_file),
