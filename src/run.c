@@ -262,8 +262,26 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     int ckpt_frame = -1;
     size_t ckpt_bytes = 0;
     double ckpt_s = 0;
+    /* The state at the last finished frame, kept in memory so that a blow-up can leave it
+     * behind as a checkpoint (41 bytes per fluid particle in single precision). */
+    void *good = NULL;
+    size_t good_len = 0;
+    int good_frame = frame0;
+    pfsph_error enc_err;
+    if (pfsph_checkpoint_encode(sim, frame0, &good, &good_len, &enc_err) != PFSPH_OK) good = NULL;
     for (frame = frame0 + 1; frame <= nframes && !rc; frame++) {
         rc = pfsph_sim_advance(sim, frame / s->fps, err);
+        if (rc == PFSPH_EUNSTABLE && good) {
+            char cp[PFSPH_PATH_LEN + 64];
+            pfsph_error e3;
+            pfsph_checkpoint_path(cp, sizeof cp, dir, good_frame);
+            snprintf(path, sizeof path, "%s/checkpoints", dir);
+            size_t len = strlen(err->msg);
+            if (pfsph_mkdirs(path, &e3) == PFSPH_OK &&
+                pfsph_write_file_atomic(cp, good, good_len, &e3) == PFSPH_OK)
+                snprintf(err->msg + len, sizeof err->msg - len,
+                         ". The last good state (frame %d) is kept in %s", good_frame, cp);
+        }
         if (rc) break;
         double t0 = omp_get_wtime();
         if (frame % fi == 0) {
@@ -277,6 +295,16 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
             ckpt_s = omp_get_wtime() - c0;
             ckpt_frame = frame;
         }
+        if (!rc) {
+            void *g2 = NULL;
+            size_t l2 = 0;
+            if (pfsph_checkpoint_encode(sim, frame, &g2, &l2, &enc_err) == PFSPH_OK) {
+                free(good);
+                good = g2;
+                good_len = l2;
+                good_frame = frame;
+            }
+        }
         pfsph_sim_add_stage_time(sim, PFSPH_STAGE_OUTPUT, omp_get_wtime() - t0);
         if (o && o->progress) {
             double wall = omp_get_wtime() - w0;
@@ -287,6 +315,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
         }
     }
     fclose(csv);
+    free(good);
     pfsph_error e2;
     const char *status = rc == PFSPH_OK ? "finished" : rc == PFSPH_EUNSTABLE ? "unstable" : "failed";
     run_info info = {resume ? frame0 : -1, ckpt_frame, ckpt_bytes, ckpt_s};

@@ -1,0 +1,62 @@
+/* A scene tuned to explode (WCSPH with a speed of sound below the free-fall speed of its column)
+ * stops with exit status 3 and a diagnosis naming step, time, stage, particle and cause, and
+ * leaves the last good frame behind as a checkpoint that loads. */
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "pfsph/checkpoint.h"
+#include "pfsph/scene.h"
+#include "pfsph/sim.h"
+#include "testutil.h"
+
+static const char *SCENE =
+    "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
+    " \"domain\": {\"min\": [-0.05, -0.05], \"max\": [0.65, 0.45]},"
+    " \"solver\": {\"type\": \"wcsph\", \"sound_speed\": 1.5},"
+    " \"time\": {\"end\": 1, \"fps\": 50},"
+    " \"phases\": [{\"name\": \"water\", \"viscosity\": 2e-4}, {\"name\": \"wall\", \"kind\": \"solid\"}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.15, 0.3], \"phase\": \"water\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.6, 0.4], \"phase\": \"wall\"}]}";
+
+static void test_blowup_diagnosis(void **state)
+{
+    (void)state;
+    char scene[512], run[512], cmd[2048], out[8192];
+    snprintf(scene, sizeof scene, "%s/explode.json", tu_tmpdir());
+    snprintf(run, sizeof run, "%s/explode_run", tu_tmpdir());
+    assert_int_equal(tu_write_file(scene, SCENE), 0);
+    snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet", tu_pfsph_bin(), scene, run);
+    int st = tu_run(cmd, out, sizeof out);
+    printf("exit %d: %s", st, out);
+    assert_int_equal(st, 3);
+    const char *must[] = {"unstable at step", "t = ", "stage ", "particle id", "phase 'water'",
+                          "position", "likely cause", "sound_speed", "last good state (frame"};
+    for (size_t k = 0; k < sizeof must / sizeof *must; k++)
+        if (!strstr(out, must[k])) fail_msg("diagnosis lacks \"%s\"", must[k]);
+    /* the kept checkpoint is the named frame and restores into the same scene */
+    int frame = -1;
+    const char *f = strstr(out, "last good state (frame ");
+    assert_int_equal(sscanf(f, "last good state (frame %d)", &frame), 1);
+    char cp[1024];
+    pfsph_checkpoint_path(cp, sizeof cp, run, frame);
+    struct stat sb;
+    assert_int_equal(stat(cp, &sb), 0);
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(&s, SCENE, "explode", &err), PFSPH_OK);
+    pfsph_sim *sim;
+    assert_int_equal(pfsph_sim_create(&sim, &s, &err), PFSPH_OK);
+    pfsph_checkpoint_info info;
+    int rc = pfsph_checkpoint_load(cp, sim, &info, &err);
+    if (rc) fail_msg("%s", err.msg);
+    assert_int_equal(info.frame, frame);
+    pfsph_sim_destroy(sim);
+}
+
+int main(int argc, char **argv)
+{
+    tu_init(argc, argv);
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_blowup_diagnosis)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
