@@ -41,6 +41,9 @@ struct pfsph_sim {
     double stage_s[PFSPH_NSTAGES];
 };
 
+/* compression (rho / rho0 - 1) that stops a run as unstable */
+#define PFSPH_DENSITY_ERROR_LIMIT 0.5
+
 static double now(void) { return omp_get_wtime(); }
 static double max_speed(const pfsph_particles *f, size_t *worst);
 
@@ -422,8 +425,21 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     t0 = t1;
 
     pfsph__number_density(c, f->x, f->y, f->z, c->nd);
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) f->rho[i] = c->mass[f->phase[i]] * c->nd[i];
+    pfsph_real ndmax = 0;
+#pragma omp parallel for schedule(static) reduction(max : ndmax)
+    for (size_t i = 0; i < n; i++) {
+        f->rho[i] = c->mass[f->phase[i]] * c->nd[i];
+        if (c->nd[i] > ndmax) ndmax = c->nd[i];
+    }
+    /* A particle compressed by half again its rest density means the pressure solve has lost
+     * control (PCISPH aims at 0.5%, WCSPH at Mach 0.1 stays near 1%): stop before the pressure
+     * solve turns it into NaN. */
+    if ((double)ndmax / (double)c->nd0 - 1 > PFSPH_DENSITY_ERROR_LIMIT) {
+        size_t wi = 0;
+        for (size_t i = 1; i < n; i++)
+            if (c->nd[i] > c->nd[wi]) wi = i;
+        return blowup(sim, "density", wi, "relative density error", (double)ndmax / (double)c->nd0 - 1, err);
+    }
     t1 = now();
     sim->stage_s[PFSPH_STAGE_DENSITY] += t1 - t0;
     t0 = t1;

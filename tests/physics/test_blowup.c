@@ -1,6 +1,7 @@
 /* A scene tuned to explode (WCSPH with a speed of sound below the free-fall speed of its column)
  * stops with exit status 3 and a diagnosis naming step, time, stage, particle and cause, and
- * leaves the last good frame behind as a checkpoint that loads. */
+ * leaves the last good frame behind as a checkpoint that loads; a squeezed state stops at the
+ * density check. */
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -54,9 +55,40 @@ static void test_blowup_diagnosis(void **state)
     pfsph_sim_destroy(sim);
 }
 
+/* A state squeezed to a quarter of its area (2D: four times the rest density) stops at the
+ * density check, naming it. */
+static void test_density_explosion(void **state)
+{
+    (void)state;
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(&s, SCENE, "explode", &err), PFSPH_OK);
+    s.solver = PFSPH_SOLVER_PCISPH;
+    pfsph_sim *sim;
+    assert_int_equal(pfsph_sim_create(&sim, &s, &err), PFSPH_OK);
+    const pfsph_particles *f = pfsph_sim_ctx(sim)->fluid;
+    pfsph_particles squeezed;
+    assert_int_equal(pfsph_particles_init(&squeezed, f->n), PFSPH_OK);
+    for (size_t i = 0; i < f->n; i++) {
+        pfsph_real x[3] = {f->x[i] * (pfsph_real)0.5, f->y[i] * (pfsph_real)0.5, 0};
+        assert_true(pfsph_particles_push(&squeezed, x, NULL, f->phase[i]) >= 0);
+    }
+    pfsph_sim_state st;
+    pfsph_sim_get_state(sim, &st);
+    assert_int_equal(pfsph_sim_restore(sim, &st, &squeezed, NULL, 0, 0, &err), PFSPH_OK);
+    int rc = pfsph_sim_step(sim, 1.0, &err);
+    printf("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_EUNSTABLE);
+    assert_non_null(strstr(err.msg, "stage density"));
+    assert_non_null(strstr(err.msg, "relative density error"));
+    pfsph_particles_free(&squeezed);
+    pfsph_sim_destroy(sim);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_blowup_diagnosis)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_blowup_diagnosis),
+                                       cmocka_unit_test(test_density_explosion)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
