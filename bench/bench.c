@@ -17,9 +17,13 @@ static void usage(void)
 {
     fprintf(stderr,
             "usage: bench [--particles N] [--steps N] [--warmup N] [--solver wcsph|pcisph]\n"
-            "             [--pairwise] [--threads N]\n"
+            "             [--pairwise] [--threads N] [--diffuse N] [--diffuse-emit-all]\n"
             "Runs a 3D dam break of about N fluid particles (default 50000) for --steps steps\n"
-            "(default 20) after --warmup steps (default 3) and prints throughput figures.\n");
+            "(default 20) after --warmup steps (default 3) and prints throughput figures.\n"
+            "--diffuse N turns diffuse material on (the limits of scenes/diffuse_dam_*.json)\n"
+            "and seeds N diffuse particles in and around the water block before the warm-up;\n"
+            "--diffuse-emit-all sets phi_e_min = 0 so every moving fluid particle evaluates the\n"
+            "velocity difference of Eqs. 10-13 (worst case of the generation stage).\n");
 }
 
 /* Mean number of neighbours j != i within h of each fluid particle: fluid ones through the
@@ -57,10 +61,64 @@ static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_n
     *fluid_cand = n > 0 ? (double)nc / (double)n : 0;
 }
 
+/* Deterministic uniform in [0, 1) from an integer (splitmix64 finaliser). */
+static double hash_unit(uint64_t k)
+{
+    k += 0x9E3779B97F4A7C15ull;
+    k = (k ^ (k >> 30)) * 0xBF58476D1CE4E5B9ull;
+    k = (k ^ (k >> 27)) * 0x94D049BB133111EBull;
+    k ^= k >> 31;
+    return (double)(k >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Seed n diffuse particles around the fluid of a freshly created simulation (through
+ * pfsph_sim_restore, as a checkpoint would): of every five, three sit inside the water within
+ * a spacing of a fluid particle (bubbles), one on the block's top surface (foam) and one in the
+ * air above it (spray, up to 0.3 m higher). Fluid particles are taken in a fixed stride, so the
+ * seeding is deterministic. Lifetimes are long enough that none expires during the run. */
+static int seed_diffuse(pfsph_sim *sim, long n, double top, pfsph_error *err)
+{
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    const pfsph_particles *f = c->fluid;
+    pfsph_particles fc, dp;
+    if (pfsph_particles_init(&fc, f->n) != PFSPH_OK) return PFSPH_ENOMEM;
+    if (pfsph_particles_init(&dp, (size_t)n + 1) != PFSPH_OK) {
+        pfsph_particles_free(&fc);
+        return PFSPH_ENOMEM;
+    }
+    for (int k = 0; k < PFSPH_NFIELDS; k++) memcpy(fc.f[k], f->f[k], f->n * sizeof(pfsph_real));
+    memcpy(fc.phase, f->phase, f->n);
+    memcpy(fc.id, f->id, f->n * sizeof(uint32_t));
+    fc.n = f->n;
+    fc.next_id = f->next_id;
+    const double d = (double)c->spacing;
+    for (long i = 0; i < n; i++) {
+        size_t j = (size_t)((unsigned long long)i * f->n / (unsigned long long)n);
+        double u0 = hash_unit(4 * (uint64_t)i), u1 = hash_unit(4 * (uint64_t)i + 1),
+               u2 = hash_unit(4 * (uint64_t)i + 2);
+        double x = f->x[j] + d * (2 * u0 - 1), y = f->y[j], z = f->z[j] + d * (2 * u2 - 1);
+        switch (i % 5) {
+        case 3: y = top + 0.5 * d * u1; break;    /* foam layer */
+        case 4: y = top + 2 * d + 0.3 * u1; break; /* spray */
+        default: y += d * (2 * u1 - 1); break;    /* bubbles */
+        }
+        const pfsph_real p[3] = {(pfsph_real)x, (pfsph_real)y, (pfsph_real)z};
+        long s = pfsph_particles_push(&dp, p, NULL, 0);
+        if (s >= 0) dp.aux[s] = 100; /* lifetime [s] */
+    }
+    pfsph_sim_state st;
+    pfsph_sim_get_state(sim, &st);
+    int rc = pfsph_sim_restore(sim, &st, &fc, &dp, (uint64_t)dp.n, 0, err);
+    pfsph_particles_free(&fc);
+    pfsph_particles_free(&dp);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     long target = 50000, steps = 20, warmup = 3;
-    int pcisph = 0, pairwise = 0, threads = 0;
+    int pcisph = 0, pairwise = 0, threads = 0, emit_all = 0;
+    long ndiffuse = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -74,9 +132,15 @@ int main(int argc, char **argv)
             else { usage(); return 2; }
             i++;
         } else if (!strcmp(a, "--pairwise")) pairwise = 1;
+        else if (!strcmp(a, "--diffuse") && v) { ndiffuse = atol(v); i++; }
+        else if (!strcmp(a, "--diffuse-emit-all")) emit_all = 1;
         else { usage(); return !strcmp(a, "--help") || !strcmp(a, "-h") ? 0 : 2; }
     }
-    if (target < 100 || steps < 1 || warmup < 0 || threads < 0) { usage(); return 2; }
+    if (target < 100 || steps < 1 || warmup < 0 || threads < 0 || (emit_all && ndiffuse < 0) ||
+        ndiffuse > 100000000) {
+        usage();
+        return 2;
+    }
 
     /* The block is 3 x 4 x 3 lattice units per unit k (0.45 x 0.6 x 0.45 m as in
      * scenes/dam_break_3d.json), so n = 36 k^3; the spacing follows from the 0.6 m height.
@@ -97,7 +161,17 @@ int main(int argc, char **argv)
         snprintf(pair, sizeof pair,
                  ",\n\"pairwise\": {\"coefficients\": [{\"phases\": [\"water\", \"water\"], "
                  "\"c\": 1000}]}");
-    char json[4096];
+    /* Diffuse block: the limits of scenes/diffuse_dam_*.json; the cap leaves room above the
+     * seeded count so that generation runs (it is skipped at the cap). */
+    char dif[1024] = "";
+    if (ndiffuse >= 0)
+        snprintf(dif, sizeof dif,
+                 ",\n\"diffuse\": {\"max_particles\": %ld, \"sampling_rate\": 100, "
+                 "\"phi_v_min\": 2, \"phi_v_max\": 8, \"phi_e_min\": %g, \"phi_e_max\": 4.5, "
+                 "\"energy_mass\": 1, \"emit_radius_scale\": 2, \"lifetime_min\": 0.5, "
+                 "\"lifetime_max\": 2.5}",
+                 2 * ndiffuse + 100000, emit_all ? 0.0 : 0.5);
+    char json[8192];
     snprintf(json, sizeof json,
              "{\"name\": \"bench\", \"dimension\": 3, \"particle_radius\": %.9g,\n"
              "\"gravity\": [0, -9.81, 0], \"threads\": %d,\n"
@@ -113,9 +187,9 @@ int main(int argc, char **argv)
              "\"max\": [%.9g, %.9g, %.9g], \"open_top\": true, \"layers\": 2, "
              "\"phase\": \"wall\"}],\n"
              "\"output\": {\"directory\": \"bench_run\", \"formats\": [], \"boundary\": false}"
-             "%s}\n",
+             "%s%s}\n",
              r, threads, -m, -m, -m, tx + m, ty + m, tz + m, pcisph ? "pcisph" : "wcsph", bx,
-             by, bz, tx, ty, tz, pair);
+             by, bz, tx, ty, tz, pair, dif);
 
     static pfsph_scene scene;
     pfsph_error err = {0};
@@ -133,6 +207,11 @@ int main(int argc, char **argv)
         return 1;
     }
     double t_create = omp_get_wtime() - t0;
+    if (ndiffuse > 0 && seed_diffuse(sim, ndiffuse, by, &err) != PFSPH_OK) {
+        fprintf(stderr, "bench: seeding diffuse particles: %s\n", err.msg);
+        pfsph_sim_destroy(sim);
+        return 1;
+    }
     const pfsph_ctx *ctx = pfsph_sim_ctx(sim);
     const size_t n_fluid0 = ctx->fluid->n, n_bnd = ctx->boundary ? ctx->boundary->n : 0;
 
@@ -192,6 +271,20 @@ int main(int argc, char **argv)
         printf("  %-10s %9.4f  %5.1f\n", pfsph_stage_names[i], sec, tot > 0 ? 100 * sec / tot : 0);
     }
     printf("  %-10s %9.4f  (wall %.4f)\n", "sum", tot, wall);
+    const double dif_s = st1[PFSPH_STAGE_DIFFUSE] - st0[PFSPH_STAGE_DIFFUSE];
+    const double fluid_s = tot - dif_s - (st1[PFSPH_STAGE_OUTPUT] - st0[PFSPH_STAGE_OUTPUT]);
+    size_t dc[3] = {0, 0, 0};
+    if (ndiffuse >= 0) {
+        pfsph_sim_diffuse_counts(sim, dc);
+        uint64_t created = 0, refused = 0;
+        pfsph_sim_diffuse_totals(sim, &created, &refused);
+        printf("  diffuse particles   %zu at the end (spray %zu, foam %zu, bubble %zu); %llu "
+               "created in all (seeded included), %llu refused\n",
+               dc[0] + dc[1] + dc[2], dc[0], dc[1], dc[2], (unsigned long long)created,
+               (unsigned long long)refused);
+        printf("  diffuse stage       %.4f s = %.1f%% of the fluid step (%.4f s: all other stages)"
+               "\n", dif_s, fluid_s > 0 ? 100 * dif_s / fluid_s : 0, fluid_s);
+    }
 
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
@@ -203,10 +296,10 @@ int main(int argc, char **argv)
     /* One line for grep. */
     printf("BENCH solver=%s pairwise=%d threads=%d fluid=%zu boundary=%zu steps=%ld wall_s=%.3f "
            "psteps_per_s=%.4g iters=%.2f nb_fluid=%.1f nb_bnd=%.1f cand=%.1f bytes_per_particle=%.0f "
-           "status=%s\n",
+           "diffuse=%zu diffuse_s=%.4f fluid_s=%.4f diffuse_pct=%.1f status=%s\n",
            pcisph ? "pcisph" : "wcsph", pairwise, threads > 0 ? threads : omp_get_max_threads(),
-           n_fluid0, n_bnd, done, wall, rate, avg_it, nbf, nbb, ncand, bpp,
-           rc == PFSPH_OK ? "ok" : "failed");
+           n_fluid0, n_bnd, done, wall, rate, avg_it, nbf, nbb, ncand, bpp, dc[0] + dc[1] + dc[2],
+           dif_s, fluid_s, fluid_s > 0 ? 100 * dif_s / fluid_s : 0, rc == PFSPH_OK ? "ok" : "failed");
     pfsph_sim_destroy(sim);
     return rc == PFSPH_OK ? 0 : 3;
 }

@@ -1,6 +1,9 @@
 /* The run driver: a scene in, a run directory out (frames, stats.csv, summary.json). */
 #include "pfsph/run.h"
 
+#include "pfsph/bodies.h"
+#include "pfsph/surface_io.h"
+
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <math.h>
@@ -56,6 +59,73 @@ static int write_set(const pfsph_scene *s, const char *dir, const char *name, in
     return PFSPH_OK;
 }
 
+/* Bodies of a frame: their particles ("bodies_NNNNN", like the other sets) and their
+ * surfaces ("surfaces_NNNNN", triangle meshes with each body's pose). */
+static int write_bodies(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *b,
+                        const pfsph_bodies *B, double t, pfsph_error *err)
+{
+    const int nb = pfsph_bodies_count(B);
+    const uint32_t first = pfsph_bodies_first_id(B);
+    pfsph_particles ps;
+    size_t n = 0;
+    for (size_t j = 0; j < b->n; j++) n += b->id[j] >= first;
+    if (pfsph_particles_init(&ps, n ? n : 1)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    for (size_t j = 0; j < b->n; j++) {
+        if (b->id[j] < first) continue;
+        for (int k = 0; k < PFSPH_NFIELDS; k++) ps.f[k][ps.n] = b->f[k][j];
+        ps.phase[ps.n] = b->phase[j];
+        ps.id[ps.n] = b->id[j];
+        ps.n++;
+    }
+    int rc = write_set(s, dir, "bodies", frame, &ps, "volume", t, err);
+    pfsph_particles_free(&ps);
+    if (rc) return rc;
+    pfsph_mesh *m = calloc((size_t)nb, sizeof *m);
+    pfsph_body_pose *pose = calloc((size_t)nb, sizeof *pose);
+    if (!m || !pose) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    for (int i = 0; i < nb && !rc; i++) {
+        pfsph_body_state st;
+        pfsph_bodies_get_state(B, i, &st);
+        pose[i].name = pfsph_bodies_name(B, i);
+        memcpy(pose[i].x, st.x, sizeof st.x);
+        memcpy(pose[i].q, st.q, sizeof st.q);
+        if (pfsph_bodies_world_mesh(B, i, &m[i])) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    }
+    char path[PFSPH_PATH_LEN + 64];
+    if (!rc && s->output.vtp) {
+        snprintf(path, sizeof path, "%s/frames/surfaces_%05d.vtp", dir, frame);
+        rc = pfsph_write_surfaces_vtp(path, m, nb, pose, t, err);
+    }
+    if (!rc && s->output.ply) {
+        snprintf(path, sizeof path, "%s/frames/surfaces_%05d.ply", dir, frame);
+        rc = pfsph_write_surfaces_ply(path, m, nb, pose, t, err);
+    }
+    for (int i = 0; m && i < nb; i++) pfsph_mesh_free(&m[i]);
+    free(m);
+    free(pose);
+    return rc;
+}
+
+static void bodies_rows(FILE *f, int frame, const pfsph_sim *sim)
+{
+    const pfsph_bodies *B = pfsph_sim_bodies(sim);
+    for (int i = 0; i < pfsph_bodies_count(B); i++) {
+        pfsph_body_state st;
+        double F[3], T[3];
+        pfsph_bodies_get_state(B, i, &st);
+        pfsph_bodies_last_force(B, i, F, T);
+        fprintf(f, "%d,%.9g,%d,%s", frame, pfsph_sim_time(sim), i, pfsph_bodies_name(B, i));
+        for (int a = 0; a < 3; a++) fprintf(f, ",%.9g", st.x[a]);
+        for (int a = 0; a < 4; a++) fprintf(f, ",%.9g", st.q[a]);
+        for (int a = 0; a < 3; a++) fprintf(f, ",%.9g", st.v[a]);
+        for (int a = 0; a < 3; a++) fprintf(f, ",%.9g", st.w[a]);
+        for (int a = 0; a < 3; a++) fprintf(f, ",%.9g", F[a]);
+        for (int a = 0; a < 3; a++) fprintf(f, ",%.9g", T[a]);
+        fputc('\n', f);
+    }
+    fflush(f);
+}
+
 static int write_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_sim *sim,
                        pfsph_error *err)
 {
@@ -66,6 +136,8 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
         rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
     const pfsph_particles *d = pfsph_sim_diffuse(sim);
     if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);
+    const pfsph_bodies *B = pfsph_sim_bodies(sim);
+    if (!rc && B) rc = write_bodies(s, dir, frame, c->boundary, B, t, err);
     return rc;
 }
 
@@ -248,6 +320,24 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
         pfsph_sim_destroy(sim);
         return PFSPH_EIO;
     }
+    static const char bheader[] = "frame,time,body,name,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,fx,fy,fz,tx,ty,tz\n";
+    FILE *bcsv = NULL;
+    if (pfsph_sim_bodies(sim)) {
+        snprintf(path, sizeof path, "%s/bodies.csv", dir);
+        if (resume && (rc = truncate_csv(path, bheader, frame0, err))) {
+            fclose(csv);
+            pfsph_sim_destroy(sim);
+            return rc;
+        }
+        bcsv = fopen(path, resume ? "a" : "w");
+        if (!bcsv) {
+            pfsph_fail(err, PFSPH_EIO, "%s: cannot write: %s", path, strerror(errno));
+            fclose(csv);
+            pfsph_sim_destroy(sim);
+            return PFSPH_EIO;
+        }
+        if (!resume) fputs(bheader, bcsv);
+    }
     int nframes = (int)floor(end * s->fps + 1e-9);
     const int fi = s->output.frame_interval, ci = s->output.checkpoint_interval;
     int frame = frame0, written = 0;
@@ -256,6 +346,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
         rc = write_frame(s, dir, 0, sim, err);
         if (!rc) written++;
         csv_row(csv, 0, sim);
+        if (bcsv) bodies_rows(bcsv, 0, sim);
     } else {
         written = frame0 / fi + 1; /* on disk from before */
     }
@@ -289,6 +380,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
             if (!rc) written++;
         }
         csv_row(csv, frame, sim);
+        if (bcsv) bodies_rows(bcsv, frame, sim);
         if (!rc && ci > 0 && frame % ci == 0) {
             double c0 = omp_get_wtime();
             rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &ckpt_bytes, err);
@@ -315,6 +407,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
         }
     }
     fclose(csv);
+    if (bcsv) fclose(bcsv);
     free(good);
     pfsph_error e2;
     const char *status = rc == PFSPH_OK ? "finished" : rc == PFSPH_EUNSTABLE ? "unstable" : "failed";

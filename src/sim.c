@@ -10,11 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pfsph/bodies.h"
 #include "physics/stages.h"
 #include "scene/shapes.h"
 
 const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
-    "grid", "density", "forces", "pairwise", "pressure", "integrate", "diffuse", "output"};
+    "grid", "density", "forces", "pairwise", "pressure", "integrate", "diffuse", "bodies", "output"};
 
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_XP, SCR_YP, SCR_ZP,
        SCR_NDP, SCR_ERR, SCR_N };
@@ -34,6 +35,7 @@ struct pfsph_sim {
     double vbound;          /* speeds above this are a blow-up */
     pfsph_pairwise *pw;
     pfsph_diffuse *df;
+    pfsph_bodies *bodies;
     double time;
     uint64_t step;
     size_t removed;
@@ -98,6 +100,28 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
         fluid->next_id = (uint32_t)w;
     }
     return PFSPH_OK;
+}
+
+/* Fluid particles inside a body or nearer than 0.4 d to its surface are not made (as for
+ * static solids); ids stay equal to indices. */
+static void drop_inside_bodies(const pfsph_bodies *B, int nb, double d, pfsph_particles *f)
+{
+    size_t w = 0;
+    for (size_t j = 0; j < f->n; j++) {
+        double p[3] = {f->x[j], f->y[j], f->z[j]};
+        int keep = 1;
+        for (int k = 0; k < nb && keep; k++)
+            if (pfsph_bodies_distance(B, k, p) < 0.4 * d) keep = 0;
+        if (!keep) continue;
+        if (w != j) {
+            for (int q = 0; q < PFSPH_NFIELDS; q++) f->f[q][w] = f->f[q][j];
+            f->phase[w] = f->phase[j];
+        }
+        f->id[w] = (uint32_t)w;
+        w++;
+    }
+    f->n = w;
+    f->next_id = (uint32_t)w;
 }
 
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
@@ -199,6 +223,10 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         goto fail;
     }
     if ((rc = build_particles(s, d, &sim->fluid, &sim->boundary, err))) goto fail;
+    if (s->nbodies) {
+        if ((rc = pfsph_bodies_create(&sim->bodies, s, d, &sim->boundary, err))) goto fail;
+        drop_inside_bodies(sim->bodies, s->nbodies, d, &sim->fluid);
+    }
     c->fluid = &sim->fluid;
     c->boundary = &sim->boundary;
 
@@ -266,6 +294,7 @@ void pfsph_sim_destroy(pfsph_sim *sim)
     if (!sim) return;
     if (sim->pw) pfsph_pairwise_destroy(sim->pw);
     if (sim->df) pfsph_diffuse_destroy(sim->df);
+    pfsph_bodies_destroy(sim->bodies);
     pfsph_particles_free(&sim->fluid);
     pfsph_particles_free(&sim->boundary);
     pfsph_grid_free(&sim->grid);
@@ -423,6 +452,12 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     t1 = now();
     sim->stage_s[PFSPH_STAGE_GRID] += t1 - t0;
     t0 = t1;
+    if (sim->pw) { /* particle shifting, if the scene asks (docs/pairwise.md); uses c->dt */
+        pfsph_pairwise_shift(sim->pw, c);
+        t1 = now();
+        sim->stage_s[PFSPH_STAGE_PAIRWISE] += t1 - t0;
+        t0 = t1;
+    }
 
     pfsph__number_density(c, f->x, f->y, f->z, c->nd);
     pfsph_real ndmax = 0;
@@ -449,7 +484,8 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     size_t worst = 0;
     double vmax = sim->removed != removed_before ? max_speed(f, &worst) : sim->stats.vmax;
     int collapsed;
-    double dt = choose_dt(sim, vmax, t_limit, &collapsed);
+    double dt = choose_dt(sim, sim->bodies ? fmax(vmax, pfsph_bodies_vmax(sim->bodies)) : vmax, t_limit,
+                          &collapsed);
     if (collapsed) {
         vmax = max_speed(f, &worst);
         return blowup(sim, "timestep", worst, "time step fell below time.dt_min; speed", vmax, err);
@@ -487,6 +523,13 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     t1 = now();
     sim->stage_s[PFSPH_STAGE_PRESSURE] += t1 - t0;
     t0 = t1;
+    if (sim->bodies) {
+        /* fluid forces on the bodies from this step's pressure, before the fluid moves */
+        pfsph_bodies_fluid_forces(sim->bodies, c);
+        t1 = now();
+        sim->stage_s[PFSPH_STAGE_BODIES] += t1 - t0;
+        t0 = t1;
+    }
 
     /* symplectic Euler; the largest acceleration feeds the next step's force criterion */
     const pfsph_real fdt = (pfsph_real)dt;
@@ -535,6 +578,26 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
         pfsph_diffuse_step(sim->df, c);
         t1 = now();
         sim->stage_s[PFSPH_STAGE_DIFFUSE] += t1 - t0;
+        t0 = t1;
+    }
+    if (sim->bodies) {
+        pfsph_bodies_step(sim->bodies, &sim->boundary, sim->time, dt);
+        for (int i = 0; i < pfsph_bodies_count(sim->bodies); i++) {
+            pfsph_body_state bs;
+            pfsph_bodies_get_state(sim->bodies, i, &bs);
+            double q = bs.x[0] + bs.x[1] + bs.x[2] + bs.v[0] + bs.v[1] + bs.v[2] + bs.w[0] + bs.w[1] + bs.w[2];
+            if (!isfinite(q) || sqrt(bs.v[0] * bs.v[0] + bs.v[1] * bs.v[1] + bs.v[2] * bs.v[2]) > sim->vbound)
+                return pfsph_fail(err, PFSPH_EUNSTABLE,
+                                  "simulation unstable at step %llu, t = %.6g s, stage bodies: body \"%s\" "
+                                  "at %.4g %.4g %.4g moves at %.4g %.4g %.4g m/s; likely cause: a body much "
+                                  "lighter than the fluid it displaces, or too large a time step (lower time.cfl)",
+                                  (unsigned long long)sim->step, sim->time, pfsph_bodies_name(sim->bodies, i),
+                                  bs.x[0], bs.x[1], bs.x[2], bs.v[0], bs.v[1], bs.v[2]);
+        }
+        if (pfsph_grid_sort(&sim->bgrid, &sim->boundary, NULL))
+            return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sorting the boundary particles");
+        t1 = now();
+        sim->stage_s[PFSPH_STAGE_BODIES] += t1 - t0;
     }
     sim->time += dt;
     sim->step++;
@@ -569,6 +632,51 @@ const pfsph_particles *pfsph_sim_diffuse(const pfsph_sim *sim)
     return sim->df ? pfsph_diffuse_particles(sim->df) : NULL;
 }
 double pfsph_sim_sound_speed(const pfsph_sim *sim) { return sim->sound_speed; }
+const pfsph_bodies *pfsph_sim_bodies(const pfsph_sim *sim) { return sim->bodies; }
+
+int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const pfsph_body_state *st,
+                             const uint32_t *ids, size_t n, pfsph_error *err)
+{
+    pfsph_particles *b = &sim->boundary;
+    if (nbodies != pfsph_bodies_count(sim->bodies))
+        return pfsph_fail(err, PFSPH_EINPUT, "restore: %d bodies, the scene has %d", nbodies,
+                          pfsph_bodies_count(sim->bodies));
+    if (!nbodies) return PFSPH_OK;
+    if (n > b->n) return pfsph_fail(err, PFSPH_EINPUT, "restore: %zu boundary particles, the scene has %zu", n, b->n);
+    for (int i = 0; i < nbodies; i++) {
+        double s = 0;
+        for (int a = 0; a < 3; a++) s += st[i].x[a] + st[i].v[a] + st[i].w[a];
+        s += st[i].q[0] + st[i].q[1] + st[i].q[2] + st[i].q[3];
+        if (!isfinite(s)) return pfsph_fail(err, PFSPH_EINPUT, "restore: body %d has a non-finite state", i);
+    }
+    /* where each id sits now */
+    uint32_t *where = malloc((b->next_id ? b->next_id : 1) * sizeof(uint32_t));
+    uint32_t *perm = malloc((n ? n : 1) * sizeof(uint32_t));
+    if (!where || !perm) {
+        free(where);
+        free(perm);
+        return pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory");
+    }
+    memset(where, 0xff, (b->next_id ? b->next_id : 1) * sizeof(uint32_t));
+    for (size_t j = 0; j < b->n; j++)
+        if (b->id[j] < b->next_id) where[b->id[j]] = (uint32_t)j;
+    int rc = PFSPH_OK;
+    for (size_t j = 0; j < n && !rc; j++) {
+        if (ids[j] >= b->next_id || where[ids[j]] == UINT32_MAX)
+            rc = pfsph_fail(err, PFSPH_EINPUT, "restore: unknown or repeated boundary particle id %u", ids[j]);
+        else {
+            perm[j] = where[ids[j]];
+            where[ids[j]] = UINT32_MAX;
+        }
+    }
+    if (!rc && pfsph_particles_permute(b, perm, n, NULL)) rc = pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory");
+    free(where);
+    free(perm);
+    if (rc) return rc;
+    for (int i = 0; i < nbodies; i++) pfsph_bodies_set_state(sim->bodies, i, &st[i], b);
+    if (pfsph_grid_sort(&sim->bgrid, b, NULL)) return pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory");
+    return PFSPH_OK;
+}
 void pfsph_sim_add_stage_time(pfsph_sim *sim, int stage, double seconds)
 {
     if (stage >= 0 && stage < PFSPH_NSTAGES) sim->stage_s[stage] += seconds;

@@ -8,6 +8,7 @@
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "pfsph/shifting.h"
 #include "pfsph/types.h"
 
 /* scene.h includes this header, so the scene and the context are only forward-declared. */
@@ -32,6 +33,7 @@ typedef struct pfsph_pairwise_params {
     double eta;       /* Eq. 11, default 0.2 */
     double eps_min;   /* Eq. 8 clamp on eigenvalues normalised by the largest one, default 0.5 */
     int center;       /* enum pfsph_pw_center */
+    pfsph_shift_params shift; /* particle shifting stage (off unless the scene asks) */
     /* Coefficient matrix c[a][b] over scene phases (solids included), symmetric, >= 0.
      * Pair force c m_i m_j f(r): c in N/kg^2 in 3D; in 2D masses are per metre of depth. */
     double c[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
@@ -94,10 +96,21 @@ void pfsph_pairwise_destroy(pfsph_pairwise *pw); /* NULL is a no-op */
  * Deterministic for any thread count. This is also the function the benchmark times. */
 void pfsph_pairwise_apply(pfsph_pairwise *pw, const struct pfsph_ctx *ctx);
 
+/* Particle shifting (include/pfsph/shifting.h) with the scene's "shifting" parameters, for a
+ * step of ctx->dt: called right after the grid sort, before the density. No-op when off. The
+ * shift per step is capped at min(max_frac d, cell - h) so that neighbour searches stay exact. */
+void pfsph_pairwise_shift(pfsph_pairwise *pw, const struct pfsph_ctx *ctx);
+
 /* Diagnostics for tests and measurements, same neighbour loops as apply. For each fluid
  * particle i: vir[i] = sum_j r_ij . F_ji [J] (F_ji the filtered force on i from j, fluid and
  * solid neighbours); T (if not NULL) receives the 9 entries of T_i row-major at T + 9 i. */
 void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const struct pfsph_ctx *ctx, double *vir,
                              double *T);
+
+/* As pfsph_pairwise_diagnose, and (if W is not NULL) the virial tensor of each fluid particle,
+ * W_i = sum_j F_ji (x) r_ij [J], 9 entries row-major at W + 9 i (its trace is vir[i]); for the
+ * stress-anisotropy route to the Laplace pressure (docs/pairwise.md). */
+void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const struct pfsph_ctx *ctx,
+                                    double *vir, double *T, double *W);
 
 #endif

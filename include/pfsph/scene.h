@@ -14,6 +14,8 @@
 #define PFSPH_MAX_SOLIDS 64
 #define PFSPH_NAME_LEN 64
 #define PFSPH_PATH_LEN 1024
+#define PFSPH_MAX_BODIES 32
+#define PFSPH_MAX_KEYFRAMES 16
 
 enum pfsph_solver { PFSPH_SOLVER_WCSPH = 0, PFSPH_SOLVER_PCISPH = 1 };
 enum pfsph_phase_kind { PFSPH_PHASE_FLUID = 0, PFSPH_PHASE_GAS = 1, PFSPH_PHASE_SOLID = 2 };
@@ -59,6 +61,38 @@ typedef struct pfsph_solid {
     int layers;            /* boundary particle layers, >= 1 */
     bool open_top;         /* CONTAINER */
 } pfsph_solid;
+
+/* A rigid body (docs/bodies.md): dynamic (moved by fluid forces, gravity and contacts) or
+ * kinematic (moved by keyframes). Geometry is given in body coordinates about `position`. */
+enum pfsph_body_shape { PFSPH_BODY_BOX = 0, PFSPH_BODY_SPHERE, PFSPH_BODY_CYLINDER, PFSPH_BODY_MESH };
+
+typedef struct pfsph_keyframe {
+    double t;              /* s */
+    double position[3];    /* m */
+    double rotation[3];    /* degrees about x, then y, then z (fixed axes) */
+} pfsph_keyframe;
+
+typedef struct pfsph_body_def {
+    char name[PFSPH_NAME_LEN];
+    int shape;             /* enum pfsph_body_shape */
+    int phase;             /* a solid phase: pair coefficients and colour */
+    double half[3];        /* BOX half extents */
+    double radius, height; /* SPHERE, CYLINDER */
+    int axis;              /* CYLINDER, body coordinates */
+    char mesh[PFSPH_PATH_LEN]; /* MESH: OBJ path, resolved against the scene's directory */
+    double scale;          /* MESH: vertex scale */
+    double position[3];    /* m: centre of mass (shape centre for primitives, mesh origin for meshes) */
+    double rotation[3];    /* degrees, as in pfsph_keyframe */
+    double velocity[3], angular_velocity[3]; /* m/s, rad/s */
+    double density;        /* kg/m^3 (per unit depth in 2D); 0: from mass */
+    double mass;           /* kg; 0: from density */
+    double friction;       /* Coulomb coefficient of contacts */
+    double restitution;    /* of contacts, 0..1 */
+    int layers;            /* particle layers inside the surface (2: V0 volumes, 1: Akinci's) */
+    bool kinematic;
+    int nkeys;
+    pfsph_keyframe keys[PFSPH_MAX_KEYFRAMES];
+} pfsph_body_def;
 
 typedef struct pfsph_output {
     char dir[PFSPH_PATH_LEN]; /* run directory */
@@ -108,6 +142,8 @@ typedef struct pfsph_scene {
     pfsph_block blocks[PFSPH_MAX_BLOCKS];
     int nsolids;
     pfsph_solid solids[PFSPH_MAX_SOLIDS];
+    int nbodies;
+    pfsph_body_def bodies[PFSPH_MAX_BODIES];
     pfsph_pairwise_params pairwise; /* see pairwise.h */
     pfsph_diffuse_params diffuse;   /* see diffuse.h */
     pfsph_output output;

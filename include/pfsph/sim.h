@@ -33,7 +33,8 @@ typedef struct pfsph_ctx {
 
 enum pfsph_stage {
     PFSPH_STAGE_GRID, PFSPH_STAGE_DENSITY, PFSPH_STAGE_FORCES, PFSPH_STAGE_PAIRWISE,
-    PFSPH_STAGE_PRESSURE, PFSPH_STAGE_INTEGRATE, PFSPH_STAGE_DIFFUSE, PFSPH_STAGE_OUTPUT,
+    PFSPH_STAGE_PRESSURE, PFSPH_STAGE_INTEGRATE, PFSPH_STAGE_DIFFUSE, PFSPH_STAGE_BODIES,
+    PFSPH_STAGE_OUTPUT,
     PFSPH_NSTAGES
 };
 extern const char *const pfsph_stage_names[PFSPH_NSTAGES];
@@ -94,6 +95,15 @@ void pfsph_sim_diffuse_totals(const pfsph_sim *sim, uint64_t *created, uint64_t 
 int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_particles *fluid,
                       const pfsph_particles *diffuse, uint64_t created, uint64_t refused,
                       pfsph_error *err);
+
+/* Rigid bodies (NULL when the scene has none); see bodies.h. */
+struct pfsph_bodies;
+struct pfsph_body_state;
+const struct pfsph_bodies *pfsph_sim_bodies(const pfsph_sim *sim);
+/* Restore body states and the boundary set's order (a checkpoint's; ids, n of them) after
+ * pfsph_sim_restore. */
+int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const struct pfsph_body_state *st,
+                             const uint32_t *boundary_ids, size_t n, pfsph_error *err);
 
 /* Number of particles and bytes a scene would need, without allocating them. */
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,

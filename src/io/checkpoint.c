@@ -3,6 +3,8 @@
  * counters, the fluid set and the diffuse set), all little-endian. */
 #include "pfsph/checkpoint.h"
 
+#include "pfsph/bodies.h"
+
 #include <dirent.h>
 #include <errno.h>
 #include <omp.h>
@@ -159,6 +161,37 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
             h_f64(h, d->type[t].k_t);
         }
     }
+    /* bodies: only when there are some, so scenes without bodies keep their hash */
+    if (s->nbodies) {
+        h_int(h, s->nbodies);
+        for (int i = 0; i < s->nbodies && i < PFSPH_MAX_BODIES; i++) {
+            const pfsph_body_def *b = &s->bodies[i];
+            h_str(h, b->name);
+            h_int(h, b->shape);
+            h_int(h, b->phase);
+            h_vec(h, b->half, 3);
+            h_f64(h, b->radius);
+            h_f64(h, b->height);
+            h_int(h, b->axis);
+            h_str(h, b->mesh);
+            h_f64(h, b->scale);
+            h_vec(h, b->position, 3);
+            h_vec(h, b->rotation, 3);
+            h_vec(h, b->velocity, 3);
+            h_vec(h, b->angular_velocity, 3);
+            h_f64(h, b->density);
+            h_f64(h, b->mass);
+            h_f64(h, b->friction);
+            h_f64(h, b->restitution);
+            h_int(h, b->kinematic);
+            h_int(h, b->nkeys);
+            for (int k = 0; k < b->nkeys && k < PFSPH_MAX_KEYFRAMES; k++) {
+                h_f64(h, b->keys[k].t);
+                h_vec(h, b->keys[k].position, 3);
+                h_vec(h, b->keys[k].rotation, 3);
+            }
+        }
+    }
     return H.h;
 }
 
@@ -213,6 +246,12 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
     pfsph_sim_get_state(sim, &st);
     size_t payload = 4 + 4 + 4 + 4 + 8 * 5 + 8 * 5 + 4 + 4 + 8 * PFSPH_NSTAGES + set_bytes(c->fluid->n) + 1;
     if (df) payload += 16 + set_bytes(df->n);
+    /* bodies: count, 13 doubles each, then the boundary set's order (its positions follow from
+     * the bodies' poses, but the order decides summation order: bit-exact resume) */
+    const pfsph_bodies *B = pfsph_sim_bodies(sim);
+    const int nbod = pfsph_bodies_count(B);
+    payload += 4;
+    if (nbod) payload += (size_t)nbod * 13 * 8 + 8 + 4 * c->boundary->n;
     size_t total = HEADER_LEN + payload;
     unsigned char *buf = malloc(total);
     if (!buf) return pfsph_fail(err, PFSPH_ENOMEM, "checkpoint: out of memory for %zu bytes", total);
@@ -242,6 +281,19 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
         w_u64(&w, created);
         w_u64(&w, refused);
         w_set(&w, df);
+    }
+    w_u32(&w, (uint32_t)nbod);
+    if (nbod) {
+        for (int i = 0; i < nbod; i++) {
+            pfsph_body_state bs;
+            pfsph_bodies_get_state(B, i, &bs);
+            for (int a = 0; a < 3; a++) w_f64(&w, bs.x[a]);
+            for (int a = 0; a < 4; a++) w_f64(&w, bs.q[a]);
+            for (int a = 0; a < 3; a++) w_f64(&w, bs.v[a]);
+            for (int a = 0; a < 3; a++) w_f64(&w, bs.w[a]);
+        }
+        w_u64(&w, c->boundary->n);
+        for (size_t j = 0; j < c->boundary->n; j++) w_u32(&w, c->boundary->id[j]);
     }
     if (w.len != total) {
         free(buf);
@@ -421,13 +473,38 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
             return rc;
         }
     }
+    uint32_t nbod = r_u32(&r);
+    pfsph_body_state *bst = NULL;
+    uint32_t *bids = NULL;
+    uint64_t nbid = 0;
+    if (!r.bad && nbod > 0 && nbod <= PFSPH_MAX_BODIES) {
+        bst = calloc(nbod, sizeof *bst);
+        for (uint32_t i = 0; bst && i < nbod; i++) {
+            for (int a = 0; a < 3; a++) bst[i].x[a] = r_f64(&r);
+            for (int a = 0; a < 4; a++) bst[i].q[a] = r_f64(&r);
+            for (int a = 0; a < 3; a++) bst[i].v[a] = r_f64(&r);
+            for (int a = 0; a < 3; a++) bst[i].w[a] = r_f64(&r);
+        }
+        nbid = r_u64(&r);
+        if (bst && !r.bad && nbid <= (r.len - r.pos) / 4) {
+            bids = malloc((nbid ? nbid : 1) * sizeof *bids);
+            for (uint64_t j = 0; bids && j < nbid; j++) bids[j] = r_u32(&r);
+        } else
+            r.bad = 1;
+        if (!bst || !bids) r.bad = 1;
+    } else if (nbod > PFSPH_MAX_BODIES)
+        r.bad = 1;
     if (r.bad || r.pos != r.len) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: payload length does not match its contents", name);
+    } else if ((int)nbod != pfsph_bodies_count(pfsph_sim_bodies(sim))) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint has %u bodies, the scene %d", name, nbod,
+                        pfsph_bodies_count(pfsph_sim_bodies(sim)));
     } else if ((has_d != 0) != (pfsph_sim_diffuse(sim) != NULL)) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint %s diffuse particles but the scene has them %s", name,
                         has_d ? "has" : "has no", has_d ? "off" : "on");
     } else {
         rc = pfsph_sim_restore(sim, &st, &fluid, has_d ? &diff : NULL, created, refused, err);
+        if (!rc && nbod) rc = pfsph_sim_restore_bodies(sim, (int)nbod, bst, bids, (size_t)nbid, err);
         if (rc) {
             char msg[sizeof err->msg];
             snprintf(msg, sizeof msg, "%s", err->msg);
@@ -436,6 +513,8 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
     }
     pfsph_particles_free(&fluid);
     if (has_d) pfsph_particles_free(&diff);
+    free(bst);
+    free(bids);
     if (!rc && info) {
         info->frame = fr;
         info->threads = threads;

@@ -42,7 +42,8 @@ void pfsph__nonpressure(const pfsph_ctx *ctx)
                     pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
                     pfsph_real r2 = dx * dx + dy * dy + dz * dz;
                     if (r2 >= h2) continue;
-                    pfsph_real vdx = vxi * dx + vyi * dy + vzi * dz;
+                    /* relative to the wall: static walls rest, body particles move */
+                    pfsph_real vdx = (vxi - b->vx[j]) * dx + (vyi - b->vy[j]) * dy + (vzi - b->vz[j]) * dz;
                     pfsph_real s = b->aux[j] * vdx / (r2 + eps) * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
                     bx += s * dx;
                     by += s * dy;

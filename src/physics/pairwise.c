@@ -17,6 +17,9 @@ static const double PI = 3.14159265358979323846;
 struct pfsph_pairwise {
     int dim;
     double R; /* k h */
+    pfsph_real *sx, *sy, *sz; /* shifting scratch */
+    size_t cap;
+    double shift_max; /* largest shift of the last step [m] */
 };
 
 double pfsph_pairwise_shape(double r, double R)
@@ -82,7 +85,36 @@ int pfsph_pairwise_create(pfsph_pairwise **out, const pfsph_ctx *ctx, pfsph_erro
     return PFSPH_OK;
 }
 
-void pfsph_pairwise_destroy(pfsph_pairwise *pw) { free(pw); }
+void pfsph_pairwise_destroy(pfsph_pairwise *pw)
+{
+    if (!pw) return;
+    free(pw->sx);
+    free(pw->sy);
+    free(pw->sz);
+    free(pw);
+}
+
+void pfsph_pairwise_shift(pfsph_pairwise *pw, const pfsph_ctx *ctx)
+{
+    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    if (!pw || !pp->enabled || !(pp->shift.D > 0 || pp->shift.A > 0) || !(ctx->dt > 0)) return;
+    const size_t n = ctx->fluid->n;
+    if (n > pw->cap) {
+        pfsph_real *a = realloc(pw->sx, n * sizeof(pfsph_real));
+        if (a) pw->sx = a;
+        pfsph_real *b = realloc(pw->sy, n * sizeof(pfsph_real));
+        if (b) pw->sy = b;
+        pfsph_real *c = realloc(pw->sz, n * sizeof(pfsph_real));
+        if (c) pw->sz = c;
+        if (!a || !b || !c) return; /* out of memory: skip shifting this step */
+        pw->cap = n;
+    }
+    pfsph_shift_params sp = pp->shift;
+    /* neighbour searches within h stay exact if nothing moves more than cell - h */
+    double room = ((double)ctx->grid->cell - (double)ctx->h) / (double)ctx->spacing;
+    if (sp.max_frac > room) sp.max_frac = room > 0 ? room : 0;
+    pw->shift_max = pfsph_shift_apply(ctx, &sp, ctx->dt, pw->R, pw->sx, pw->sy, pw->sz);
+}
 
 /* Constants of one apply call, shared by all particles. */
 typedef struct pw_job {
@@ -169,7 +201,7 @@ static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfs
 /* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial and
  * T_i itself. */
 static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir,
-                            double *vir, double Tout[9])
+                            double *vir, double Tout[9], double Wout[9])
 {
     const pfsph_ctx *ctx = J->ctx;
     const pfsph_particles *f = ctx->fluid;
@@ -209,6 +241,13 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
         for (int a = 0; a < 3; a++)
             for (int b = 0; b < 3; b++) tr += T[a][b] * Sm[b][a];
         *vir = (double)ctx->mass[pa] * tr;
+        if (Wout) /* sum_j (T f_ji) (x) r_ij = m_i T S */
+            for (int a = 0; a < 3; a++)
+                for (int b = 0; b < 3; b++) {
+                    double t = 0;
+                    for (int q = 0; q < 3; q++) t += T[a][q] * Sm[q][b];
+                    Wout[3 * a + b] = (double)ctx->mass[pa] * t;
+                }
     }
     if (Tout)
         for (int a = 0; a < 3; a++)
@@ -226,7 +265,7 @@ void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 #pragma omp parallel for schedule(dynamic, 256)
     for (size_t i = 0; i < n; i++) {
         double acc[3];
-        particle(&J, i, acc, false, NULL, NULL);
+        particle(&J, i, acc, false, NULL, NULL, NULL);
         ax[i] += (pfsph_real)acc[0];
         ay[i] += (pfsph_real)acc[1];
         az[i] += (pfsph_real)acc[2];
@@ -234,6 +273,12 @@ void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 }
 
 void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T)
+{
+    pfsph_pairwise_diagnose_tensor(pw, ctx, vir, T, NULL);
+}
+
+void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir,
+                                    double *T, double *W)
 {
     (void)pw;
     pw_job J;
@@ -245,7 +290,7 @@ void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *v
 #pragma omp parallel for schedule(dynamic, 256)
     for (size_t i = 0; i < n; i++) {
         double acc[3], v = 0;
-        particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL);
+        particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL);
         if (vir) vir[i] = v;
     }
 }
@@ -261,6 +306,7 @@ void pfsph_pairwise_defaults(pfsph_pairwise_params *p)
     p->eta = 0.2;
     p->eps_min = 0.5;
     p->center = PFSPH_PW_CENTER_PARTICLE; /* Eq. 7 as written */
+    pfsph_shift_defaults(&p->shift);
 }
 
 double pfsph_pairwise_lambda(int dim, double R)

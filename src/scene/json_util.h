@@ -42,5 +42,8 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
                                 pfsph_jctx *ctx);
 int pfsph__scene_parse_diffuse(const cJSON *node, const char *path, pfsph_scene *s,
                                pfsph_jctx *ctx);
+/* The "bodies" array (src/scene/scene_bodies.c), after solids and fluid. */
+int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s,
+                              pfsph_jctx *ctx);
 
 #endif

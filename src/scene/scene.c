@@ -917,7 +917,7 @@ static int parse_root(parser *p, const cJSON *root)
     pfsph_scene *s = p->s;
     static const char *const keys[] = {"name", "dimension", "particle_radius", "support_factor",
                                        "gravity", "domain", "solver", "time", "seed", "threads",
-                                       "phases", "fluid", "solids", "pairwise", "diffuse",
+                                       "phases", "fluid", "solids", "bodies", "pairwise", "diffuse",
                                        "output", "camera", "comment", NULL};
     if (!cJSON_IsObject(root))
         return pfsph__json_fail(&p->ctx, "$", "a scene must be a JSON object { ... }");
@@ -948,6 +948,8 @@ static int parse_root(parser *p, const cJSON *root)
     TRY(parse_solids(p, root));
     TRY(parse_fluid(p, root));
     TRY(check_blocks(p));
+    const cJSON *bd = get(root, "bodies");
+    if (bd) TRY(pfsph__scene_parse_bodies(bd, "$.bodies", s, &p->ctx));
     /* Sub-parsers of other modules see every phase, the default solid phase included. */
     const cJSON *pw = get(root, "pairwise");
     if (pw) {

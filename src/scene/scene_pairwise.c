@@ -96,7 +96,7 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
                                 pfsph_jctx *ctx)
 {
     static const char *const keys[] = {"enabled", "k", "filter", "eta", "eps_min", "center",
-                                       "coefficients", "comment", NULL};
+                                       "shifting", "coefficients", "comment", NULL};
     pfsph_pairwise_params *pp = &s->pairwise;
     int rc = pfsph__json_check_keys(node, path, keys, ctx);
     if (rc) return rc;
@@ -118,6 +118,24 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
         if (found < 0)
             return pfsph__json_fail(ctx, kp, "expected \"particle\" or \"mean\"");
         pp->center = found;
+    }
+    const cJSON *sh = cJSON_GetObjectItemCaseSensitive(node, "shifting");
+    if (sh) {
+        static const char *const skeys[] = {"diffusivity", "speed_factor", "surface",
+                                            "max_step", "comment", NULL};
+        char sp[600];
+        snprintf(sp, sizeof sp, "%s.shifting", path);
+        if (!cJSON_IsObject(sh))
+            return pfsph__json_fail(ctx, sp, "expected an object {\"diffusivity\": D, ...}");
+        if ((rc = pfsph__json_check_keys(sh, sp, skeys, ctx))) return rc;
+        if ((rc = pfsph__json_number(sh, sp, "diffusivity", 0.0, 10.0, &pp->shift.D, ctx)))
+            return rc;
+        if ((rc = pfsph__json_number(sh, sp, "speed_factor", 0.0, 100.0, &pp->shift.A, ctx)))
+            return rc;
+        if ((rc = pfsph__json_number(sh, sp, "surface", 0.0, 1.0, &pp->shift.surface, ctx)))
+            return rc;
+        if ((rc = pfsph__json_number(sh, sp, "max_step", 0.0, 0.25, &pp->shift.max_frac, ctx)))
+            return rc;
     }
     const cJSON *co = cJSON_GetObjectItemCaseSensitive(node, "coefficients");
     if (co) {
