@@ -139,6 +139,18 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
         if (c < 0) return pfsph_fail(err, PFSPH_EINPUT, "cannot sample solid %d", i);
         nb += c;
     }
+    if (s->nbodies) {
+        /* bodies are sampled for real: this also reads and checks their mesh files, so that
+         * `pfsph check` reports a bad OBJ file */
+        pfsph_particles tmp;
+        pfsph_bodies *B = NULL;
+        if (pfsph_particles_init(&tmp, 1024)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+        int rc = pfsph_bodies_create(&B, s, d, &tmp, err);
+        nb += (long)tmp.n;
+        pfsph_bodies_destroy(B);
+        pfsph_particles_free(&tmp);
+        if (rc) return rc;
+    }
     pfsph_real h = (pfsph_real)(s->support_factor * d);
     double cell = query_radius(s, h);
     double cells = 1;

@@ -2,7 +2,8 @@
  * go, and run to frame 5 then resumed to frame 10, give the same frame files byte for byte
  * (fluid and diffuse, a middle frame and the last) and the same stats.csv; with the newest
  * checkpoint corrupted, `pfsph run --resume` says so, falls back to the previous one and still
- * matches. Same thread count throughout (this process's). */
+ * matches. A floating box (a rigid body, issue 5) rides the wave: its particles, surfaces and
+ * bodies.csv must match too. Same thread count throughout (this process's). */
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +19,10 @@ static const char *SCENE =
     " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 0.4, \"fps\": 25, \"dt_max\": 0.004},\n"
     " \"seed\": 7,\n"
     " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": 5e-4},\n"
-    "              {\"name\": \"wall\", \"kind\": \"solid\"}],\n"
+    "              {\"name\": \"wall\", \"kind\": \"solid\"},\n"
+    "              {\"name\": \"wood\", \"kind\": \"solid\", \"rest_density\": 500}],\n"
+    " \"bodies\": [{\"name\": \"crate\", \"shape\": \"box\", \"half_extents\": [0.06, 0.04],\n"
+    "              \"position\": [0.6, 0.05], \"rotation\": 10, \"phase\": \"wood\"}],\n"
     " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.3, 0.5], \"phase\": \"water\"}],\n"
     " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [1.0, 0.7], \"open_top\": true,\n"
     "               \"layers\": 2, \"phase\": \"wall\"}],\n"
@@ -82,6 +86,9 @@ static void compare_runs(const char *a, const char *b)
     assert_same_file(a, b, "frames/diffuse_00010.vtp");
     assert_same_file(a, b, "frames/diffuse_00007.vtp");
     assert_same_file(a, b, "stats.csv");
+    assert_same_file(a, b, "frames/bodies_00010.vtp");
+    assert_same_file(a, b, "frames/surfaces_00010.vtp");
+    assert_same_file(a, b, "bodies.csv");
 }
 
 static char full_dir[1024];
