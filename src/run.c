@@ -132,11 +132,25 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     double t = pfsph_sim_time(sim);
     int rc = write_set(s, dir, "fluid", frame, c->fluid, NULL, t, err);
-    if (!rc && frame == 0 && c->boundary->n)
-        rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
+    const pfsph_bodies *B = pfsph_sim_bodies(sim);
+    if (!rc && frame == 0 && c->boundary->n) {
+        if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
+        else { /* the static part; body particles go to bodies_NNNNN every frame */
+            pfsph_particles st;
+            if (pfsph_particles_init(&st, c->boundary->n)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+            for (size_t j = 0; j < c->boundary->n; j++) {
+                if (c->boundary->id[j] >= pfsph_bodies_first_id(B)) continue;
+                for (int k = 0; k < PFSPH_NFIELDS; k++) st.f[k][st.n] = c->boundary->f[k][j];
+                st.phase[st.n] = c->boundary->phase[j];
+                st.id[st.n] = c->boundary->id[j];
+                st.n++;
+            }
+            rc = write_set(s, dir, "boundary", frame, &st, "volume", t, err);
+            pfsph_particles_free(&st);
+        }
+    }
     const pfsph_particles *d = pfsph_sim_diffuse(sim);
     if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);
-    const pfsph_bodies *B = pfsph_sim_bodies(sim);
     if (!rc && B) rc = write_bodies(s, dir, frame, c->boundary, B, t, err);
     return rc;
 }

@@ -845,8 +845,8 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
     ctx x;
     memset(&x, 0, sizeof x);
     x.sc = sc;
-    frame_list fl = {0}, bl = {0}, dl = {0};
-    pfsph_particles fluid = {0}, bnd = {0}, dif = {0};
+    frame_list fl = {0}, bl = {0}, dl = {0}, rl = {0};
+    pfsph_particles fluid = {0}, bnd = {0}, dif = {0}, both = {0};
     int bnd_loaded = -1, rendered = 0;
 
     const char *cby = o->color_by ? o->color_by : sc->camera.color_by;
@@ -870,6 +870,7 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
     if ((rc = list_frames(fdir, "fluid_", &fl, err))) goto out;
     if ((rc = list_frames(fdir, "boundary_", &bl, err))) goto out;
     if ((rc = list_frames(fdir, "diffuse_", &dl, err))) goto out;
+    if ((rc = list_frames(fdir, "bodies_", &rl, err))) goto out;
     if (fl.n == 0) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: no fluid_NNNNN.vtp or .ply frames", fdir);
         goto out;
@@ -919,6 +920,29 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
                 goto out;
             bnd_loaded = bl.num[bi];
         }
+        /* rigid bodies move: their particles of this frame join the static boundary */
+        int ri = find_num(&rl, f);
+        if (ri >= 0) {
+            pfsph_particles bod;
+            if ((rc = read_frame(fdir, "bodies_", f, rl.ply[ri], &bod, NULL, err))) goto out;
+            const pfsph_particles *st0 = bi >= 0 ? &bnd : NULL;
+            size_t n0 = st0 ? st0->n : 0;
+            pfsph_particles_free(&both);
+            rc = pfsph_particles_init(&both, n0 + bod.n + 1);
+            for (size_t j = 0; !rc && j < n0 + bod.n; j++) {
+                const pfsph_particles *src = j < n0 ? st0 : &bod;
+                size_t k = j < n0 ? j : j - n0;
+                for (int q = 0; q < PFSPH_NFIELDS; q++) both.f[q][j] = src->f[q][k];
+                both.phase[j] = src->phase[k];
+                both.id[j] = src->id[k];
+            }
+            both.n = n0 + bod.n;
+            pfsph_particles_free(&bod);
+            if (rc) {
+                rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+                goto out;
+            }
+        }
         int di = find_num(&dl, f);
         pfsph_particles_free(&dif);
         if (di >= 0 && (rc = read_frame(fdir, "diffuse_", f, dl.ply[di], &dif, NULL, err)))
@@ -934,8 +958,8 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
             x.vref = speed_scale(sc, &fluid);
         }
         snprintf(path, sizeof path, "%s/frame_%05d.png", pdir, f);
-        rc = render_frame(&x, &fluid, bi >= 0 ? &bnd : NULL, di >= 0 ? &dif : NULL, f, t, path,
-                          err);
+        rc = render_frame(&x, &fluid, ri >= 0 ? &both : bi >= 0 ? &bnd : NULL, di >= 0 ? &dif : NULL, f, t,
+                          path, err);
         if (rc != PFSPH_OK) goto out;
         rendered++;
         if (!o->quiet) fprintf(stderr, "\rrender: %s", path);
@@ -948,9 +972,11 @@ out:
     pfsph_particles_free(&fluid);
     pfsph_particles_free(&bnd);
     pfsph_particles_free(&dif);
+    pfsph_particles_free(&both);
     free_list(&fl);
     free_list(&bl);
     free_list(&dl);
+    free_list(&rl);
     for (int l = 0; l < 2; l++) {
         free(x.im.z[l]);
         free(x.im.id[l]);
