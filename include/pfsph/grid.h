@@ -15,6 +15,7 @@ typedef struct pfsph_grid {
     pfsph_real keep_lo[3], keep_hi[3]; /* particles outside this box are removed by sort
                                         * (defaults to the cell extent) */
     pfsph_real cell, inv_cell;
+    int reach;          /* a query walks reach cells each way (1 or 2): it covers reach * cell */
     int nc[3];          /* cells per axis (nc[2] == 1 in 2D) */
     size_t ncells;
     uint32_t *start;    /* ncells + 1 entries: cell c holds [start[c], start[c+1]) */
@@ -25,11 +26,12 @@ typedef struct pfsph_grid {
 } pfsph_grid;
 
 typedef struct pfsph_ranges {
-    uint32_t b[9], e[9];
+    uint32_t b[25], e[25]; /* (2 reach + 1)^(dim - 1) rows, reach <= 2 */
     int n;
 } pfsph_ranges;
 
-/* Grid over [lo, hi] with cells of edge `cell`. */
+/* Grid over [lo, hi] with cells of edge `cell`; queries reach one cell each way (set
+ * g->reach = 2 after init for cells of half the query radius). */
 int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_real hi[3],
                     pfsph_real cell);
 void pfsph_grid_free(pfsph_grid *g);
@@ -39,7 +41,8 @@ void pfsph_grid_free(pfsph_grid *g);
 int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed);
 
 /* Index ranges (into the sorted set) of the cells around a point; the union covers every
- * particle within distance g->cell of (x, y, z). The point may lie outside the domain. */
+ * particle within distance g->reach * g->cell of (x, y, z). The point may lie outside the
+ * domain. */
 static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_real y,
                                      pfsph_real z, pfsph_ranges *r)
 {
@@ -50,13 +53,14 @@ static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_re
         c[a] = t < 0 ? -1 : (t >= (pfsph_real)g->nc[a] ? g->nc[a] : (int)t);
     }
     r->n = 0;
-    int x0 = c[0] - 1 < 0 ? 0 : c[0] - 1;
-    int x1 = c[0] + 1 >= g->nc[0] ? g->nc[0] - 1 : c[0] + 1;
+    const int R = g->reach;
+    int x0 = c[0] - R < 0 ? 0 : c[0] - R;
+    int x1 = c[0] + R >= g->nc[0] ? g->nc[0] - 1 : c[0] + R;
     if (x0 > x1) return;
-    int zlo = g->dim == 3 ? c[2] - 1 : 0, zhi = g->dim == 3 ? c[2] + 1 : 0;
+    int zlo = g->dim == 3 ? c[2] - R : 0, zhi = g->dim == 3 ? c[2] + R : 0;
     for (int cz = zlo; cz <= zhi; cz++) {
         if (cz < 0 || cz >= g->nc[2]) continue;
-        for (int cy = c[1] - 1; cy <= c[1] + 1; cy++) {
+        for (int cy = c[1] - R; cy <= c[1] + R; cy++) {
             if (cy < 0 || cy >= g->nc[1]) continue;
             size_t row = ((size_t)cz * (size_t)g->nc[1] + (size_t)cy) * (size_t)g->nc[0];
             uint32_t b = g->start[row + (size_t)x0], e = g->start[row + (size_t)x1 + 1];

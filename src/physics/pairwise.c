@@ -72,11 +72,11 @@ int pfsph_pairwise_create(pfsph_pairwise **out, const pfsph_ctx *ctx, pfsph_erro
     *out = NULL;
     const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
     double R = pp->k * (double)ctx->h;
-    if (ctx->grid && (double)ctx->grid->cell < R * (1.0 - 1e-6))
+    if (ctx->grid && (double)ctx->grid->cell * ctx->grid->reach < R * (1.0 - 1e-6))
         return pfsph_fail(err, PFSPH_EINPUT,
                           "pairwise: grid cell %g m is smaller than the pair force radius k*h = "
                           "%g m (size cells with pfsph_pairwise_radius)",
-                          (double)ctx->grid->cell, R);
+                          (double)ctx->grid->cell * ctx->grid->reach, R);
     pfsph_pairwise *pw = calloc(1, sizeof(*pw));
     if (!pw) return pfsph_fail(err, PFSPH_ENOMEM, "pairwise: out of memory");
     pw->dim = ctx->dim;
@@ -111,7 +111,7 @@ void pfsph_pairwise_shift(pfsph_pairwise *pw, const pfsph_ctx *ctx)
     }
     pfsph_shift_params sp = pp->shift;
     /* neighbour searches within h stay exact if nothing moves more than cell - h */
-    double room = ((double)ctx->grid->cell - (double)ctx->h) / (double)ctx->spacing;
+    double room = ((double)ctx->grid->cell * ctx->grid->reach - (double)ctx->h) / (double)ctx->spacing;
     if (sp.max_frac > room) sp.max_frac = room > 0 ? room : 0;
     pw->shift_max = pfsph_shift_apply(ctx, &sp, ctx->dt, pw->R, pw->sx, pw->sy, pw->sz);
 }
@@ -432,6 +432,10 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
                 pp->eps_min, pp->center == PFSPH_PW_CENTER_MEAN ? "mean" : "particle");
     else
         fprintf(out, "\n  anisotropic filter off (momentum conserved exactly)\n");
+    if (pp->shift.D > 0 || pp->shift.A > 0)
+        fprintf(out, "  particle shifting on: diffusivity %g m^2/s, speed factor %g, surface %g, "
+                "max step %g d\n", pp->shift.D, pp->shift.A, pp->shift.surface,
+                pp->shift.max_frac);
     fprintf(out, "  coefficients c[a][b] (%s):\n  %-14s", s->dim == 2 ? "N m/kg^2, 2D" : "N/kg^2",
             "");
     for (int b = 0; b < np; b++) fprintf(out, " %12.12s", s->phases[b].name);
