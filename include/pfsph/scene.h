@@ -86,6 +86,8 @@ typedef struct pfsph_body_def {
     double velocity[3], angular_velocity[3]; /* m/s, rad/s */
     double density;        /* kg/m^3 (per unit depth in 2D); 0: from mass */
     double mass;           /* kg; 0: from density */
+    double inertia[3];     /* principal moments about the centre of mass in body axes [kg m^2];
+                            * 0: from the shape (2D: inertia[2] only, per metre of depth) */
     double friction;       /* Coulomb coefficient of contacts */
     double restitution;    /* of contacts, 0..1 */
     int layers;            /* particle layers inside the surface (2: V0 volumes, 1: Akinci's) */

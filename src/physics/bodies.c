@@ -435,6 +435,11 @@ static void set_mass(pfsph_bodies *B, body *bd, int dim)
         break;
     }
     }
+    if (d->inertia[2] > 0) { /* given principal moments (2D: about z only) */
+        double I[3] = {d->inertia[0], d->inertia[1], d->inertia[2]};
+        if (dim == 2) I[0] = I[1] = I[2];
+        dMassSetParameters(&m, bd->mass, 0, 0, 0, I[0], I[1], I[2], 0, 0, 0);
+    }
     dBodySetMass(bd->id, &m);
     (void)B;
 }

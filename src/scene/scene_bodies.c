@@ -151,7 +151,7 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
         if (!cJSON_IsObject(e)) return pfsph__json_fail(ctx, P, "expected an object");
         static const char *const keys[] = {
             "name", "shape", "phase", "half_extents", "radius", "height", "axis", "file", "scale",
-            "position", "rotation", "velocity", "angular_velocity", "density", "mass", "friction",
+            "position", "rotation", "velocity", "angular_velocity", "density", "mass", "inertia", "friction",
             "restitution", "layers", "kinematic", "keyframes", "comment", NULL};
         int rc;
         if ((rc = pfsph__json_check_keys(e, P, keys, ctx))) return rc;
@@ -241,6 +241,22 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
         if ((rc = positive(e, P, "density", &b->density, ctx)) ||
             (rc = positive(e, P, "mass", &b->mass, ctx)))
             return rc;
+        if (cJSON_GetObjectItemCaseSensitive(e, "inertia")) {
+            if (s->dim == 2) {
+                rc = positive(e, P, "inertia", &b->inertia[2], ctx);
+            } else {
+                rc = pfsph__json_vec(e, P, "inertia", 3, 0, 1e12, b->inertia, ctx);
+                if (!rc && !(b->inertia[0] > 0 && b->inertia[1] > 0 && b->inertia[2] > 0 &&
+                             b->inertia[0] + b->inertia[1] >= b->inertia[2] &&
+                             b->inertia[1] + b->inertia[2] >= b->inertia[0] &&
+                             b->inertia[0] + b->inertia[2] >= b->inertia[1])) {
+                    snprintf(kp, sizeof kp, "%s.inertia", P);
+                    return pfsph__json_fail(ctx, kp, "principal moments must be > 0 and each at most the sum of "
+                                                     "the other two (a rigid body's)");
+                }
+            }
+            if (rc) return rc;
+        }
         if (b->density > 0 && b->mass > 0) {
             snprintf(kp, sizeof kp, "%s.mass", P);
             return pfsph__json_fail(ctx, kp, "give either \"density\" or \"mass\", not both");

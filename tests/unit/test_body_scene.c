@@ -92,6 +92,10 @@ static void test_parse_errors(void **st)
     expect_error(2, "{\"name\": \"a\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5]},"
                     "{\"name\": \"a\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.2, 0.5]}",
                  "$.bodies[1].name", "used by");
+    expect_error(3, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5, 0.5], \"inertia\": [1, 1, 3]}",
+                 "$.bodies[0].inertia", "sum of");
+    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"inertia\": 0}",
+                 "$.bodies[0].inertia", "> 0");
     expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"colour\": 1}",
                  "$.bodies[0]", "colour");
 }
