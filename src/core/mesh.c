@@ -3,7 +3,6 @@
 #include "pfsph/mesh.h"
 
 #include <errno.h>
-#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -820,9 +819,9 @@ static int offer_lattice(sampler *s, const double *P0, const double *P1, const d
         double xl = cx * y / H + margin * lenl / H, xr = L + (cx - L) * y / H - margin * lenr / H;
         if (xr < xl) continue;
         double off = (j & 1) ? 0.5 * step : 0.0;
-        double i0 = ceil((xl - off) / step);
-        size_t cnt = (size_t)(floor((xr - off) / step) - i0 + 1.0);
-        if (!(xr - off >= i0 * step)) continue;
+        double i0 = ceil((xl - off) / step), i1 = floor((xr - off) / step);
+        if (!(i1 >= i0)) continue;
+        size_t cnt = (size_t)(i1 - i0 + 1.0); /* <= L / step, bounded by the size guard */
         for (size_t i = 0; i < cnt; i++) {
             double x = off + (i0 + (double)i) * step, p[3];
             for (int a = 0; a < 3; a++) p[a] = A[a] + x * u[a] + y * v[a];
@@ -999,8 +998,9 @@ int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts,
 static int mesh_alloc(pfsph_mesh *m, size_t nv, size_t nt)
 {
     memset(m, 0, sizeof *m);
-    m->v = malloc(3 * nv * sizeof(double));
-    m->tri = malloc(3 * nt * sizeof(uint32_t));
+    /* at least one element each: malloc(0) may return NULL, which is not a failure */
+    m->v = malloc(3 * (nv ? nv : 1) * sizeof(double));
+    m->tri = malloc(3 * (nt ? nt : 1) * sizeof(uint32_t));
     if (!m->v || !m->tri) {
         pfsph_mesh_free(m);
         return PFSPH_ENOMEM;
