@@ -1,6 +1,8 @@
 /* Throughput benchmark: a 3D dam break built in memory with a chosen number of fluid particles,
  * run for a few steps; prints particle-steps per second, time per stage, neighbour counts and
- * peak memory per particle. Results are recorded in docs/benchmarks.md. */
+ * peak memory per particle. With --diffuse N, diffuse material is on with N seeded particles
+ * and the diffuse stage is reported against the rest of the step. Results are recorded in
+ * docs/benchmarks.md. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

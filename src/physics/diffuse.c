@@ -320,10 +320,10 @@ static int fluid_sample(const pfsph_diffuse *d, const pfsph_ctx *ctx, const pfsp
     pfsph_grid_ranges(ctx->grid, xd[0], xd[1], xd[2], &rg);
     int count = 0;
     double w = 0, s0 = 0, s1 = 0, s2 = 0;
-    /* Two passes per block of candidates: a branch-free one that keeps the indices within h
-     * (about 1 in 7 of the 27-cell candidates), then the kernel sums over those alone, in the
-     * same order as a single loop would take them (the sums are the same bit for bit), without
-     * the mispredicted branch per candidate. */
+    /* Per block of candidates: squared distances (vectorised), a branch-free compaction of the
+     * indices within h (about 1 in 7 of the 27-cell candidates), their kernel weights
+     * (vectorised), then the sums over those alone in the order a single loop would take them:
+     * the same bits as that loop, without its mispredicted branch per candidate. */
     uint32_t nb[SAMPLE_BLOCK];
     pfsph_real r2b[SAMPLE_BLOCK], r2c[SAMPLE_BLOCK], wb[SAMPLE_BLOCK];
     const pfsph_real inv_h = ctx->kern.inv_h, sigma = ctx->kern.sigma;

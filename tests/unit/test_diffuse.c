@@ -495,6 +495,93 @@ static void test_emission_cylinder(void **state)
     fx_free(&f);
 }
 
+/* Gas phases neither count as neighbours nor carry diffuse particles: a diffuse particle in
+ * the middle of a gas block is spray and keeps its velocity; in a liquid block it is a bubble
+ * and follows the liquid. */
+static void test_gas_not_counted(void **state)
+{
+    (void)state;
+    for (int gas = 0; gas < 2; gas++) {
+        fixture f;
+        fx_init(&f, 3, 0.1, 1e-3);
+        f.scene.nphases = 2;
+        f.scene.phases[1].kind = PFSPH_PHASE_GAS;
+        f.scene.phases[1].rest_density = 1;
+        f.ctx.mass[1] = f.ctx.mass[0];
+        fx_lattice(&f, 10, 10, 10, 0.5, 0, 0);
+        for (size_t i = 0; i < f.fluid.n; i++) f.fluid.phase[i] = (uint8_t)gas;
+        fx_grid(&f);
+        f.scene.diffuse.sampling_rate = 0;
+        pfsph_diffuse *d = NULL;
+        for (int t = 0; t < PFSPH_DIFFUSE_NTYPES; t++) f.scene.diffuse.type[t].k_ext = 0;
+        f.scene.diffuse.type[PFSPH_DIFFUSE_BUBBLE].k_b = 0;
+        f.scene.diffuse.type[PFSPH_DIFFUSE_BUBBLE].k_cp = 1;
+        d = mk(&f);
+        const pfsph_real x0[3] = {0.45f, 0.45f, 0.45f}, v0[3] = {0, 0, 0};
+        assert_int_equal(pfsph_diffuse_add(d, x0, v0, PFSPH_DIFFUSE_FOAM, 100), 0);
+        pfsph_diffuse_step(d, &f.ctx);
+        const pfsph_particles *p = pfsph_diffuse_particles(d);
+        assert_int_equal(p->n, 1);
+        if (gas) {
+            assert_int_equal(p->phase[0], PFSPH_DIFFUSE_SPRAY);
+            assert_true(p->vx[0] == 0);
+        } else {
+            assert_int_equal(p->phase[0], PFSPH_DIFFUSE_BUBBLE);
+            assert_true(fabs(p->vx[0] - 0.5) < 1e-6);
+        }
+        pfsph_diffuse_destroy(d);
+        fx_free(&f);
+    }
+}
+
+/* The fluid is only read: 30 steps that emit and advect leave every byte of the fluid set
+ * and of the grid's cell ranges as they were. */
+static void test_fluid_untouched(void **state)
+{
+    (void)state;
+    fixture f;
+    build_shear(&f, 1.5, 0.3);
+    f.scene.diffuse.emit_radius_scale = 4;
+    const pfsph_particles *fl = &f.fluid;
+    const size_t n = fl->n;
+    pfsph_real *copy[PFSPH_NFIELDS];
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        copy[k] = malloc(n * sizeof(pfsph_real));
+        assert_non_null(copy[k]);
+        memcpy(copy[k], fl->f[k], n * sizeof(pfsph_real));
+    }
+    uint8_t *phase = malloc(n);
+    uint32_t *id = malloc(n * sizeof(uint32_t));
+    uint32_t *start = malloc((f.grid.ncells + 1) * sizeof(uint32_t));
+    assert_true(phase && id && start);
+    memcpy(phase, fl->phase, n);
+    memcpy(id, fl->id, n * sizeof(uint32_t));
+    memcpy(start, f.grid.start, (f.grid.ncells + 1) * sizeof(uint32_t));
+    const uint32_t next_id = fl->next_id;
+    pfsph_diffuse *d = mk(&f);
+    for (int s = 1; s <= 30; s++) {
+        f.ctx.step = (uint64_t)s;
+        pfsph_diffuse_step(d, &f.ctx);
+    }
+    uint64_t created = 0;
+    pfsph_diffuse_totals(d, &created, NULL);
+    assert_true(created > 100);
+    assert_int_equal(fl->n, n);
+    assert_int_equal(fl->next_id, next_id);
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        assert_memory_equal(copy[k], fl->f[k], n * sizeof(pfsph_real));
+        free(copy[k]);
+    }
+    assert_memory_equal(phase, fl->phase, n);
+    assert_memory_equal(id, fl->id, n * sizeof(uint32_t));
+    assert_memory_equal(start, f.grid.start, (f.grid.ncells + 1) * sizeof(uint32_t));
+    free(phase);
+    free(id);
+    free(start);
+    pfsph_diffuse_destroy(d);
+    fx_free(&f);
+}
+
 /* Same seed: identical particles with 1 and 2 threads; another seed: different ones. */
 static void run_shear(uint64_t seed, int threads, pfsph_particles *out)
 {
@@ -559,7 +646,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bubble_rises),       cmocka_unit_test(test_classification),
         cmocka_unit_test(test_lifetime_and_cap),   cmocka_unit_test(test_rest_makes_nothing),
         cmocka_unit_test(test_shear_layer_rate),   cmocka_unit_test(test_emission_cylinder),
-        cmocka_unit_test(test_determinism),
+        cmocka_unit_test(test_determinism),        cmocka_unit_test(test_fluid_untouched),
+        cmocka_unit_test(test_gas_not_counted),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
