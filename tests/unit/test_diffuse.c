@@ -638,6 +638,52 @@ static void test_determinism(void **state)
     pfsph_particles_free(&c);
 }
 
+/* A spray particle falling onto a floor of boundary particles (a 2D row at y = 0, spacing d)
+ * is removed once it comes within d/2 of them (it has entered the solid); one falling beside
+ * the floor's end is not. */
+static void test_removed_in_solid(void **state)
+{
+    (void)state;
+    fixture f;
+    fx_init(&f, 2, 0.05, 1e-3);
+    fx_push(&f, 5, 5, 0, 0, 0, 0); /* far away */
+    fx_grid(&f);
+    f.scene.diffuse.sampling_rate = 0;
+    pfsph_particles b;
+    pfsph_grid bg;
+    assert_int_equal(pfsph_particles_init(&b, 64), PFSPH_OK);
+    for (int i = 0; i < 20; i++) {
+        const pfsph_real p[3] = {(pfsph_real)(0.05 * i), 0, 0};
+        assert_true(pfsph_particles_push(&b, p, NULL, 0) >= 0);
+    }
+    const pfsph_real lo[3] = {-10, -10, 0}, hi[3] = {10, 10, 0};
+    assert_int_equal(pfsph_grid_init(&bg, 2, lo, hi, f.ctx.h), PFSPH_OK);
+    assert_int_equal(pfsph_grid_sort(&bg, &b, NULL), PFSPH_OK);
+    f.ctx.boundary = &b;
+    f.ctx.bgrid = &bg;
+    pfsph_diffuse *d = mk(&f);
+    const pfsph_real xa[3] = {0.5, 0.2, 0}, xb[3] = {1.5, 0.2, 0}, v0[3] = {0, -1, 0};
+    assert_int_equal(pfsph_diffuse_add(d, xa, v0, PFSPH_DIFFUSE_SPRAY, 100), 0);
+    assert_true(pfsph_diffuse_add(d, xb, v0, PFSPH_DIFFUSE_SPRAY, 100) >= 0);
+    double ymin_seen = 1;
+    for (int s = 1; s <= 300; s++) {
+        f.ctx.step = (uint64_t)s;
+        pfsph_diffuse_step(d, &f.ctx);
+        const pfsph_particles *p = pfsph_diffuse_particles(d);
+        for (size_t i = 0; i < p->n; i++)
+            if (fabs(p->x[i] - 0.5) < 1e-3) ymin_seen = fmin(ymin_seen, p->y[i]);
+    }
+    const pfsph_particles *p = pfsph_diffuse_particles(d);
+    assert_int_equal(p->n, 1);                     /* the one over the floor is gone */
+    assert_true(fabs(p->x[0] - 1.5) < 1e-6);       /* the other falls on */
+    assert_true(p->y[0] < -0.1);
+    assert_true(ymin_seen >= 0.025 - 0.01 - 1e-6); /* removed within one step (1 cm) of d/2 */
+    pfsph_diffuse_destroy(d);
+    pfsph_grid_free(&bg);
+    pfsph_particles_free(&b);
+    fx_free(&f);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -647,7 +693,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_lifetime_and_cap),   cmocka_unit_test(test_rest_makes_nothing),
         cmocka_unit_test(test_shear_layer_rate),   cmocka_unit_test(test_emission_cylinder),
         cmocka_unit_test(test_determinism),        cmocka_unit_test(test_fluid_untouched),
-        cmocka_unit_test(test_gas_not_counted),
+        cmocka_unit_test(test_gas_not_counted),    cmocka_unit_test(test_removed_in_solid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
