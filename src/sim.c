@@ -49,21 +49,25 @@ struct pfsph_sim {
 static double now(void) { return omp_get_wtime(); }
 static double max_speed(const pfsph_particles *f, size_t *worst);
 
-/* Cells per query radius. With pairwise forces the grid has cells of k h / 2 and queries walk
- * two cells each way: every stage then tests a cube of side 2.5 k h instead of 3 k h, 0.58x
- * the candidates in 3D (0.69x in 2D), and the h-radius stages no longer pay the full
- * k h neighbourhood (docs/benchmarks.md, pairwise). */
-static int grid_reach(const pfsph_scene *s) { return s->pairwise.enabled ? 2 : 1; }
-
-/* Largest radius any stage queries: h, or k*h with pairwise forces. */
-static pfsph_real query_radius(const pfsph_scene *s, pfsph_real h)
+/* Grid cells. Without pair forces cells of h, queries one cell each way. With them cells of
+ * max(h / 2, k h / 3): the h-radius stages walk 2 cells each way (a cube of side 2.5 h instead
+ * of 3 h) and the pair forces 3 (2.52 k h instead of 3 k h). Cells of k h, as before, made the
+ * h stages walk (3 k h)^3: 2.6x the candidates (docs/benchmarks.md, pairwise). */
+static pfsph_real grid_cell(const pfsph_scene *s, pfsph_real h, int *reach, int *reach_far)
 {
-    pfsph_real r = h;
-    if (s->pairwise.enabled) {
-        pfsph_real rp = pfsph_pairwise_radius(s, h);
-        if (rp > r) r = rp;
+    if (!s->pairwise.enabled) {
+        *reach = *reach_far = 1;
+        return h;
     }
-    return r;
+    pfsph_real R = pfsph_pairwise_radius(s, h);
+    pfsph_real cell = h / 2 > R / 3 ? h / 2 : R / 3;
+    *reach = (int)ceil((double)h / (double)cell - 1e-6);
+    *reach_far = (int)ceil((double)R / (double)cell - 1e-6);
+    if (*reach < 1) *reach = 1;
+    if (*reach_far < *reach) *reach_far = *reach;
+    /* shifting moves particles after the sort: h queries need room beyond h (pairwise.h) */
+    if (s->pairwise.shift.D > 0 || s->pairwise.shift.A > 0) *reach = *reach_far;
+    return cell;
 }
 
 static int build_particles(const pfsph_scene *s, double d, pfsph_particles *fluid,
@@ -158,7 +162,8 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
         if (rc) return rc;
     }
     pfsph_real h = (pfsph_real)(s->support_factor * d);
-    double cell = query_radius(s, h) / grid_reach(s);
+    int r1, r2;
+    double cell = grid_cell(s, h, &r1, &r2);
     double cells = 1;
     for (int a = 0; a < s->dim; a++)
         cells *= ceil((s->domain_max[a] - s->domain_min[a]) / cell + 8);
@@ -250,7 +255,8 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
 
     /* The grid spans the domain and every boundary particle, plus a cell of margin; fluid
      * particles leaving the domain itself are removed. */
-    pfsph_real cell = query_radius(s, c->h) / (pfsph_real)grid_reach(s);
+    int reach, reach_far;
+    pfsph_real cell = grid_cell(s, c->h, &reach, &reach_far);
     pfsph_real lo[3], hi[3];
     for (int a = 0; a < 3; a++) {
         lo[a] = (pfsph_real)s->domain_min[a];
@@ -273,7 +279,8 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
                    "particle_radius or shrink the domain", (double)cell);
         goto fail;
     }
-    sim->grid.reach = sim->bgrid.reach = grid_reach(s);
+    sim->grid.reach = sim->bgrid.reach = reach;
+    sim->grid.reach_far = sim->bgrid.reach_far = reach_far;
     for (int a = 0; a < s->dim; a++) {
         sim->grid.keep_lo[a] = (pfsph_real)s->domain_min[a];
         sim->grid.keep_hi[a] = (pfsph_real)s->domain_max[a];

@@ -15,7 +15,8 @@ typedef struct pfsph_grid {
     pfsph_real keep_lo[3], keep_hi[3]; /* particles outside this box are removed by sort
                                         * (defaults to the cell extent) */
     pfsph_real cell, inv_cell;
-    int reach;          /* a query walks reach cells each way (1 or 2): it covers reach * cell */
+    int reach;          /* a query walks reach cells each way: it covers reach * cell (h) */
+    int reach_far;      /* the same for the far queries (k h of the pair forces), <= 3 */
     int nc[3];          /* cells per axis (nc[2] == 1 in 2D) */
     size_t ncells;
     uint32_t *start;    /* ncells + 1 entries: cell c holds [start[c], start[c+1]) */
@@ -26,7 +27,7 @@ typedef struct pfsph_grid {
 } pfsph_grid;
 
 typedef struct pfsph_ranges {
-    uint32_t b[25], e[25]; /* (2 reach + 1)^(dim - 1) rows, reach <= 2 */
+    uint32_t b[49], e[49]; /* (2 reach + 1)^(dim - 1) rows, reach <= 3 */
     int n;
 } pfsph_ranges;
 
@@ -41,10 +42,10 @@ void pfsph_grid_free(pfsph_grid *g);
 int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed);
 
 /* Index ranges (into the sorted set) of the cells around a point; the union covers every
- * particle within distance g->reach * g->cell of (x, y, z). The point may lie outside the
+ * particle within distance R * g->cell of (x, y, z) (R <= 3). The point may lie outside the
  * domain. */
-static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_real y,
-                                     pfsph_real z, pfsph_ranges *r)
+static inline void pfsph_grid_ranges_reach(const pfsph_grid *g, pfsph_real x, pfsph_real y,
+                                           pfsph_real z, int R, pfsph_ranges *r)
 {
     int c[3];
     const pfsph_real p[3] = {x, y, z};
@@ -53,7 +54,6 @@ static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_re
         c[a] = t < 0 ? -1 : (t >= (pfsph_real)g->nc[a] ? g->nc[a] : (int)t);
     }
     r->n = 0;
-    const int R = g->reach;
     int x0 = c[0] - R < 0 ? 0 : c[0] - R;
     int x1 = c[0] + R >= g->nc[0] ? g->nc[0] - 1 : c[0] + R;
     if (x0 > x1) return;
@@ -71,6 +71,19 @@ static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_re
             }
         }
     }
+}
+
+static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_real y,
+                                     pfsph_real z, pfsph_ranges *r)
+{
+    pfsph_grid_ranges_reach(g, x, y, z, g->reach, r);
+}
+
+/* Ranges covering every particle within g->reach_far * g->cell (the pair forces' k h). */
+static inline void pfsph_grid_ranges_far(const pfsph_grid *g, pfsph_real x, pfsph_real y,
+                                         pfsph_real z, pfsph_ranges *r)
+{
+    pfsph_grid_ranges_reach(g, x, y, z, g->reach_far, r);
 }
 
 /* Test oracle: indices j != i of ps with |x_i - x_j| < radius, ascending; returns the count

@@ -12,6 +12,7 @@ int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_
     g->dim = dim;
     g->cell = cell;
     g->reach = 1;
+    g->reach_far = 1;
     g->inv_cell = (pfsph_real)1 / cell;
     g->ncells = 1;
     for (int a = 0; a < 3; a++) {

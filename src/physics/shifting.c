@@ -37,7 +37,7 @@ static double concentration(const pfsph_ctx *ctx, size_t i, pfsph_real xi, pfsph
     for (int set = 0; set < 2; set++) {
         const pfsph_particles *ps = set ? b : f;
         if (!ps || ps->n == 0) continue;
-        pfsph_grid_ranges(set ? ctx->bgrid : ctx->grid, xi, yi, zi, &r);
+        pfsph_grid_ranges_far(set ? ctx->bgrid : ctx->grid, xi, yi, zi, &r); /* h and k h */
         for (int q = 0; q < r.n; q++)
             for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
                 pfsph_real dx = xi - ps->x[j], dy = yi - ps->y[j], dz = zi - ps->z[j];

@@ -81,7 +81,8 @@ static int cmp_u32(const void *a, const void *b)
 }
 
 /* Sort, then check the kept set and the neighbour ranges for both radii. */
-static void check_dim(int dim, size_t n)
+/* fine: cells of max(h/2, k h/3) walked 2 (h) or 3 (k h) cells each way, as with pair forces */
+static void check_dim(int dim, size_t n, int fine)
 {
     pfsph_particles ps;
     unsigned char *in_flag = calloc(n, 1);
@@ -89,7 +90,12 @@ static void check_dim(int dim, size_t n)
     size_t n_outside;
     make_set(&ps, dim, n, 1000 + (uint64_t)dim, in_flag, &n_outside);
     pfsph_grid g;
-    assert_int_equal(pfsph_grid_init(&g, dim, LO, HI, KH * H), PFSPH_OK);
+    const pfsph_real cell = fine ? (H / 2 > KH * H / 3 ? H / 2 : KH * H / 3) : KH * H;
+    assert_int_equal(pfsph_grid_init(&g, dim, LO, HI, cell), PFSPH_OK);
+    if (fine) {
+        g.reach = 2;
+        g.reach_far = 3;
+    }
     size_t removed = 0;
     assert_int_equal(pfsph_grid_sort(&g, &ps, &removed), PFSPH_OK);
     printf("%dD: %zu particles, %zu outside/non-finite, removed %zu, kept %zu, grid %dx%dx%d\n",
@@ -125,8 +131,9 @@ static void check_dim(int dim, size_t n)
         for (size_t i = 0; i < ps.n; i++) {
             size_t nb = pfsph_neighbors_brute(&ps, i, radii[ri], brute, ps.n);
             pfsph_ranges rg;
-            pfsph_grid_ranges(&g, ps.x[i], ps.y[i], ps.z[i], &rg);
-            assert_true(rg.n <= (dim == 3 ? 9 : 3));
+            const int R = ri == 0 ? g.reach : g.reach_far;
+            pfsph_grid_ranges_reach(&g, ps.x[i], ps.y[i], ps.z[i], R, &rg);
+            assert_true(rg.n <= (dim == 3 ? (2 * R + 1) * (2 * R + 1) : 2 * R + 1));
             size_t cnt = 0, span = 0;
             for (int s = 0; s < rg.n; s++) {
                 assert_true(rg.b[s] < rg.e[s] && rg.e[s] <= ps.n);
@@ -160,8 +167,8 @@ static void check_dim(int dim, size_t n)
     pfsph_particles_free(&ps);
 }
 
-static void test_neighbours_2d(void **state) { (void)state; check_dim(2, 3000); }
-static void test_neighbours_3d(void **state) { (void)state; check_dim(3, 8000); }
+static void test_neighbours_2d(void **state) { (void)state; check_dim(2, 3000, 0); check_dim(2, 3000, 1); }
+static void test_neighbours_3d(void **state) { (void)state; check_dim(3, 8000, 0); check_dim(3, 8000, 1); }
 
 /* Sorting the same input with 1 and 2 threads, and twice in a row, gives the same order; a
  * second sort of an already sorted set is the identity (stable). */
