@@ -81,7 +81,7 @@ typedef struct pfsph_body_def {
     int axis;              /* CYLINDER, body coordinates */
     char mesh[PFSPH_PATH_LEN]; /* MESH: OBJ path, resolved against the scene's directory */
     double scale;          /* MESH: vertex scale */
-    double position[3];    /* m: centre of mass (shape centre for primitives, mesh origin for meshes) */
+    double position[3];    /* m: centre of mass (a mesh is moved so that its own lies here) */
     double rotation[3];    /* degrees, as in pfsph_keyframe */
     double velocity[3], angular_velocity[3]; /* m/s, rad/s */
     double density;        /* kg/m^3 (per unit depth in 2D); 0: from mass */

@@ -363,7 +363,7 @@ typedef struct splat_set {
 } splat_set;
 
 static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, double rad,
-                   int layer, int kind /* 0 fluid, 1 boundary, 2 diffuse */,
+                   int layer, int kind /* 0 fluid, 1 boundary, 2 diffuse, 3 bodies */,
                    const pfsph_scene *sc, int by, double vref, int ssf)
 {
     if (ss->n + ps->n > ss->cap) {
@@ -390,7 +390,7 @@ static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, doubl
         } else if (kind == 2) {
             int t = ps->phase[i] < 3 ? ps->phase[i] : 0;
             memcpy(s->col, DIFFUSE_COL[t], sizeof s->col);
-        } else if (by == COLOR_PHASE) {
+        } else if (by == COLOR_PHASE || kind == 3) {
             int ph = ps->phase[i];
             if (ph < sc->nphases) memcpy(s->col, sc->phases[ph].color, sizeof s->col);
             else s->col[0] = 0.8f, s->col[1] = 0.2f, s->col[2] = 0.8f;
@@ -578,8 +578,8 @@ typedef struct ctx {
 } ctx;
 
 static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_particles *bnd,
-                        const pfsph_particles *dif, int frame, double time, const char *png_path,
-                        pfsph_error *err)
+                        const pfsph_particles *bod, const pfsph_particles *dif, int frame,
+                        double time, const char *png_path, pfsph_error *err)
 {
     const pfsph_scene *sc = x->sc;
     const double r = sc->particle_radius > 0 ? sc->particle_radius : 0.01;
@@ -597,6 +597,9 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
                       ssf)))
         goto oom;
     if (dif && (rc = add_set(&x->sp, &x->c, dif, 0.4 * r, 0, 2, sc, COLOR_PHASE, 0, ssf)))
+        goto oom;
+    /* rigid bodies are drawn solid in their phase's colour, not as translucent walls */
+    if (bod && (rc = add_set(&x->sp, &x->c, bod, r, 0, 3, sc, COLOR_PHASE, 0, ssf)))
         goto oom;
 
     if (x->sp.n > UINT32_MAX)
@@ -920,29 +923,10 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
                 goto out;
             bnd_loaded = bl.num[bi];
         }
-        /* rigid bodies move: their particles of this frame join the static boundary */
+        /* rigid bodies move: their particles of this frame */
         int ri = find_num(&rl, f);
-        if (ri >= 0) {
-            pfsph_particles bod;
-            if ((rc = read_frame(fdir, "bodies_", f, rl.ply[ri], &bod, NULL, err))) goto out;
-            const pfsph_particles *st0 = bi >= 0 ? &bnd : NULL;
-            size_t n0 = st0 ? st0->n : 0;
-            pfsph_particles_free(&both);
-            rc = pfsph_particles_init(&both, n0 + bod.n + 1);
-            for (size_t j = 0; !rc && j < n0 + bod.n; j++) {
-                const pfsph_particles *src = j < n0 ? st0 : &bod;
-                size_t k = j < n0 ? j : j - n0;
-                for (int q = 0; q < PFSPH_NFIELDS; q++) both.f[q][j] = src->f[q][k];
-                both.phase[j] = src->phase[k];
-                both.id[j] = src->id[k];
-            }
-            both.n = n0 + bod.n;
-            pfsph_particles_free(&bod);
-            if (rc) {
-                rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-                goto out;
-            }
-        }
+        pfsph_particles_free(&both);
+        if (ri >= 0 && (rc = read_frame(fdir, "bodies_", f, rl.ply[ri], &both, NULL, err))) goto out;
         int di = find_num(&dl, f);
         pfsph_particles_free(&dif);
         if (di >= 0 && (rc = read_frame(fdir, "diffuse_", f, dl.ply[di], &dif, NULL, err)))
@@ -958,8 +942,8 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
             x.vref = speed_scale(sc, &fluid);
         }
         snprintf(path, sizeof path, "%s/frame_%05d.png", pdir, f);
-        rc = render_frame(&x, &fluid, ri >= 0 ? &both : bi >= 0 ? &bnd : NULL, di >= 0 ? &dif : NULL, f, t,
-                          path, err);
+        rc = render_frame(&x, &fluid, bi >= 0 ? &bnd : NULL, ri >= 0 ? &both : NULL, di >= 0 ? &dif : NULL, f,
+                          t, path, err);
         if (rc != PFSPH_OK) goto out;
         rendered++;
         if (!o->quiet) fprintf(stderr, "\rrender: %s", path);
