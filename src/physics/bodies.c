@@ -712,6 +712,10 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
     const pfsph_real visc_c = (pfsph_real)(2 * (ctx->dim + 2));
     const uint32_t first = B->first_id;
     const size_t nb = b->n;
+    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    const bool pw_on = pp->enabled;
+    const double Rk = pw_on ? pp->k * (double)ctx->h : 0, U_R = pw_on ? 1.5 * PI / Rk : 0;
+    const pfsph_real R2 = (pfsph_real)(Rk * Rk);
 #pragma omp parallel for schedule(static)
     for (size_t j = 0; j < nb; j++) {
         if (b->id[j] < first) continue;
@@ -741,6 +745,27 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
                 fy += (double)(s * dy);
                 fz += (double)(s * dz);
             }
+        if (pw_on) {
+            /* the pair forces' reaction (PF Eq. 3): -c m_i m_b f(r) x_ib / r, over k h. The
+             * fluid applies its filter T_i (Eq. 12) to its own sum, so with eta > 0 action and
+             * reaction differ by that filter; with eta = 0 they cancel exactly. */
+            const int pb = b->phase[j];
+            pfsph_grid_ranges_far(ctx->grid, xj, yj, zj, &r);
+            for (int q = 0; q < r.n; q++)
+                for (uint32_t i = r.b[q]; i < r.e[q]; i++) {
+                    const double cf = pp->c[f->phase[i]][pb] * (double)ctx->mass[f->phase[i]] *
+                                      (double)ctx->mass[pb];
+                    if (cf == 0.0) continue;
+                    pfsph_real dx = f->x[i] - xj, dy = f->y[i] - yj, dz = f->z[i] - zj;
+                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+                    if (r2 >= R2 || r2 <= 0) continue;
+                    double rr = sqrt((double)r2);
+                    double sp = -cf * (double)cosf((float)(U_R * rr)) / rr;
+                    fx += sp * dx;
+                    fy += sp * dy;
+                    fz += sp * dz;
+                }
+        }
         B->fp[3 * l] = fx;
         B->fp[3 * l + 1] = fy;
         B->fp[3 * l + 2] = fz;
