@@ -674,6 +674,11 @@ int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const pfsph_body_state
         for (int a = 0; a < 3; a++) s += st[i].x[a] + st[i].v[a] + st[i].w[a];
         s += st[i].q[0] + st[i].q[1] + st[i].q[2] + st[i].q[3];
         if (!isfinite(s)) return pfsph_fail(err, PFSPH_EINPUT, "restore: body %d has a non-finite state", i);
+        double qn = st[i].q[0] * st[i].q[0] + st[i].q[1] * st[i].q[1] + st[i].q[2] * st[i].q[2] +
+                    st[i].q[3] * st[i].q[3];
+        if (!(fabs(qn - 1) < 1e-6))
+            return pfsph_fail(err, PFSPH_EINPUT, "restore: body %d's orientation is not a unit quaternion (norm^2 %g)",
+                              i, qn);
     }
     /* where each id sits now */
     uint32_t *where = malloc((b->next_id ? b->next_id : 1) * sizeof(uint32_t));
