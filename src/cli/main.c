@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "pfsph/bodies.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/render.h"
 #include "pfsph/run.h"
@@ -249,6 +250,23 @@ static int cmd_check(int argc, char **argv)
            s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
     rc = check_memory(&s, 1);
     if (rc) return rc;
+    if (s.nbodies) {
+        /* check_memory has read and checked the mesh files already */
+        pfsph_error err = {0};
+        pfsph_particles tmp;
+        pfsph_bodies *B = NULL;
+        if (pfsph_particles_init(&tmp, 1024) == PFSPH_OK &&
+            pfsph_bodies_create(&B, &s, 2 * s.particle_radius, &tmp, &err) == PFSPH_OK) {
+            static const char *const shapes[] = {"box", "sphere", "cylinder", "mesh"};
+            printf("bodies: %d, %zu particles\n", s.nbodies, tmp.n);
+            for (int i = 0; i < s.nbodies; i++)
+                printf("  %s: %s, %s, mass %.4g kg%s\n", s.bodies[i].name, shapes[s.bodies[i].shape],
+                       s.bodies[i].kinematic ? "kinematic" : "dynamic", pfsph_bodies_mass(B, i),
+                       s.dim == 2 ? " per metre of depth" : "");
+        }
+        pfsph_bodies_destroy(B);
+        pfsph_particles_free(&tmp);
+    }
     if (s.pairwise.enabled) {
         pfsph_error err = {0};
         double d = 2 * s.particle_radius;
