@@ -55,6 +55,8 @@ void pfsph_bodies_last_force(const pfsph_bodies *b, int i, double f[3], double t
 double pfsph_bodies_mass(const pfsph_bodies *b, int i);
 /* Body i's surface in world coordinates at its current pose (caller frees m). */
 int pfsph_bodies_world_mesh(const pfsph_bodies *b, int i, pfsph_mesh *m);
+/* Particles sampled on all bodies (ids first_id .. first_id + count - 1). */
+uint32_t pfsph_bodies_particle_count(const pfsph_bodies *b);
 /* First boundary-particle id that belongs to a body (ids below are static solids). */
 uint32_t pfsph_bodies_first_id(const pfsph_bodies *b);
 

@@ -183,6 +183,8 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
             h_f64(h, b->mass);
             h_f64(h, b->friction);
             h_f64(h, b->restitution);
+            h_int(h, b->layers);
+            h_vec(h, b->inertia, 3);
             h_int(h, b->kinematic);
             h_int(h, b->nkeys);
             for (int k = 0; k < b->nkeys && k < PFSPH_MAX_KEYFRAMES; k++) {
@@ -251,7 +253,7 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     const int nbod = pfsph_bodies_count(B);
     payload += 4;
-    if (nbod) payload += (size_t)nbod * 13 * 8 + 8 + 4 * c->boundary->n;
+    if (nbod) payload += 4 + (size_t)nbod * 13 * 8 + 8 + 4 * c->boundary->n;
     size_t total = HEADER_LEN + payload;
     unsigned char *buf = malloc(total);
     if (!buf) return pfsph_fail(err, PFSPH_ENOMEM, "checkpoint: out of memory for %zu bytes", total);
@@ -284,6 +286,8 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
     }
     w_u32(&w, (uint32_t)nbod);
     if (nbod) {
+        /* the sampled particle count: a mesh file edited since (not in the scene hash) shows */
+        w_u32(&w, pfsph_bodies_particle_count(B));
         for (int i = 0; i < nbod; i++) {
             pfsph_body_state bs;
             pfsph_bodies_get_state(B, i, &bs);
@@ -477,7 +481,9 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
     pfsph_body_state *bst = NULL;
     uint32_t *bids = NULL;
     uint64_t nbid = 0;
+    uint32_t nbp = 0;
     if (!r.bad && nbod > 0 && nbod <= PFSPH_MAX_BODIES) {
+        nbp = r_u32(&r);
         bst = calloc(nbod, sizeof *bst);
         for (uint32_t i = 0; bst && i < nbod; i++) {
             for (int a = 0; a < 3; a++) bst[i].x[a] = r_f64(&r);
@@ -499,6 +505,9 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
     } else if ((int)nbod != pfsph_bodies_count(pfsph_sim_bodies(sim))) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint has %u bodies, the scene %d", name, nbod,
                         pfsph_bodies_count(pfsph_sim_bodies(sim)));
+    } else if (nbod && nbp != pfsph_bodies_particle_count(pfsph_sim_bodies(sim))) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint has %u body particles, the scene makes %u (a mesh file "
+                        "changed?)", name, nbp, pfsph_bodies_particle_count(pfsph_sim_bodies(sim)));
     } else if ((has_d != 0) != (pfsph_sim_diffuse(sim) != NULL)) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint %s diffuse particles but the scene has them %s", name,
                         has_d ? "has" : "has no", has_d ? "off" : "on");

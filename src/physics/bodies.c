@@ -641,6 +641,7 @@ int pfsph_bodies_count(const pfsph_bodies *B) { return B ? B->nb : 0; }
 const char *pfsph_bodies_name(const pfsph_bodies *B, int i) { return B->b[i].def.name; }
 double pfsph_bodies_mass(const pfsph_bodies *B, int i) { return B->b[i].mass; }
 uint32_t pfsph_bodies_first_id(const pfsph_bodies *B) { return B->first_id; }
+uint32_t pfsph_bodies_particle_count(const pfsph_bodies *B) { return B ? B->np : 0; }
 
 void pfsph_bodies_last_force(const pfsph_bodies *B, int i, double f[3], double tq[3])
 {
@@ -734,6 +735,9 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
     const bool pw_on = pp->enabled;
     const double Rk = pw_on ? pp->k * (double)ctx->h : 0, U_R = pw_on ? 1.5 * PI / Rk : 0;
     const pfsph_real R2 = (pfsph_real)(Rk * Rk);
+    /* particles dropped from the boundary set (a body that left the grid) must not keep their
+     * last force: only the present ones are written below */
+    memset(B->fp, 0, 3 * (size_t)B->np * sizeof(double));
 #pragma omp parallel for schedule(static)
     for (size_t j = 0; j < nb; j++) {
         if (b->id[j] < first) continue;

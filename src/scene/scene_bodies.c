@@ -98,9 +98,10 @@ static int resolve_mesh(const pfsph_scene *s, const char *P, const char *file, c
     return PFSPH_OK;
 }
 
-static int parse_keys(const cJSON *arr, const char *P, int dim, pfsph_body_def *b,
+static int parse_keys(const cJSON *arr, const char *P, const pfsph_scene *s, pfsph_body_def *b,
                       pfsph_jctx *ctx)
 {
+    const int dim = s->dim;
     char kp[192];
     snprintf(kp, sizeof kp, "%s.keyframes", P);
     if (!cJSON_IsArray(arr)) return pfsph__json_fail(ctx, kp, "expected an array of keyframes");
@@ -125,6 +126,12 @@ static int parse_keys(const cJSON *arr, const char *P, int dim, pfsph_body_def *
             (rc = vec(k, Q, "position", dim, -COORD_MAX, COORD_MAX, f->position, ctx)) ||
             (rc = rotation(k, Q, dim, f->rotation, ctx)))
             return rc;
+        for (int a = 0; a < dim; a++)
+            if (f->position[a] < s->domain_min[a] || f->position[a] > s->domain_max[a]) {
+                char T[240];
+                snprintf(T, sizeof T, "%s.position", Q);
+                return pfsph__json_fail(ctx, T, "lies outside the domain (a body outside the grid loses its particles)");
+            }
         if (prev && !(f->t > prev->t)) {
             char T[240];
             snprintf(T, sizeof T, "%s.t", Q);
@@ -285,7 +292,7 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
                 snprintf(kp, sizeof kp, "%s.keyframes", P);
                 return pfsph__json_fail(ctx, kp, "keyframes move kinematic bodies only: add \"kinematic\": true");
             }
-            if ((rc = parse_keys(kf, P, s->dim, b, ctx))) return rc;
+            if ((rc = parse_keys(kf, P, s, b, ctx))) return rc;
         }
         for (int k = 0; k < s->dim; k++)
             if (b->position[k] < s->domain_min[k] || b->position[k] > s->domain_max[k]) {

@@ -87,6 +87,9 @@ static void test_parse_errors(void **st)
     expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"kinematic\": true,"
                     " \"keyframes\": [{\"t\": 1}, {\"t\": 0.5}]}",
                  "$.bodies[0].keyframes[1].t", "increase");
+    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"kinematic\": true,"
+                    " \"keyframes\": [{\"t\": 0}, {\"t\": 1, \"position\": [3, 0.5]}]}",
+                 "$.bodies[0].keyframes[1].position", "outside the domain");
     expect_error(2, "{\"name\": \"a,b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5]}",
                  "$.bodies[0].name", "letters");
     expect_error(2, "{\"name\": \"a\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5]},"
