@@ -198,6 +198,45 @@ static void test_momentum_pairwise(void **state)
              "{\"phases\": [\"water\", \"body\"], \"contact_angle\": 45}]}");
 }
 
+/* Regression (review of the bodies code): a body that leaves the domain (here pushed out by
+ * its own velocity, no gravity, water adhering to it) loses its particles; it must then feel
+ * no fluid force at all, not the last one its particles had (it used to keep braking at a
+ * constant -0.0626 N on water it no longer touched). */
+static void test_left_domain_feels_nothing(void **state)
+{
+    (void)state;
+    static const char *json =
+        "{\"dimension\": 2, \"particle_radius\": 0.01, \"gravity\": [0, 0],"
+        " \"domain\": {\"min\": [0, 0], \"max\": [1.0, 1.0]},"
+        " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 0.6, \"fps\": 25, \"dt_max\": 0.004},"
+        " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": 0},"
+        "              {\"name\": \"body\", \"kind\": \"solid\", \"rest_density\": 1000}],"
+        " \"bodies\": [{\"name\": \"crate\", \"shape\": \"box\", \"half_extents\": [0.05, 0.05],"
+        "              \"position\": [0.85, 0.45], \"velocity\": [0.6, 0], \"phase\": \"body\"}],"
+        " \"fluid\": [{\"shape\": \"box\", \"min\": [0.5, 0.3], \"max\": [0.95, 0.6], \"phase\": \"water\"}],"
+        " \"pairwise\": {\"filter\": false, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 0.5},"
+        "              {\"phases\": [\"water\", \"body\"], \"contact_angle\": 45}]}}";
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(&s, json, "left", &err), PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    assert_int_equal(pfsph_sim_create(&sim, &s, &err), PFSPH_OK);
+    advance(sim, 0.52);
+    const pfsph_bodies *B = pfsph_sim_bodies(sim);
+    pfsph_body_state a, b;
+    double F[3], T[3];
+    pfsph_bodies_get_state(B, 0, &a);
+    advance(sim, 0.6);
+    pfsph_bodies_get_state(B, 0, &b);
+    pfsph_bodies_last_force(B, 0, F, T);
+    printf("left the domain: x %.4f -> %.4f m, vx %.9f -> %.9f m/s, force %g %g N\n", a.x[0], b.x[0], a.v[0],
+           b.v[0], F[0], F[1]);
+    assert_true(a.x[0] - 0.05 > 1.0 + 0.02); /* wholly outside, beyond the grid's margin */
+    assert_true(F[0] == 0 && F[1] == 0 && T[2] == 0);
+    assert_true(b.v[0] == a.v[0]);
+    pfsph_sim_destroy(sim);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -207,6 +246,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_archimedes),
         cmocka_unit_test(test_rest_on_floor),
         cmocka_unit_test(test_sinking_disc),
+        cmocka_unit_test(test_left_domain_feels_nothing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
