@@ -59,26 +59,32 @@ static int write_set(const pfsph_scene *s, const char *dir, const char *name, in
     return PFSPH_OK;
 }
 
+/* The boundary particles with ids >= first (bodies) or below it (static solids) as one set. */
+static int write_boundary_part(const pfsph_scene *s, const char *dir, const char *name, int frame,
+                               const pfsph_particles *b, uint32_t first, bool bodies, double t,
+                               pfsph_error *err)
+{
+    pfsph_particles ps;
+    if (pfsph_particles_init(&ps, b->n ? b->n : 1)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    for (size_t j = 0; j < b->n; j++) {
+        if ((b->id[j] >= first) != bodies) continue;
+        for (int k = 0; k < PFSPH_NFIELDS; k++) ps.f[k][ps.n] = b->f[k][j];
+        ps.phase[ps.n] = b->phase[j];
+        ps.id[ps.n] = b->id[j];
+        ps.n++;
+    }
+    int rc = write_set(s, dir, name, frame, &ps, "volume", t, err);
+    pfsph_particles_free(&ps);
+    return rc;
+}
+
 /* Bodies of a frame: their particles ("bodies_NNNNN", like the other sets) and their
  * surfaces ("surfaces_NNNNN", triangle meshes with each body's pose). */
 static int write_bodies(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *b,
                         const pfsph_bodies *B, double t, pfsph_error *err)
 {
     const int nb = pfsph_bodies_count(B);
-    const uint32_t first = pfsph_bodies_first_id(B);
-    pfsph_particles ps;
-    size_t n = 0;
-    for (size_t j = 0; j < b->n; j++) n += b->id[j] >= first;
-    if (pfsph_particles_init(&ps, n ? n : 1)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-    for (size_t j = 0; j < b->n; j++) {
-        if (b->id[j] < first) continue;
-        for (int k = 0; k < PFSPH_NFIELDS; k++) ps.f[k][ps.n] = b->f[k][j];
-        ps.phase[ps.n] = b->phase[j];
-        ps.id[ps.n] = b->id[j];
-        ps.n++;
-    }
-    int rc = write_set(s, dir, "bodies", frame, &ps, "volume", t, err);
-    pfsph_particles_free(&ps);
+    int rc = write_boundary_part(s, dir, "bodies", frame, b, pfsph_bodies_first_id(B), true, t, err);
     if (rc) return rc;
     pfsph_mesh *m = calloc((size_t)nb, sizeof *m);
     pfsph_body_pose *pose = calloc((size_t)nb, sizeof *pose);
@@ -135,19 +141,9 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     if (!rc && frame == 0 && c->boundary->n) {
         if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
-        else { /* the static part; body particles go to bodies_NNNNN every frame */
-            pfsph_particles st;
-            if (pfsph_particles_init(&st, c->boundary->n)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-            for (size_t j = 0; j < c->boundary->n; j++) {
-                if (c->boundary->id[j] >= pfsph_bodies_first_id(B)) continue;
-                for (int k = 0; k < PFSPH_NFIELDS; k++) st.f[k][st.n] = c->boundary->f[k][j];
-                st.phase[st.n] = c->boundary->phase[j];
-                st.id[st.n] = c->boundary->id[j];
-                st.n++;
-            }
-            rc = write_set(s, dir, "boundary", frame, &st, "volume", t, err);
-            pfsph_particles_free(&st);
-        }
+        else /* the static part; body particles go to bodies_NNNNN every frame */
+            rc = write_boundary_part(s, dir, "boundary", frame, c->boundary, pfsph_bodies_first_id(B), false,
+                                     t, err);
     }
     const pfsph_particles *d = pfsph_sim_diffuse(sim);
     if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);

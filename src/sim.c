@@ -71,7 +71,7 @@ static pfsph_real grid_cell(const pfsph_scene *s, pfsph_real h, int *reach, int 
 }
 
 static int build_particles(const pfsph_scene *s, double d, pfsph_particles *fluid,
-                           pfsph_particles *boundary, pfsph_error *err)
+                           pfsph_particles *boundary, pfsph_bodies **bodies, pfsph_error *err)
 {
     /* Boundary volumes. A wall of two or more layers at the fluid's spacing continues the
      * fluid's lattice, so V_b = V0 gives exactly the rest density next to it. Akinci's
@@ -86,18 +86,25 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling solids");
         for (size_t j = first; j < boundary->n; j++) boundary->aux[j] = s->solids[i].layers > 1 ? v0 : -1;
     }
+    /* bodies after the static solids: their boundary ids follow (pfsph_bodies_first_id) */
+    if (s->nbodies) {
+        int rc = pfsph_bodies_create(bodies, s, d, boundary, err);
+        if (rc) return rc;
+    }
     for (int i = 0; i < s->nblocks; i++) {
         size_t first = fluid->n;
         if (pfsph__sample_block(s, &s->blocks[i], d, fluid) < 0)
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
-        /* drop fluid particles inside or too close to a solid (their boundary particles sit
-         * d/2 inside the surface; a fluid particle nearer than 0.4 d would start compressed) */
+        /* drop fluid particles inside or too close to a solid or a body (their boundary
+         * particles sit d/2 inside the surface; one nearer than 0.4 d would start compressed) */
         size_t w = first;
         for (size_t j = first; j < fluid->n; j++) {
             double p[3] = {fluid->x[j], fluid->y[j], fluid->z[j]};
             int keep = 1;
             for (int k = 0; k < s->nsolids && keep; k++)
                 if (pfsph__solid_distance(&s->solids[k], s->dim, p) < 0.4 * d) keep = 0;
+            for (int k = 0; k < s->nbodies && keep; k++)
+                if (pfsph_bodies_distance(*bodies, k, p) < 0.4 * d) keep = 0;
             if (!keep) continue;
             if (w != j) {
                 for (int f = 0; f < PFSPH_NFIELDS; f++) fluid->f[f][w] = fluid->f[f][j];
@@ -110,28 +117,6 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
         fluid->next_id = (uint32_t)w;
     }
     return PFSPH_OK;
-}
-
-/* Fluid particles inside a body or nearer than 0.4 d to its surface are not made (as for
- * static solids); ids stay equal to indices. */
-static void drop_inside_bodies(const pfsph_bodies *B, int nb, double d, pfsph_particles *f)
-{
-    size_t w = 0;
-    for (size_t j = 0; j < f->n; j++) {
-        double p[3] = {f->x[j], f->y[j], f->z[j]};
-        int keep = 1;
-        for (int k = 0; k < nb && keep; k++)
-            if (pfsph_bodies_distance(B, k, p) < 0.4 * d) keep = 0;
-        if (!keep) continue;
-        if (w != j) {
-            for (int q = 0; q < PFSPH_NFIELDS; q++) f->f[q][w] = f->f[q][j];
-            f->phase[w] = f->phase[j];
-        }
-        f->id[w] = (uint32_t)w;
-        w++;
-    }
-    f->n = w;
-    f->next_id = (uint32_t)w;
 }
 
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
@@ -245,11 +230,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         pfsph_fail(err, rc, "out of memory");
         goto fail;
     }
-    if ((rc = build_particles(s, d, &sim->fluid, &sim->boundary, err))) goto fail;
-    if (s->nbodies) {
-        if ((rc = pfsph_bodies_create(&sim->bodies, s, d, &sim->boundary, err))) goto fail;
-        drop_inside_bodies(sim->bodies, s->nbodies, d, &sim->fluid);
-    }
+    if ((rc = build_particles(s, d, &sim->fluid, &sim->boundary, &sim->bodies, err))) goto fail;
     c->fluid = &sim->fluid;
     c->boundary = &sim->boundary;
 

@@ -266,7 +266,7 @@ static int body_particles(const pfsph_scene *s, const body *bd, double d, pfsph_
 
 /* Akinci volumes over the body's own particles, so that a body's volumes do not depend on
  * what it touches at the start. */
-static int body_volumes(const pfsph_particles *src, double d, int dim, double h,
+static int body_volumes(const pfsph_particles *src, int dim, double h,
                         pfsph_real *vol)
 {
     pfsph_particles ps;
@@ -289,7 +289,6 @@ static int body_volumes(const pfsph_particles *src, double d, int dim, double h,
         lo[a] -= (pfsph_real)(2 * h);
         hi[a] += (pfsph_real)(2 * h);
     }
-    (void)d;
     if ((rc = pfsph_grid_init(&g, dim, lo, hi, (pfsph_real)h))) {
         pfsph_particles_free(&ps);
         return rc;
@@ -399,7 +398,7 @@ static int add_statics(pfsph_bodies *B, const pfsph_scene *s)
     return PFSPH_OK;
 }
 
-static void set_mass(pfsph_bodies *B, body *bd, int dim)
+static void set_mass(body *bd, int dim)
 {
     const pfsph_body_def *d = &bd->def;
     dMass m;
@@ -442,7 +441,6 @@ static void set_mass(pfsph_bodies *B, body *bd, int dim)
         dMassSetParameters(&m, bd->mass, 0, 0, 0, I[0], I[1], I[2], 0, 0, 0);
     }
     dBodySetMass(bd->id, &m);
-    (void)B;
 }
 
 static void make_geom(pfsph_bodies *B, body *bd, int dim)
@@ -552,7 +550,7 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
          * one layer a floating box rode 0.22 d too high (submerged fraction 0.454 for 0.5). */
         if (vol && bd->def.layers > 1)
             for (size_t j = 0; j < tmp.n; j++) vol[j] = (pfsph_real)(s->dim == 2 ? spacing * spacing : spacing * spacing * spacing);
-        if (!vol || !loc || !own || (bd->def.layers == 1 && (rc = body_volumes(&tmp, spacing, s->dim, h, vol)))) {
+        if (!vol || !loc || !own || (bd->def.layers == 1 && (rc = body_volumes(&tmp, s->dim, h, vol)))) {
             free(vol);
             rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
             goto fail;
@@ -578,7 +576,7 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
         B->np += (uint32_t)tmp.n;
 
         bd->id = dBodyCreate(B->world);
-        set_mass(B, bd, s->dim);
+        set_mass(bd, s->dim);
         make_geom(B, bd, s->dim);
         double q[4];
         euler_quat(bd->def.rotation, q);
@@ -795,7 +793,6 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
     /* sums in id order: the same bits for any thread count and particle order */
     for (int i = 0; i < B->nb; i++) {
         body *bd = &B->b[i];
-        const dReal *c = dBodyGetPosition(bd->id);
         const dReal *Rm = dBodyGetRotation(bd->id);
         double F[3] = {0, 0, 0}, T[3] = {0, 0, 0};
         for (uint32_t l = bd->first; l < bd->first + bd->n; l++) {
@@ -809,7 +806,6 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
             T[2] += rr[0] * fl[1] - rr[1] * fl[0];
         }
         if (B->dim == 2) F[2] = T[0] = T[1] = 0;
-        (void)c;
         memcpy(bd->f, F, sizeof F);
         memcpy(bd->tq, T, sizeof T);
     }
