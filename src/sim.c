@@ -102,7 +102,7 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
             double p[3] = {fluid->x[j], fluid->y[j], fluid->z[j]};
             int keep = 1;
             for (int k = 0; k < s->nsolids && keep; k++)
-                if (pfsph__solid_distance(&s->solids[k], s->dim, p) < 0.4 * d) keep = 0;
+                if (pfsph__solid_distance(&s->solids[k], s->dim, (double)d, p) < 0.4 * d) keep = 0;
             for (int k = 0; k < s->nbodies && keep; k++)
                 if (pfsph_bodies_distance(*bodies, k, p) < 0.4 * d) keep = 0;
             if (!keep) continue;

@@ -258,17 +258,24 @@ long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
     }
 }
 
-double pfsph__solid_distance(const pfsph_solid *o, int dim, const double p[3])
+double pfsph__solid_distance(const pfsph_solid *o, int dim, double d, const double p[3])
 {
     switch (o->shape) {
     case PFSPH_SHAPE_CONTAINER: {
-        double m = INFINITY;
+        /* Inside the fluid region (above an open top too): distance to the nearest wall face.
+         * Outside it, the walls are a shell layers x d thick: negative within the shell,
+         * positive beyond it, so that fluid next to (or inside) another container is kept. */
+        double m = INFINITY, q2 = 0;
         for (int a = 0; a < dim; a++) {
             double lo = p[a] - o->min[a], hi = o->max[a] - p[a];
-            if (lo < m) m = lo;
-            if (!(a == 1 && o->open_top) && hi < m) m = hi;
+            if (a == 1 && o->open_top) hi = INFINITY;
+            double in = lo < hi ? lo : hi;
+            if (in < m) m = in;
+            if (in < 0) q2 += in * in;
         }
-        return m;
+        if (m >= 0) return m;
+        double q = sqrt(q2), T = o->layers * d;
+        return q <= T ? -(q < T - q ? q : T - q) : q - T;
     }
     case PFSPH_SHAPE_BOX: {
         double out = 0, in = -INFINITY;

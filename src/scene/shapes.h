@@ -13,7 +13,8 @@ long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d,
  * centred d/2 inside the solid surface). ps may be NULL to only count. */
 long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
                          pfsph_particles *ps);
-/* Signed distance from p to the solid's surface, positive on the fluid side. */
-double pfsph__solid_distance(const pfsph_solid *o, int dim, const double p[3]);
+/* Signed distance from p to the solid's surface, positive on the fluid side (d: the particle
+ * spacing, which sets the thickness of container walls). */
+double pfsph__solid_distance(const pfsph_solid *o, int dim, double d, const double p[3]);
 
 #endif

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "pfsph/scene.h"
+#include "pfsph/sim.h"
 #include "scene/shapes.h"
 #include "testutil.h"
 
@@ -242,6 +243,40 @@ static void test_touching_blocks_ok(void **state)
               "{\"shape\":\"sphere\",\"center\":[0.1,0.3,0.1],\"radius\":0.1},"
               "{\"shape\":\"sphere\",\"center\":[0.3,0.3,0.1],\"radius\":0.1}]}");
     assert_int_equal(g_scene.nblocks, 4);
+}
+
+/* Regression: a container's walls are a shell `layers` spacings thick. Fluid in a second
+ * container beside it (or anywhere beyond the shell) is kept; fluid inside the shell is not.
+ * The first version treated every point outside a container as inside its walls, and two
+ * side-by-side containers started with no fluid at all. */
+static void test_two_containers_keep_fluid(void **state)
+{
+    (void)state;
+    const char *json =
+        "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
+        " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.7, 0.4]},"
+        " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.2, 0.1]},"
+        "             {\"shape\": \"box\", \"min\": [0.3, 0], \"max\": [0.5, 0.1]},"
+        "             {\"shape\": \"box\", \"min\": [0.2, 0.2], \"max\": [0.3, 0.25]},"
+        "             {\"shape\": \"box\", \"min\": [0.55, 0], \"max\": [0.65, 0.05]}],"
+        " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.2, 0.3], \"layers\": 2},"
+        "              {\"shape\": \"container\", \"min\": [0.3, 0], \"max\": [0.5, 0.3], \"layers\": 2}]}";
+    pfsph_scene *s = malloc(sizeof *s);
+    assert_non_null(s);
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(s, json, "two.json", &err), PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    int rc = pfsph_sim_create(&sim, s, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    /* 20 x 10 in each container. The block over the gap (x 0.2-0.3) meets both walls'
+     * shells (0.2-0.22 and 0.28-0.3): 2 columns at each side go, 6 columns x 5 rows stay.
+     * The block at x 0.55-0.65 lies beyond the right shell (0.52): all 10 x 5 stay. */
+    size_t n = pfsph_sim_ctx(sim)->fluid->n;
+    print_message("fluid particles kept: %zu\n", n);
+    assert_int_equal(n, 200 + 200 + 30 + 50);
+    pfsph_sim_destroy(sim);
+    free(s);
 }
 
 static void test_error_leaves_scene_unchanged(void **state)
@@ -561,6 +596,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_defaults),
         cmocka_unit_test(test_2d),
         cmocka_unit_test(test_touching_blocks_ok),
+        cmocka_unit_test(test_two_containers_keep_fluid),
         cmocka_unit_test(test_block_jitter),
         cmocka_unit_test(test_error_leaves_scene_unchanged),
         cmocka_unit_test(test_default_scene),
