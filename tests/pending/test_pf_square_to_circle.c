@@ -66,13 +66,13 @@ static void test_rectangle_to_disc(void **state)
     const double L = getenv("PF_L") ? atof(getenv("PF_L")) : 0.15;
     const char *ek = getenv("PF_K"), *ej = getenv("PF_JIT"), *en = getenv("PF_NU"), *es = getenv("PF_SIG");
     snprintf(json, sizeof json,
-        "{\"dimension\": 2, \"seed\": %s, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
+        "{\"dimension\": 2, %s \"seed\": %s, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
         " \"domain\": {\"min\": [-0.5, -0.5], \"max\": [0.5, 0.5]},"
-        " \"solver\": {\"type\": \"%s\"}, \"time\": {\"dt_max\": 0.002},"
+        " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": 0.002},"
         " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}],"
         " \"fluid\": [{\"shape\": \"box\", \"min\": [-%g, -%g], \"max\": [%g, %g], \"jitter\": %s}],"
         " \"pairwise\": {%s \"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %s}]}}",
-        getenv("PF_SEED") ? getenv("PF_SEED") : "1", getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", en ? en : "0.001", L, 0.5 * L, L, 0.5 * L, ej ? ej : "0", getenv("PF_PW") ? getenv("PF_PW") : "", ek ? ek : "1.7", es ? es : "4");
+        getenv("PF_TOP") ? getenv("PF_TOP") : "", getenv("PF_SEED") ? getenv("PF_SEED") : "1", getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", getenv("PF_SOLVEX") ? getenv("PF_SOLVEX") : "", en ? en : "0.001", L, 0.5 * L, L, 0.5 * L, ej ? ej : "0", getenv("PF_PW") ? getenv("PF_PW") : "", ek ? ek : "1.7", es ? es : "4");
     pfsph_scene *s = malloc(sizeof *s);
     pfsph_error err = {0};
     int rc = pfsph_scene_parse(s, json, "rect.json", &err);
