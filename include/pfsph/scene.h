@@ -33,6 +33,7 @@ typedef struct pfsph_phase {
     double rest_density;   /* kg/m^3 */
     double viscosity;      /* kinematic, m^2/s */
     float color[3];        /* 0..1 */
+    bool color_set;        /* "color" given in the scene (walls are drawn grey otherwise) */
 } pfsph_phase;
 
 /* A region of fluid particles. */

@@ -386,7 +386,12 @@ static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, doubl
         double rp = s->r / ssf;
         s->relief = (float)(rp <= 1.5 ? 0.0 : (rp >= 4.0 ? 1.0 : (rp - 1.5) / 2.5));
         if (kind == 1) {
-            s->col[0] = 0.78f, s->col[1] = 0.78f, s->col[2] = 0.80f;
+            /* walls recede in light grey unless their phase asks for a colour */
+            int ph = ps->phase[i];
+            if (ph < sc->nphases && sc->phases[ph].color_set)
+                memcpy(s->col, sc->phases[ph].color, sizeof s->col);
+            else
+                s->col[0] = 0.78f, s->col[1] = 0.78f, s->col[2] = 0.80f;
         } else if (kind == 2) {
             int t = ps->phase[i] < 3 ? ps->phase[i] : 0;
             memcpy(s->col, DIFFUSE_COL[t], sizeof s->col);

@@ -382,6 +382,7 @@ static int parse_phases(parser *p, const cJSON *root)
         double c[3] = {ph->color[0], ph->color[1], ph->color[2]};
         TRY(pfsph__json_vec(e, P, "color", 3, 0.0, 1.0, c, &p->ctx));
         for (int k = 0; k < 3; k++) ph->color[k] = (float)c[k];
+        ph->color_set = cJSON_GetObjectItemCaseSensitive(e, "color") != NULL;
     }
     s->nphases = i;
     return PFSPH_OK;

@@ -236,6 +236,47 @@ static void run_3d(const char *name, const char *camera, int use_ply)
     free(m.rgb);
 }
 
+/* A solid phase with a "color" draws its walls in that colour; without one they stay grey
+ * (test_render_2d checks the grey floor). */
+static void test_render_wall_color(void **state)
+{
+    (void)state;
+    char scene[sizeof SCENE_2D + 64];
+    const char *from = "{\"name\": \"wall\", \"kind\": \"solid\"}";
+    const char *at = strstr(SCENE_2D, from);
+    assert_non_null(at);
+    snprintf(scene, sizeof scene, "%.*s{\"name\": \"wall\", \"kind\": \"solid\", \"color\": [0.9, 0.1, 0.1]}%s",
+             (int)(at - SCENE_2D), SCENE_2D, at + strlen(from));
+    const char *run = make_run("runwall", scene);
+    char p[700];
+    pfsph_particles bd;
+    pfsph_io_opts o = {.dim = 2, .aux_name = "volume"};
+    assert_int_equal(pfsph_particles_init(&bd, 64), PFSPH_OK);
+    block(&bd, 0.02, 0.02, 0, 49, 1, 1, 0.02, 1, 0); /* floor, phase 1 = wall */
+    snprintf(p, sizeof p, "%s/frames/boundary_00000.vtp", run);
+    write_or_fail(p, &bd, &o);
+    pfsph_particles fl;
+    assert_int_equal(pfsph_particles_init(&fl, 64), PFSPH_OK);
+    block(&fl, 0.1, 0.1, 0, 4, 4, 1, 0.02, 0, 0.1);
+    o.aux_name = NULL;
+    snprintf(p, sizeof p, "%s/frames/fluid_00000.vtp", run);
+    write_or_fail(p, &fl, &o);
+    pfsph_particles_free(&fl);
+    pfsph_particles_free(&bd);
+    pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1,
+                            .quiet = true};
+    pfsph_error err = {0};
+    int count = -1;
+    if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
+    snprintf(p, sizeof p, "%s/png/frame_00000.png", run);
+    img m = load_png(p);
+    int ix, iy;
+    to_px(m.w, m.h, 0.8, 0.02, &ix, &iy);
+    const unsigned char *c = px(&m, ix, iy);
+    assert_true(c[0] > c[1] + 60 && c[0] > c[2] + 60); /* red */
+    free(m.rgb);
+}
+
 static void test_render_3d_default_camera(void **state)
 {
     (void)state;
@@ -305,6 +346,7 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_2d),
+        cmocka_unit_test(test_render_wall_color),
         cmocka_unit_test(test_render_3d_default_camera),
         cmocka_unit_test(test_render_3d_scene_camera),
         cmocka_unit_test(test_render_errors),
