@@ -29,6 +29,8 @@ struct pfsph_sim {
     size_t scr_cap;         /* entries in each scratch array */
     double B, gamma;        /* Tait: p = B rho0 ((rho/rho0)^gamma - 1), B = c^2 / gamma */
     double sound_speed;
+    double rho_common;      /* WCSPH pressure scale common to all phases, 0: per phase */
+    double c_fast;          /* sound speed of the lightest phase (= sound_speed unless common) */
     double proto;           /* PCISPH prototype gradient sum */
     double amax;            /* largest acceleration of the last step */
     double amax_np;         /* largest non-pressure acceleration of the last step */
@@ -277,6 +279,20 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     auto_sound_speed(sim);
     sim->gamma = s->gamma;
     sim->B = sim->sound_speed * sim->sound_speed / sim->gamma;
+    sim->rho_common = 0;
+    sim->c_fast = sim->sound_speed;
+    if (s->pressure_scale == PFSPH_PRESSURE_COMMON) {
+        double hi = 0, lo = INFINITY;
+        for (int a = 0; a < s->nphases; a++)
+            if (s->phases[a].kind != PFSPH_PHASE_SOLID) {
+                hi = fmax(hi, s->phases[a].rest_density);
+                lo = fmin(lo, s->phases[a].rest_density);
+            }
+        if (hi > 0 && lo > 0) {
+            sim->rho_common = hi;
+            sim->c_fast = sim->sound_speed * sqrt(hi / lo); /* c^2 = B gamma rho_common / rho0 */
+        }
+    }
     sim->proto = pfsph__pcisph_prototype(&c->kern, s->dim, c->spacing);
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     sim->amax = g;
@@ -370,7 +386,7 @@ static double choose_dt(pfsph_sim *sim, double vmax, double t_limit, int *collap
     const pfsph_scene *s = &sim->scene;
     const double d = sim->ctx.spacing;
     double dt = s->dt_max;
-    double vsig = s->solver == PFSPH_SOLVER_WCSPH ? vmax + sim->sound_speed : vmax;
+    double vsig = s->solver == PFSPH_SOLVER_WCSPH ? vmax + sim->c_fast : vmax;
     if (vsig > 0) dt = fmin(dt, s->cfl * d / vsig);                 /* CFL */
     /* force criterion. PCISPH's pressure acceleration scales as 1/dt^2, so feeding it back
      * would shrink dt step after step: PCISPH uses the non-pressure acceleration only. */
@@ -516,7 +532,7 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     if (s->solver == PFSPH_SOLVER_PCISPH) {
         pcisph_pressure(sim, dt);
     } else {
-        pfsph__tait(c, c->nd, sim->B, sim->gamma, f->p);
+        pfsph__tait(c, c->nd, sim->B, sim->gamma, sim->rho_common, f->p);
         pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, f->p, apx, apy, apz);
         pfsph_real *er = sim->scr[SCR_ERR];
 #pragma omp parallel for schedule(static)

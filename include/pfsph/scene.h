@@ -27,6 +27,12 @@ enum pfsph_shape {
     PFSPH_SHAPE_PLANE,     /* finite plane patch inside the domain */
 };
 
+/* WCSPH with several densities: each phase's own rest density scales its Tait pressure
+ * (Solenthaler & Pajarola 2008), or the densest fluid's scales all of them (Colagrossi &
+ * Landrini 2003: equal stiffness, a light phase gets a sqrt(rho_max / rho) faster sound speed
+ * and the time step shrinks by that factor; needed at density ratios of about 100 and more). */
+enum pfsph_pressure_scale { PFSPH_PRESSURE_PHASE = 0, PFSPH_PRESSURE_COMMON };
+
 typedef struct pfsph_phase {
     char name[PFSPH_NAME_LEN];
     int kind;              /* enum pfsph_phase_kind */
@@ -135,6 +141,7 @@ typedef struct pfsph_scene {
     /* WCSPH */
     double sound_speed;        /* m/s; 0 = automatic (10 x estimated max speed) */
     double gamma;              /* Tait exponent, default 7 */
+    int pressure_scale;        /* enum pfsph_pressure_scale: the Tait pressure's rho0 */
     /* PCISPH */
     double pcisph_tolerance;   /* average relative density error, default 0.005 */
     int pcisph_min_iter, pcisph_max_iter;

@@ -250,6 +250,27 @@ static int cmd_check(int argc, char **argv)
            s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
     rc = check_memory(&s, 1);
     if (rc) return rc;
+    double rho_hi = 0, rho_lo = INFINITY;
+    for (int a = 0; a < s.nphases; a++)
+        if (s.phases[a].kind != PFSPH_PHASE_SOLID) {
+            rho_hi = fmax(rho_hi, s.phases[a].rest_density);
+            rho_lo = fmin(rho_lo, s.phases[a].rest_density);
+        }
+    if (rho_hi > 0 && rho_lo > 0 && rho_hi > rho_lo) {
+        double ratio = rho_hi / rho_lo;
+        printf("density ratio %.4g between fluid phases", ratio);
+        if (s.solver == PFSPH_SOLVER_WCSPH && s.pressure_scale == PFSPH_PRESSURE_COMMON)
+            printf(": one pressure scale, the lightest phase's sound speed is %.3gx the "
+                   "solver's (the time step shrinks by as much)\n", sqrt(ratio));
+        else if (s.solver == PFSPH_SOLVER_PCISPH && ratio > 10.0 + 1e-9)
+            printf(": PCISPH is tested to 10 and diverged at 100 (docs/pairwise.md, \"Density "
+                   "ratios\"); use solver \"wcsph\" with \"pressure_scale\": \"common\"\n");
+        else if (s.solver == PFSPH_SOLVER_WCSPH && ratio > 100.0 + 1e-9)
+            printf(": per-phase pressure scales are tested to 100 and blew up at 1000 "
+                   "(docs/pairwise.md, \"Density ratios\"); use \"pressure_scale\": \"common\"\n");
+        else
+            printf("\n");
+    }
     if (s.nbodies) {
         /* check_memory has read and checked the mesh files already */
         pfsph_error err = {0};

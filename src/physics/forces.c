@@ -114,7 +114,7 @@ void pfsph__pressure_accel(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
 }
 
 void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double gamma,
-                 pfsph_real *p)
+                 double rho_common, pfsph_real *p)
 {
     const pfsph_particles *f = ctx->fluid;
     const double inv_nd0 = 1.0 / (double)ctx->nd0;
@@ -128,7 +128,9 @@ void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double ga
             pw = r4 * r2 * ratio;
         } else
             pw = pow(ratio, gamma);
-        double pr = ratio > 1 ? B * ctx->rest_density[f->phase[i]] * (pw - 1) : 0;
+        /* rho_common > 0: one pressure scale for all phases (scene.h, pfsph_pressure_scale) */
+        double rho0 = rho_common > 0 ? rho_common : (double)ctx->rest_density[f->phase[i]];
+        double pr = ratio > 1 ? B * rho0 * (pw - 1) : 0;
         p[i] = (pfsph_real)pr;
     }
 }

@@ -25,7 +25,7 @@ void pfsph__pressure_accel(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
 
 /* Tait equation (DF Eq. 3 with NOTES item 12), negative pressures clamped to zero. */
 void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double gamma,
-                 pfsph_real *p);
+                 double rho_common, pfsph_real *p);
 
 /* Deterministic sum (fixed blocks, serial combination): same bits for any thread count. */
 double pfsph__sum(const pfsph_real *a, size_t n);

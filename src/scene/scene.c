@@ -38,6 +38,7 @@ typedef struct parser {
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 static const char *const kind_names[] = {"fluid", "gas", "solid", NULL};
 static const char *const solver_names[] = {"wcsph", "pcisph", NULL}; /* enum order */
+static const char *const pressure_scale_names[] = {"phase", "common", NULL}; /* enum order */
 
 static void path_key(char *out, size_t cap, const char *path, const char *key)
 {
@@ -299,7 +300,7 @@ static int parse_solver(parser *p, const cJSON *root)
     const cJSON *o = get(root, "solver");
     if (!o) return PFSPH_OK;
     static const char *const keys[] = {"type", "tolerance", "min_iterations", "max_iterations",
-                                       "sound_speed", "gamma", NULL};
+                                       "sound_speed", "gamma", "pressure_scale", NULL};
     const char *P = "$.solver";
     TRY(pfsph__json_check_keys(o, P, keys, &p->ctx));
     TRY(json_enum(p, o, P, "type", solver_names, &s->solver));
@@ -312,6 +313,7 @@ static int parse_solver(parser *p, const cJSON *root)
                                 s->pcisph_min_iter, s->pcisph_max_iter);
     TRY(pfsph__json_number(o, P, "sound_speed", 0.0, 1e5, &s->sound_speed, &p->ctx));
     TRY(pfsph__json_number(o, P, "gamma", 1.0, 10.0, &s->gamma, &p->ctx));
+    TRY(json_enum(p, o, P, "pressure_scale", pressure_scale_names, &s->pressure_scale));
     return PFSPH_OK;
 }
 
