@@ -506,6 +506,8 @@ static const bad_case bad_cases[] = {
      "dt_min (0.01 s) is greater than dt_max (0.001 s)"},
     {"solver_unknown", SCENE3(",\"solver\":{\"type\":\"iisph\"}"), "$.solver.type",
      "unknown value \"iisph\" (expected one of \"wcsph\", \"pcisph\")"},
+    {"solver_pressure_scale", SCENE3(",\"solver\":{\"pressure_scale\":\"water\"}"),
+     "$.solver.pressure_scale", "unknown value"},
     {"solver_iterations", SCENE3(",\"solver\":{\"min_iterations\":10,\"max_iterations\":5}"),
      "$.solver.min_iterations", "greater than max_iterations"},
     {"dimension_4", "{\"dimension\":4," DOM3 "," FLUID3 "}", "$.dimension", "must be 2 or 3"},
