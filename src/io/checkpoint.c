@@ -79,7 +79,7 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
     h_u64(h, s->seed);
     h_f64(h, s->sound_speed);
     h_f64(h, s->gamma);
-    h_int(h, s->pressure_scale);
+    if (s->pressure_scale) h_int(h, s->pressure_scale); /* older checkpoints stay resumable */
     h_f64(h, s->pcisph_tolerance);
     h_int(h, s->pcisph_min_iter);
     h_int(h, s->pcisph_max_iter);
