@@ -2,11 +2,15 @@
 #define _GNU_SOURCE
 #include "testutil.h"
 
+#include <math.h>
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include "pfsph/sim.h"
 
 static const char *g_src = ".";
 static const char *g_bin = "pfsph";
@@ -67,4 +71,70 @@ int tu_run(const char *cmd, char *out, size_t cap)
     while (fread(sink, 1, sizeof sink, p) > 0) {}
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int uf_find(int *p, int i)
+{
+    while (p[i] != i) {
+        p[i] = p[p[i]];
+        i = p[i];
+    }
+    return i;
+}
+
+void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, double R, tu_bubble *b)
+{
+    const pfsph_particles *f = c->fluid;
+    const double h2 = (double)c->h * (double)c->h;
+    int *par = malloc(f->n * sizeof *par);
+    if (!par) abort();
+    double sx = 0, sy = 0;
+    int ng = 0;
+    b->gas_comp = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        par[i] = (int)i;
+        if (f->phase[i] != gas) continue;
+        sx += f->x[i];
+        sy += f->y[i];
+        ng++;
+        double e = (double)f->rho[i] / rho_gas - 1;
+        if (e > b->gas_comp) b->gas_comp = e;
+    }
+    b->cx = ng ? sx / ng : 0;
+    b->cy = ng ? sy / ng : 0;
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->phase[i] != gas) continue;
+        for (size_t j = i + 1; j < f->n; j++) {
+            if (f->phase[j] != gas) continue;
+            double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j];
+            if (dx * dx + dy * dy < h2) {
+                int a = uf_find(par, (int)i), q = uf_find(par, (int)j);
+                if (a != q) par[a] = q;
+            }
+        }
+    }
+    b->components = 0;
+    b->rmax = 0;
+    b->liquid_in = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->phase[i] == gas) {
+            double r = hypot((double)f->x[i] - b->cx, (double)f->y[i] - b->cy);
+            if (uf_find(par, (int)i) == (int)i) b->components++;
+            if (r > b->rmax) b->rmax = r;
+            continue;
+        }
+        /* only liquid near the bubble can be inside it */
+        if (hypot((double)f->x[i] - b->cx, (double)f->y[i] - b->cy) > 3 * R) continue;
+        int nb = 0, ngas = 0;
+        for (size_t j = 0; j < f->n; j++) {
+            if (j == i) continue;
+            double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j];
+            if (dx * dx + dy * dy < h2) {
+                nb++;
+                ngas += f->phase[j] == gas;
+            }
+        }
+        if (4 * ngas > 3 * nb) b->liquid_in++;
+    }
+    free(par);
 }

@@ -19,4 +19,17 @@ int tu_write_file(const char *path, const char *text);
  * status (or -1). */
 int tu_run(const char *cmd, char *out, size_t cap);
 
+
+/* A gas bubble in a liquid (test_pf_rising_bubble, test_pf_density_ratio), measured over the
+ * fluid particles of ctx: particles of phase `gas` are the bubble, R is its equivalent radius. */
+struct pfsph_ctx;
+typedef struct tu_bubble {
+    double cx, cy;   /* gas centroid */
+    int components;  /* connected components of gas particles, links shorter than h */
+    double rmax;     /* farthest gas particle from the centroid */
+    int liquid_in;   /* other particles within 3 R with more than 3/4 of their neighbours gas */
+    double gas_comp; /* largest gas compression rho / rho_gas - 1 */
+} tu_bubble;
+void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, double R, tu_bubble *b);
+
 #endif

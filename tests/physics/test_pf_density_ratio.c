@@ -44,75 +44,6 @@ static const char *SCENE =
 
 enum { WATER = 0, GAS = 1 };
 
-static int find(int *p, int i)
-{
-    while (p[i] != i) {
-        p[i] = p[p[i]];
-        i = p[i];
-    }
-    return i;
-}
-
-typedef struct {
-    double cx, cy;   /* gas centroid */
-    int components;  /* connected components of gas particles, links < h */
-    double rmax;     /* farthest gas particle from the centroid */
-    int water_in;    /* water particles with more than 3/4 of their neighbours gas */
-} bubble_state;
-
-static void measure(const pfsph_ctx *c, double R, bubble_state *b)
-{
-    const pfsph_particles *f = c->fluid;
-    const double h2 = (double)c->h * (double)c->h;
-    int *par = malloc(f->n * sizeof *par);
-    assert_non_null(par);
-    double sx = 0, sy = 0;
-    int ng = 0;
-    for (size_t i = 0; i < f->n; i++) {
-        par[i] = (int)i;
-        if (f->phase[i] != GAS) continue;
-        sx += f->x[i];
-        sy += f->y[i];
-        ng++;
-    }
-    b->cx = sx / ng;
-    b->cy = sy / ng;
-    for (size_t i = 0; i < f->n; i++) {
-        if (f->phase[i] != GAS) continue;
-        for (size_t j = i + 1; j < f->n; j++) {
-            if (f->phase[j] != GAS) continue;
-            double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j];
-            if (dx * dx + dy * dy < h2) {
-                int a = find(par, (int)i), q = find(par, (int)j);
-                if (a != q) par[a] = q;
-            }
-        }
-    }
-    b->components = 0;
-    b->rmax = 0;
-    b->water_in = 0;
-    for (size_t i = 0; i < f->n; i++) {
-        if (f->phase[i] == GAS) {
-            double r = hypot((double)f->x[i] - b->cx, (double)f->y[i] - b->cy);
-            if (find(par, (int)i) == (int)i) b->components++;
-            if (r > b->rmax) b->rmax = r;
-            continue;
-        }
-        if (hypot((double)f->x[i] - b->cx, (double)f->y[i] - b->cy) > 3 * R) continue;
-        int nb = 0, ngas = 0;
-        for (size_t j = 0; j < f->n; j++) {
-            if (j == i) continue;
-            double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j];
-            if (dx * dx + dy * dy < h2) {
-                nb++;
-                ngas += f->phase[j] == GAS;
-            }
-        }
-        if (4 * ngas > 3 * nb) b->water_in++;
-    }
-    free(par);
-}
-
 static void run_ratio(double rho_gas, double t_end)
 {
     char json[4096];
@@ -143,17 +74,17 @@ static void run_ratio(double rho_gas, double t_end)
         if (rc) fprintf(stderr, "%s\n", err.msg);
         assert_int_equal(rc, PFSPH_OK);
         assert_int_equal(c->fluid->n, n0);
-        bubble_state b;
-        measure(c, R, &b);
+        tu_bubble b;
+        tu_bubble_measure(c, GAS, rho_gas, R, &b);
         if (b.components != 1) worst_comp = b.components;
-        if (b.water_in > worst_in) worst_in = b.water_in;
+        if (b.liquid_in > worst_in) worst_in = b.liquid_in;
         if (b.rmax > worst_r) worst_r = b.rmax;
         if (k == ns / 2) y_mid = b.cy;
         if (k == ns) y_end = b.cy;
         if (k % 2 == 0 || k == ns)
             printf("ratio %g t=%.3f: centroid (%.4f, %.4f), components %d, rmax %.2f R, water "
                    "inside %d, ekin %.3g J\n",
-                   1000.0 / rho_gas, t, b.cx, b.cy, b.components, b.rmax / R, b.water_in,
+                   1000.0 / rho_gas, t, b.cx, b.cy, b.components, b.rmax / R, b.liquid_in,
                    pfsph_sim_stats(sim)->ekin);
     }
     double U = (y_end - y_mid) / (0.025 * (ns - ns / 2));
