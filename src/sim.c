@@ -281,17 +281,10 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     sim->B = sim->sound_speed * sim->sound_speed / sim->gamma;
     sim->rho_common = 0;
     sim->c_fast = sim->sound_speed;
-    if (s->pressure_scale == PFSPH_PRESSURE_COMMON) {
-        double hi = 0, lo = INFINITY;
-        for (int a = 0; a < s->nphases; a++)
-            if (s->phases[a].kind != PFSPH_PHASE_SOLID) {
-                hi = fmax(hi, s->phases[a].rest_density);
-                lo = fmin(lo, s->phases[a].rest_density);
-            }
-        if (hi > 0 && lo > 0) {
-            sim->rho_common = hi;
-            sim->c_fast = sim->sound_speed * sqrt(hi / lo); /* c^2 = B gamma rho_common / rho0 */
-        }
+    double rlo, rhi;
+    if (s->pressure_scale == PFSPH_PRESSURE_COMMON && pfsph_scene_density_range(s, &rlo, &rhi) && rlo > 0) {
+        sim->rho_common = rhi;
+        sim->c_fast = sim->sound_speed * sqrt(rhi / rlo); /* c^2 = B gamma rho_common / rho0 */
     }
     sim->proto = pfsph__pcisph_prototype(&c->kern, s->dim, c->spacing);
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);

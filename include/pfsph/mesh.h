@@ -39,6 +39,10 @@ int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *e
 void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[3],
                                 double inertia[9]);
 
+/* Bounding box of the vertices used by triangles (unused vertices do not count). Returns 0, or
+ * -1 when a coordinate is not finite or an index is out of range. */
+int pfsph_mesh_bounds(const pfsph_mesh *m, double lo[3], double hi[3]);
+
 /* Points on the surface at about `spacing` apart, with no hole wider than 1.5 spacings:
  * *pts gets 3 * *n coordinates (caller frees). Deterministic; no two points closer than 0.68
  * spacing; about area / (spacing^2 sqrt(3)/2) points; corners and sharp edges (dihedral

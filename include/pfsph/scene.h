@@ -176,4 +176,7 @@ const char *pfsph_scene_default_json(void);
 /* Index of the phase called name, or -1. */
 int pfsph_scene_phase_index(const pfsph_scene *s, const char *name);
 
+/* Smallest and largest rest density of the fluid and gas phases; returns 0 when there is none. */
+int pfsph_scene_density_range(const pfsph_scene *s, double *lo, double *hi);
+
 #endif

@@ -250,13 +250,8 @@ static int cmd_check(int argc, char **argv)
            s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
     rc = check_memory(&s, 1);
     if (rc) return rc;
-    double rho_hi = 0, rho_lo = INFINITY;
-    for (int a = 0; a < s.nphases; a++)
-        if (s.phases[a].kind != PFSPH_PHASE_SOLID) {
-            rho_hi = fmax(rho_hi, s.phases[a].rest_density);
-            rho_lo = fmin(rho_lo, s.phases[a].rest_density);
-        }
-    if (rho_hi > 0 && rho_lo > 0 && rho_hi > rho_lo) {
+    double rho_lo, rho_hi;
+    if (pfsph_scene_density_range(&s, &rho_lo, &rho_hi) && rho_lo > 0 && rho_hi > rho_lo) {
         double ratio = rho_hi / rho_lo;
         printf("density ratio %.4g between fluid phases", ratio);
         if (s.solver == PFSPH_SOLVER_WCSPH && s.pressure_scale == PFSPH_PRESSURE_COMMON)

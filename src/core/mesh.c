@@ -324,9 +324,7 @@ static double dot3(const double *a, const double *b)
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-/* Bounding box of the vertices used by triangles (unused vertices do not count). Returns 0, or
- * -1 when a coordinate is not finite or an index is out of range. */
-static int used_bbox(const pfsph_mesh *m, double lo[3], double hi[3])
+int pfsph_mesh_bounds(const pfsph_mesh *m, double lo[3], double hi[3])
 {
     for (int a = 0; a < 3; a++) {
         lo[a] = INFINITY;
@@ -388,7 +386,7 @@ int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *e
                               "%s: triangle %zu uses vertex %lu, out of range (%zu vertices)",
                               source, i / 3 + 1, (unsigned long)m->tri[i] + 1, m->nverts);
     double lo[3], hi[3], ref[3], d[3];
-    if (used_bbox(m, lo, hi)) return pfsph_fail(err, PFSPH_EINPUT,
+    if (pfsph_mesh_bounds(m, lo, hi)) return pfsph_fail(err, PFSPH_EINPUT,
                                                 "%s: a vertex coordinate is not finite", source);
     for (int a = 0; a < 3; a++) {
         ref[a] = 0.5 * (lo[a] + hi[a]);
@@ -487,7 +485,7 @@ void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[
 {
     double ref[3] = {0, 0, 0}, lo[3], hi[3];
     /* integrate about the bounding-box centre: far-off meshes keep their precision */
-    if (m && m->ntris && used_bbox(m, lo, hi) == 0)
+    if (m && m->ntris && pfsph_mesh_bounds(m, lo, hi) == 0)
         for (int a = 0; a < 3; a++) ref[a] = 0.5 * (lo[a] + hi[a]);
     double in[10] = {0};
     for (size_t t = 0; m && t < m->ntris; t++) {
@@ -895,7 +893,7 @@ int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts,
     if (!m || m->ntris == 0) return pfsph_fail(err, PFSPH_EINPUT, "mesh has no triangles");
     if (m->ntris > MESH_MAX_TRIS) return pfsph_fail(err, PFSPH_EINPUT, "mesh too large");
     double lo[3], hi[3];
-    if (used_bbox(m, lo, hi))
+    if (pfsph_mesh_bounds(m, lo, hi))
         return pfsph_fail(err, PFSPH_EINPUT, "mesh has a non-finite vertex or a bad index");
     /* size guard before anything is allocated: every loop below is bounded by these */
     double area = 0, elen = 0, ext = 0;

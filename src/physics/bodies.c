@@ -524,15 +524,7 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
         body *bd = &B->b[i];
         bd->def = s->bodies[i];
         if ((rc = body_mesh(s, bd, err))) goto fail;
-        for (int a = 0; a < 3; a++) {
-            bd->lo[a] = INFINITY;
-            bd->hi[a] = -INFINITY;
-        }
-        for (size_t v = 0; v < bd->mesh.nverts; v++)
-            for (int a = 0; a < 3; a++) {
-                bd->lo[a] = fmin(bd->lo[a], bd->mesh.v[3 * v + a]);
-                bd->hi[a] = fmax(bd->hi[a], bd->mesh.v[3 * v + a]);
-            }
+        pfsph_mesh_bounds(&bd->mesh, bd->lo, bd->hi); /* body_mesh validated it */
         tmp.n = 0;
         if ((rc = body_particles(s, bd, spacing, &tmp, err))) goto fail;
         if (tmp.n == 0) {
@@ -733,6 +725,10 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
     const bool pw_on = pp->enabled;
     const double Rk = pw_on ? pp->k * (double)ctx->h : 0, U_R = pw_on ? 1.5 * PI / Rk : 0;
     const pfsph_real R2 = (pfsph_real)(Rk * Rk);
+    double cm[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES]; /* c m_a m_b, once per call */
+    for (int a = 0; pw_on && a < ctx->scene->nphases; a++)
+        for (int q = 0; q < ctx->scene->nphases; q++)
+            cm[a][q] = pp->c[a][q] * (double)ctx->mass[a] * (double)ctx->mass[q];
     /* particles dropped from the boundary set (a body that left the grid) must not keep their
      * last force: only the present ones are written below */
     memset(B->fp, 0, 3 * (size_t)B->np * sizeof(double));
@@ -773,8 +769,7 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
             pfsph_grid_ranges_far(ctx->grid, xj, yj, zj, &r);
             for (int q = 0; q < r.n; q++)
                 for (uint32_t i = r.b[q]; i < r.e[q]; i++) {
-                    const double cf = pp->c[f->phase[i]][pb] * (double)ctx->mass[f->phase[i]] *
-                                      (double)ctx->mass[pb];
+                    const double cf = cm[f->phase[i]][pb];
                     if (cf == 0.0) continue;
                     pfsph_real dx = f->x[i] - xj, dy = f->y[i] - yj, dz = f->z[i] - zj;
                     pfsph_real r2 = dx * dx + dy * dy + dz * dz;

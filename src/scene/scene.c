@@ -915,6 +915,20 @@ int pfsph_scene_phase_index(const pfsph_scene *s, const char *name)
     return -1;
 }
 
+int pfsph_scene_density_range(const pfsph_scene *s, double *lo, double *hi)
+{
+    int n = 0;
+    *lo = INFINITY;
+    *hi = 0;
+    for (int a = 0; a < s->nphases; a++)
+        if (s->phases[a].kind != PFSPH_PHASE_SOLID) {
+            *lo = fmin(*lo, s->phases[a].rest_density);
+            *hi = fmax(*hi, s->phases[a].rest_density);
+            n++;
+        }
+    return n;
+}
+
 static int parse_root(parser *p, const cJSON *root)
 {
     pfsph_scene *s = p->s;

@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "pfsph/eigen.h"
 #include "pfsph/sim.h"
 #include "testutil.h"
 
@@ -25,36 +26,6 @@ typedef struct shape {
     double ratio;  /* smallest / largest principal second moment */
     double dmin;   /* closest pair [spacings] */
 } shape;
-
-static void sym_eigen_minmax(int dim, const double C[3][3], double *lo, double *hi)
-{
-    if (dim == 2) {
-        double m = 0.5 * (C[0][0] + C[1][1]), r = hypot(0.5 * (C[0][0] - C[1][1]), C[0][1]);
-        *lo = m - r;
-        *hi = m + r;
-        return;
-    }
-    /* closed form for a symmetric 3x3 (trigonometric) */
-    double p1 = C[0][1] * C[0][1] + C[0][2] * C[0][2] + C[1][2] * C[1][2];
-    double q = (C[0][0] + C[1][1] + C[2][2]) / 3.0;
-    double p2 = (C[0][0] - q) * (C[0][0] - q) + (C[1][1] - q) * (C[1][1] - q) +
-                (C[2][2] - q) * (C[2][2] - q) + 2.0 * p1;
-    double p = sqrt(p2 / 6.0);
-    if (p == 0) {
-        *lo = *hi = q;
-        return;
-    }
-    double B[3][3];
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++) B[a][b] = (C[a][b] - (a == b ? q : 0)) / p;
-    double det = B[0][0] * (B[1][1] * B[2][2] - B[1][2] * B[2][1]) -
-                 B[0][1] * (B[1][0] * B[2][2] - B[1][2] * B[2][0]) +
-                 B[0][2] * (B[1][0] * B[2][1] - B[1][1] * B[2][0]);
-    double r = fmax(-1.0, fmin(1.0, det / 2.0));
-    double phi = acos(r) / 3.0;
-    *hi = q + 2 * p * cos(phi);
-    *lo = q + 2 * p * cos(phi + 2 * PI / 3);
-}
 
 static shape measure(const pfsph_ctx *c)
 {
@@ -75,9 +46,16 @@ static shape measure(const pfsph_ctx *c)
             for (int b = 0; b < 3; b++) C[a][b] += q[a] * q[b];
     }
     shape s;
-    double lo, hi;
-    sym_eigen_minmax(dim, C, &lo, &hi);
-    s.ratio = lo / hi;
+    if (dim == 2) {
+        const double C2[2][2] = {{C[0][0], C[0][1]}, {C[0][1], C[1][1]}};
+        double w[2], v[2][2];
+        pfsph_eigen_sym2(C2, w, v);
+        s.ratio = w[1] / w[0];
+    } else {
+        double w[3], v[3][3];
+        pfsph_eigen_sym3(C, w, v);
+        s.ratio = w[2] / w[0];
+    }
     const int nd = dim == 2 ? 72 : 200;
     double hmax = -1e300, hmin = 1e300;
     for (int k = 0; k < nd; k++) {
