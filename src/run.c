@@ -158,7 +158,7 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
     fprintf(f, "%d,%.9g,%.6g,%llu,%zu,%zu,%.6g,%.6g,%.6g,%.9g,%d", frame, pfsph_sim_time(sim), st->dt,
             (unsigned long long)pfsph_sim_steps(sim), c->fluid->n, pfsph_sim_removed(sim), st->vmax,
             st->density_err_avg, st->density_err_max, st->ekin, st->iterations);
-    if (c->scene->diffuse.enabled) {
+    if (c->diffuse->enabled) {
         size_t cnt[3];
         pfsph_sim_diffuse_counts(sim, cnt);
         fprintf(f, ",%zu,%zu,%zu", cnt[0], cnt[1], cnt[2]);

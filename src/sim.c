@@ -1,6 +1,8 @@
-/* The simulation object: builds particle sets from a scene and runs the time step
- * (grid -> density -> non-pressure forces -> pressure (WCSPH or PCISPH) -> integrate ->
- * diffuse). Stages live in src/physics; this file only orders them and keeps the clock. */
+/* The simulation object: builds particle sets from a scene and runs the time step as a table
+ * of stages (grid -> density -> time step -> [divergence] -> non-pressure forces -> pair forces
+ * -> pressure -> body forces -> integrate -> diffuse -> bodies). Stages live in src/physics and
+ * the pressure solvers behind src/physics/solver.h; this file orders them, keeps the clock,
+ * times each stage and reports blow-ups, once for all (docs/architecture.md). */
 #include "pfsph/sim.h"
 
 #include <float.h>
@@ -10,34 +12,59 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/reduce.h"
 #include "pfsph/bodies.h"
-#include "physics/stages.h"
+#include "pfsph/diffuse.h"
+#include "pfsph/pairwise.h"
+#include "physics/boundary.h"
+#include "physics/density.h"
+#include "physics/solver.h"
+#include "physics/viscosity.h"
 #include "scene/shapes.h"
 
 const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
     "grid", "density", "forces", "pairwise", "pressure", "integrate", "diffuse", "bodies", "output"};
 
-enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_XP, SCR_YP, SCR_ZP,
-       SCR_NDP, SCR_ERR, SCR_N };
+/* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
+enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
+#define SCR_MAX (SCR_COMMON + 8)
+
+/* What a stage that found a blow-up reports; the step turns it into the one message format. */
+typedef struct blowup_info {
+    size_t particle;  /* fluid index, or SIZE_MAX when no particle is to blame */
+    char what[256];   /* "speed [m/s] 12.3" */
+    const char *hint; /* likely cause; NULL: the solver's */
+} blowup_info;
+
+typedef struct stage {
+    const char *name; /* in blow-up messages */
+    int slot;         /* enum pfsph_stage: where its time is counted */
+    int (*run)(pfsph_sim *sim, blowup_info *bad, pfsph_error *err);
+} stage;
+#define MAX_STAGES 16
 
 struct pfsph_sim {
     pfsph_scene scene;
     pfsph_ctx ctx;
     pfsph_particles fluid, boundary;
     pfsph_grid grid, bgrid;
-    pfsph_real *scr[SCR_N]; /* per-step scratch, one value per fluid particle */
-    size_t scr_cap;         /* entries in each scratch array */
-    double B, gamma;        /* Tait: p = B rho0 ((rho/rho0)^gamma - 1), B = c^2 / gamma */
+    pfsph_real *scr[SCR_MAX]; /* per-step scratch: SCR_COMMON of ours, then the solver's */
+    int nscr;
+    size_t scr_cap;           /* entries in each scratch array */
+    const pfsph_solver_ops *solver;
+    void *solver_state;
+    pfsph_solver_config solver_cfg;
     double sound_speed;
-    double rho_common;      /* WCSPH pressure scale common to all phases, 0: per phase */
-    double c_fast;          /* sound speed of the lightest phase (= sound_speed unless common) */
-    double proto;           /* PCISPH prototype gradient sum */
     double amax;            /* largest acceleration of the last step */
     double amax_np;         /* largest non-pressure acceleration of the last step */
     double vbound;          /* speeds above this are a blow-up */
+    double t_limit;         /* the step in progress never passes this time */
+    size_t removed_before;  /* removed count before this step's sort */
     pfsph_pairwise *pw;
     pfsph_diffuse *df;
     pfsph_bodies *bodies;
+    stage stages[MAX_STAGES];
+    int nstages;
     double time;
     uint64_t step;
     size_t removed;
@@ -50,6 +77,7 @@ struct pfsph_sim {
 
 static double now(void) { return omp_get_wtime(); }
 static double max_speed(const pfsph_particles *f, size_t *worst);
+static void build_stages(pfsph_sim *sim);
 
 /* Grid cells. Without pair forces cells of h, queries one cell each way. With them cells of
  * max(h / 2, k h / 3): the h-radius stages walk 2 cells each way (a cube of side 2.5 h instead
@@ -154,7 +182,9 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     double cells = 1;
     for (int a = 0; a < s->dim; a++)
         cells *= ceil((s->domain_max[a] - s->domain_min[a]) / cell + 8);
-    size_t per_fluid = pfsph_particles_bytes_per_particle() + SCR_N * sizeof(pfsph_real) +
+    const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
+    size_t per_fluid = pfsph_particles_bytes_per_particle() +
+                       (size_t)(SCR_COMMON + (ops ? ops->nscratch : 0)) * sizeof(pfsph_real) +
                        2 * sizeof(uint32_t) + sizeof(pfsph_real);
     size_t per_boundary = pfsph_particles_bytes_per_particle() + 2 * sizeof(uint32_t) + sizeof(pfsph_real);
     if (n_fluid) *n_fluid = (size_t)nf;
@@ -166,7 +196,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
 static int alloc_scratch(pfsph_sim *sim, size_t n)
 {
     if (!n) n = 1;
-    for (int k = 0; k < SCR_N; k++) {
+    for (int k = 0; k < sim->nscr; k++) {
         pfsph_real *q = realloc(sim->scr[k], n * sizeof(pfsph_real));
         if (!q) return PFSPH_ENOMEM;
         memset(q, 0, n * sizeof(pfsph_real));
@@ -203,6 +233,20 @@ static void auto_sound_speed(pfsph_sim *sim)
     sim->sound_speed = s->sound_speed > 0 ? s->sound_speed : 10 * vref;
 }
 
+void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s)
+{
+    for (int a = 0; a < 3; a++) {
+        c->gravity[a] = s->gravity[a];
+        c->domain_min[a] = s->domain_min[a];
+        c->domain_max[a] = s->domain_max[a];
+    }
+    c->seed = s->seed;
+    c->nphases = s->nphases;
+    c->phases = s->phases;
+    c->pairwise = &s->pairwise;
+    c->diffuse = &s->diffuse;
+}
+
 int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err)
 {
     *out = NULL;
@@ -219,7 +263,19 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     c->V0 = (pfsph_real)(s->dim == 2 ? d * d : d * d * d);
     c->nd0 = (pfsph_real)1 / c->V0;
     pfsph_kernel_init(&c->kern, s->dim, c->h);
-    c->scene = s;
+    pfsph_ctx_set_model(c, s);
+    sim->solver = pfsph_solver_find(pfsph_scene_solver_name(s));
+    if (!sim->solver) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: $.solver.type: no solver called \"%s\"", s->source,
+                        pfsph_scene_solver_name(s));
+        goto fail;
+    }
+    sim->nscr = SCR_COMMON + sim->solver->nscratch;
+    if (sim->nscr > SCR_MAX) {
+        rc = pfsph_fail(err, PFSPH_ENOMEM, "solver %s needs %d scratch arrays, at most %d", sim->solver->name,
+                        sim->solver->nscratch, SCR_MAX - SCR_COMMON);
+        goto fail;
+    }
     for (int p = 0; p < s->nphases; p++) {
         c->rest_density[p] = (pfsph_real)s->phases[p].rest_density;
         c->mass[p] = (pfsph_real)(s->phases[p].rest_density * (double)c->V0);
@@ -277,25 +333,31 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     if ((rc = alloc_scratch(sim, sim->fluid.n))) goto nomem;
 
     auto_sound_speed(sim);
-    sim->gamma = s->gamma;
-    sim->B = sim->sound_speed * sim->sound_speed / sim->gamma;
-    sim->rho_common = 0;
-    sim->c_fast = sim->sound_speed;
+    pfsph_solver_config *cfg = &sim->solver_cfg;
+    cfg->sound_speed = sim->sound_speed;
+    cfg->gamma = s->gamma;
+    cfg->rho_common = 0;
+    cfg->c_fast = sim->sound_speed;
     double rlo, rhi;
     if (s->pressure_scale == PFSPH_PRESSURE_COMMON && pfsph_scene_density_range(s, &rlo, &rhi) && rlo > 0) {
-        sim->rho_common = rhi;
-        sim->c_fast = sim->sound_speed * sqrt(rhi / rlo); /* c^2 = B gamma rho_common / rho0 */
+        cfg->rho_common = rhi;
+        cfg->c_fast = sim->sound_speed * sqrt(rhi / rlo); /* c^2 = B gamma rho_common / rho0 */
     }
-    sim->proto = pfsph__pcisph_prototype(&c->kern, s->dim, c->spacing);
+    cfg->tolerance = s->pcisph_tolerance;
+    cfg->min_iter = s->pcisph_min_iter;
+    cfg->max_iter = s->pcisph_max_iter;
+    cfg->cfl = s->cfl;
+    if ((rc = sim->solver->create(&sim->solver_state, c, cfg, err))) goto fail;
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     sim->amax = g;
     sim->amax_np = g;
     size_t worst0;
     sim->stats.vmax = max_speed(&sim->fluid, &worst0);
-    sim->vbound = s->solver == PFSPH_SOLVER_WCSPH ? sim->sound_speed : 20 * sim->sound_speed;
+    sim->vbound = sim->solver->speed_bound(sim->solver_state);
 
     if (s->pairwise.enabled && (rc = pfsph_pairwise_create(&sim->pw, c, err))) goto fail;
     if (s->diffuse.enabled && (rc = pfsph_diffuse_create(&sim->df, c, err))) goto fail;
+    build_stages(sim);
     *out = sim;
     return PFSPH_OK;
 nomem:
@@ -308,6 +370,7 @@ fail:
 void pfsph_sim_destroy(pfsph_sim *sim)
 {
     if (!sim) return;
+    if (sim->solver && sim->solver_state) sim->solver->destroy(sim->solver_state);
     if (sim->pw) pfsph_pairwise_destroy(sim->pw);
     if (sim->df) pfsph_diffuse_destroy(sim->df);
     pfsph_bodies_destroy(sim->bodies);
@@ -315,7 +378,7 @@ void pfsph_sim_destroy(pfsph_sim *sim)
     pfsph_particles_free(&sim->boundary);
     pfsph_grid_free(&sim->grid);
     pfsph_grid_free(&sim->bgrid);
-    for (int k = 0; k < SCR_N; k++) free(sim->scr[k]);
+    for (int k = 0; k < SCR_MAX; k++) free(sim->scr[k]);
     free(sim);
 }
 
@@ -356,40 +419,35 @@ static double max_speed(const pfsph_particles *f, size_t *worst)
     return bad ? NAN : sqrt(vmax);
 }
 
-static int blowup(pfsph_sim *sim, const char *stage, size_t i, const char *what, double value,
-                  pfsph_error *err)
+/* One message format for every blow-up: step, time, stage, what, where, likely cause. */
+static int report_blowup(pfsph_sim *sim, const char *stage_name, const blowup_info *b, pfsph_error *err)
 {
     const pfsph_particles *f = &sim->fluid;
-    const char *hint = sim->scene.solver == PFSPH_SOLVER_WCSPH
-                           ? "the time step is too large for the stiffness: lower time.cfl or dt_max, or raise solver.sound_speed"
-                           : "lower time.cfl or dt_max; check pairwise coefficients and viscosity";
+    const char *hint = b->hint ? b->hint : sim->solver->hint;
+    size_t i = b->particle;
     if (i < f->n)
         return pfsph_fail(err, PFSPH_EUNSTABLE,
-                          "simulation unstable at step %llu, t = %.6g s, stage %s: %s %.6g at particle id %u "
+                          "simulation unstable at step %llu, t = %.6g s, stage %s: %s at particle id %u "
                           "(phase '%s', position %.4g %.4g %.4g); likely cause: %s",
-                          (unsigned long long)sim->step, sim->time, stage, what, value, f->id[i],
+                          (unsigned long long)sim->step, sim->time, stage_name, b->what, f->id[i],
                           sim->scene.phases[f->phase[i]].name, (double)f->x[i], (double)f->y[i],
                           (double)f->z[i], hint);
-    return pfsph_fail(err, PFSPH_EUNSTABLE, "simulation unstable at step %llu, t = %.6g s, stage %s: %s %.6g; likely cause: %s",
-                      (unsigned long long)sim->step, sim->time, stage, what, value, hint);
+    return pfsph_fail(err, PFSPH_EUNSTABLE, "simulation unstable at step %llu, t = %.6g s, stage %s: %s; likely cause: %s",
+                      (unsigned long long)sim->step, sim->time, stage_name, b->what, hint);
+}
+
+static int unstable(blowup_info *b, size_t i, const char *what, double value)
+{
+    b->particle = i;
+    snprintf(b->what, sizeof b->what, "%s %.6g", what, value);
+    return PFSPH_EUNSTABLE;
 }
 
 static double choose_dt(pfsph_sim *sim, double vmax, double t_limit, int *collapsed)
 {
     const pfsph_scene *s = &sim->scene;
     const double d = sim->ctx.spacing;
-    double dt = s->dt_max;
-    double vsig = s->solver == PFSPH_SOLVER_WCSPH ? vmax + sim->c_fast : vmax;
-    if (vsig > 0) dt = fmin(dt, s->cfl * d / vsig);                 /* CFL */
-    /* force criterion. PCISPH's pressure acceleration scales as 1/dt^2, so feeding it back
-     * would shrink dt step after step: PCISPH uses the non-pressure acceleration only. */
-    double a = s->solver == PFSPH_SOLVER_PCISPH ? sim->amax_np : sim->amax;
-    if (a > 0) dt = fmin(dt, 0.25 * sqrt(d / a));
-    /* PCISPH: keep the compression one step of acceleration causes (a dt^2 / d) at 4% of the
-     * tolerance, so that a few corrections suffice. With 10x that, a 2D tank at rest needed
-     * dozens of iterations per step and diverged (docs/solvers.md). */
-    if (s->solver == PFSPH_SOLVER_PCISPH && a > 0)
-        dt = fmin(dt, 0.2 * sqrt(s->pcisph_tolerance * d / a));
+    double dt = fmin(s->dt_max, sim->solver->dt_limit(sim->solver_state, &sim->ctx, vmax, sim->amax, sim->amax_np));
     double numax = 0;
     for (int p = 0; p < s->nphases; p++) numax = fmax(numax, s->phases[p].viscosity);
     if (numax > 0) dt = fmin(dt, 0.125 * d * d / numax);            /* viscous diffusion */
@@ -405,76 +463,32 @@ static double choose_dt(pfsph_sim *sim, double vmax, double t_limit, int *collap
     return rem / steps;
 }
 
-static void pcisph_pressure(pfsph_sim *sim, double dt)
+/* ---- the stages, in the order of the table built by build_stages ---- */
+
+static int st_grid(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
-    pfsph_ctx *c = &sim->ctx;
-    pfsph_particles *f = &sim->fluid;
-    const pfsph_scene *s = &sim->scene;
-    const size_t n = f->n;
-    pfsph_real *apx = sim->scr[SCR_APX], *apy = sim->scr[SCR_APY], *apz = sim->scr[SCR_APZ];
-    pfsph_real *xp = sim->scr[SCR_XP], *yp = sim->scr[SCR_YP], *zp = sim->scr[SCR_ZP];
-    pfsph_real *ndp = sim->scr[SCR_NDP], *er = sim->scr[SCR_ERR];
-    const pfsph_real nd0 = c->nd0;
-    /* p += omega K (delta* - delta0) with K = m delta0^2 / (2 dt^2 (|sum gradW|^2 + sum |gradW|^2)):
-     * Solenthaler & Pajarola 2009 rewritten for number densities, relaxed by omega = 0.5 as
-     * IISPH relaxes its Jacobi iteration. The full K overshoots: a 2D tank at rest diverged
-     * within 5 steps; with omega = 0.5 it settles (docs/solvers.md). */
-    const double omega = 0.5;
-    const double kfac = omega * (double)nd0 * nd0 / (2 * dt * dt * sim->proto);
-    const pfsph_real fdt = (pfsph_real)dt, dt2 = (pfsph_real)(dt * dt);
-    /* Pressure starts from zero every step. A warm start (last step's pressure) turns the
-     * update into an integral controller across steps; measured on a 2D tank at rest it
-     * kept ~1 J of sloshing energy instead of settling. */
-    memset(apx, 0, n * sizeof(pfsph_real));
-    memset(apy, 0, n * sizeof(pfsph_real));
-    memset(apz, 0, n * sizeof(pfsph_real));
-    memset(f->p, 0, n * sizeof(pfsph_real));
-    int it = 0;
-    double avg = 0;
-    while (it < s->pcisph_max_iter) {
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            xp[i] = f->x[i] + fdt * f->vx[i] + dt2 * (c->ax[i] + apx[i]);
-            yp[i] = f->y[i] + fdt * f->vy[i] + dt2 * (c->ay[i] + apy[i]);
-            zp[i] = f->z[i] + fdt * f->vz[i] + dt2 * (c->az[i] + apz[i]);
-        }
-        pfsph__number_density(c, xp, yp, zp, ndp);
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            pfsph_real e = ndp[i] - nd0;
-            er[i] = e > 0 ? e / nd0 : 0;
-            pfsph_real pn = f->p[i] + (pfsph_real)(kfac * (double)c->mass[f->phase[i]]) * e;
-            f->p[i] = pn > 0 ? pn : 0;
-        }
-        avg = n ? pfsph__sum(er, n) / (double)n : 0;
-        pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
-        it++;
-        if (it >= s->pcisph_min_iter && avg <= s->pcisph_tolerance) break;
-    }
-    sim->stats.iterations = it;
-    sim->stats.density_err_avg = avg;
+    (void)bad;
+    (void)err;
+    sim->removed_before = sim->removed;
+    pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed);
+    return PFSPH_OK;
 }
 
-int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
+/* particle shifting, if the scene asks (docs/pairwise.md); uses last step's ctx->dt */
+static int st_shift(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
+    (void)bad;
+    (void)err;
+    pfsph_pairwise_shift(sim->pw, &sim->ctx);
+    return PFSPH_OK;
+}
+
+static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)err;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = &sim->fluid;
-    const pfsph_scene *s = &sim->scene;
-    double t0 = now(), t1;
-
-    const size_t removed_before = sim->removed;
-    pfsph_grid_sort(&sim->grid, f, &sim->removed);
-    size_t n = f->n;
-    t1 = now();
-    sim->stage_s[PFSPH_STAGE_GRID] += t1 - t0;
-    t0 = t1;
-    if (sim->pw) { /* particle shifting, if the scene asks (docs/pairwise.md); uses c->dt */
-        pfsph_pairwise_shift(sim->pw, c);
-        t1 = now();
-        sim->stage_s[PFSPH_STAGE_PAIRWISE] += t1 - t0;
-        t0 = t1;
-    }
-
+    const size_t n = f->n;
     pfsph__number_density(c, f->x, f->y, f->z, c->nd);
     pfsph_real ndmax = 0;
 #pragma omp parallel for schedule(static) reduction(max : ndmax)
@@ -489,71 +503,94 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
         size_t wi = 0;
         for (size_t i = 1; i < n; i++)
             if (c->nd[i] > c->nd[wi]) wi = i;
-        return blowup(sim, "density", wi, "relative density error", (double)ndmax / (double)c->nd0 - 1, err);
+        return unstable(bad, wi, "relative density error", (double)ndmax / (double)c->nd0 - 1);
     }
-    t1 = now();
-    sim->stage_s[PFSPH_STAGE_DENSITY] += t1 - t0;
-    t0 = t1;
+    return PFSPH_OK;
+}
 
+static int st_timestep(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)err;
+    pfsph_ctx *c = &sim->ctx;
     /* the last step's integration measured vmax (and stopped on non-finite values); only a
      * removal in the sort can lower it */
     size_t worst = 0;
-    double vmax = sim->removed != removed_before ? max_speed(f, &worst) : sim->stats.vmax;
+    double vmax = sim->removed != sim->removed_before ? max_speed(&sim->fluid, &worst) : sim->stats.vmax;
     int collapsed;
-    double dt = choose_dt(sim, sim->bodies ? fmax(vmax, pfsph_bodies_vmax(sim->bodies)) : vmax, t_limit,
+    double dt = choose_dt(sim, sim->bodies ? fmax(vmax, pfsph_bodies_vmax(sim->bodies)) : vmax, sim->t_limit,
                           &collapsed);
     if (collapsed) {
-        vmax = max_speed(f, &worst);
-        return blowup(sim, "timestep", worst, "time step fell below time.dt_min; speed", vmax, err);
+        vmax = max_speed(&sim->fluid, &worst);
+        return unstable(bad, worst, "time step fell below time.dt_min; speed", vmax);
     }
     c->dt = dt;
     c->time = sim->time;
     c->step = sim->step;
+    return PFSPH_OK;
+}
 
-    pfsph__nonpressure(c);
-    t1 = now();
-    sim->stage_s[PFSPH_STAGE_FORCES] += t1 - t0;
-    t0 = t1;
-    if (sim->pw) {
-        pfsph_pairwise_apply(sim->pw, c);
-        t1 = now();
-        sim->stage_s[PFSPH_STAGE_PAIRWISE] += t1 - t0;
-        t0 = t1;
-    }
+static int st_divergence(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_solve_stats out = {0, 0, 0};
+    sim->solver->pre_forces(sim->solver_state, &sim->ctx, sim->scr + SCR_COMMON, &out);
+    sim->stats.div_iterations = out.div_iterations;
+    return PFSPH_OK;
+}
 
-    pfsph_real *apx = sim->scr[SCR_APX], *apy = sim->scr[SCR_APY], *apz = sim->scr[SCR_APZ];
-    if (s->solver == PFSPH_SOLVER_PCISPH) {
-        pcisph_pressure(sim, dt);
-    } else {
-        pfsph__tait(c, c->nd, sim->B, sim->gamma, sim->rho_common, f->p);
-        pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, f->p, apx, apy, apz);
-        pfsph_real *er = sim->scr[SCR_ERR];
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            pfsph_real e = c->nd[i] / c->nd0 - 1;
-            er[i] = e > 0 ? e : 0;
-        }
-        sim->stats.density_err_avg = n ? pfsph__sum(er, n) / (double)n : 0;
-        sim->stats.iterations = 0;
-    }
-    t1 = now();
-    sim->stage_s[PFSPH_STAGE_PRESSURE] += t1 - t0;
-    t0 = t1;
-    if (sim->bodies) {
-        /* fluid forces on the bodies from this step's pressure, before the fluid moves */
-        pfsph_bodies_fluid_forces(sim->bodies, c);
-        t1 = now();
-        sim->stage_s[PFSPH_STAGE_BODIES] += t1 - t0;
-        t0 = t1;
-    }
+static int st_forces(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph__nonpressure(&sim->ctx);
+    return PFSPH_OK;
+}
 
-    /* symplectic Euler; the largest acceleration feeds the next step's force criterion */
+static int st_pairwise(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_pairwise_apply(sim->pw, &sim->ctx);
+    return PFSPH_OK;
+}
+
+static int st_pressure(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_real *const ap[3] = {sim->scr[SCR_APX], sim->scr[SCR_APY], sim->scr[SCR_APZ]};
+    pfsph_solve_stats out = {0, sim->stats.div_iterations, 0};
+    sim->solver->solve(sim->solver_state, &sim->ctx, ap, sim->scr + SCR_COMMON, &out);
+    sim->stats.iterations = out.iterations;
+    sim->stats.density_err_avg = out.density_err_avg;
+    return PFSPH_OK;
+}
+
+/* fluid forces on the bodies from this step's pressure, before the fluid moves */
+static int st_body_forces(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_bodies_fluid_forces(sim->bodies, &sim->ctx);
+    return PFSPH_OK;
+}
+
+/* symplectic Euler; the largest acceleration feeds the next step's force criterion */
+static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)err;
+    pfsph_ctx *c = &sim->ctx;
+    pfsph_particles *f = &sim->fluid;
+    const size_t n = f->n;
+    const pfsph_real *apx = sim->scr[SCR_APX], *apy = sim->scr[SCR_APY], *apz = sim->scr[SCR_APZ];
+    const double dt = c->dt;
     const pfsph_real fdt = (pfsph_real)dt;
     double amax2 = 0, anp2 = 0;
-    pfsph_real *ek = sim->scr[SCR_ERR];
+    pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
-    int bad = 0;
-#pragma omp parallel for schedule(static) reduction(max : amax2, anp2, emax, v2max) reduction(| : bad)
+    int bad_ = 0;
+#pragma omp parallel for schedule(static) reduction(max : amax2, anp2, emax, v2max) reduction(| : bad_)
     for (size_t i = 0; i < n; i++) {
         double b2 = (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i];
         if (b2 > anp2) anp2 = b2;
@@ -571,7 +608,7 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
         ek[i] = (pfsph_real)0.5 * c->mass[f->phase[i]] *
                 (f->vx[i] * f->vx[i] + f->vy[i] * f->vy[i] + f->vz[i] * f->vz[i]);
         double v2 = (double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] + (double)f->vz[i] * f->vz[i];
-        if (!isfinite(v2) || !isfinite(f->x[i] + f->y[i] + f->z[i])) bad = 1;
+        if (!isfinite(v2) || !isfinite(f->x[i] + f->y[i] + f->z[i])) bad_ = 1;
         else if (v2 > v2max) v2max = v2;
     }
     sim->amax = sqrt(amax2);
@@ -579,43 +616,81 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     sim->stats.ekin = pfsph__sum(ek, n);
     sim->stats.density_err_max = emax;
     sim->stats.dt = dt;
-    vmax = bad ? NAN : sqrt(v2max);
+    double vmax = bad_ ? NAN : sqrt(v2max);
     sim->stats.vmax = vmax;
-    t1 = now();
-    sim->stage_s[PFSPH_STAGE_INTEGRATE] += t1 - t0;
-    t0 = t1;
-    if (bad || vmax > sim->vbound) {
+    if (bad_ || vmax > sim->vbound) {
+        size_t worst;
         vmax = max_speed(f, &worst); /* rare: find the particle to name */
-        if (!isfinite(vmax)) return blowup(sim, "integrate", worst, "non-finite velocity or position", vmax, err);
-        return blowup(sim, "integrate", worst, "speed [m/s]", vmax, err);
+        if (!isfinite(vmax)) return unstable(bad, worst, "non-finite velocity or position", vmax);
+        return unstable(bad, worst, "speed [m/s]", vmax);
     }
+    return PFSPH_OK;
+}
 
-    if (sim->df) {
-        pfsph_diffuse_step(sim->df, c);
-        t1 = now();
-        sim->stage_s[PFSPH_STAGE_DIFFUSE] += t1 - t0;
-        t0 = t1;
-    }
-    if (sim->bodies) {
-        pfsph_bodies_step(sim->bodies, &sim->boundary, sim->time, dt);
-        for (int i = 0; i < pfsph_bodies_count(sim->bodies); i++) {
-            pfsph_body_state bs;
-            pfsph_bodies_get_state(sim->bodies, i, &bs);
-            double q = bs.x[0] + bs.x[1] + bs.x[2] + bs.v[0] + bs.v[1] + bs.v[2] + bs.w[0] + bs.w[1] + bs.w[2];
-            if (!isfinite(q) || sqrt(bs.v[0] * bs.v[0] + bs.v[1] * bs.v[1] + bs.v[2] * bs.v[2]) > sim->vbound)
-                return pfsph_fail(err, PFSPH_EUNSTABLE,
-                                  "simulation unstable at step %llu, t = %.6g s, stage bodies: body \"%s\" "
-                                  "at %.4g %.4g %.4g moves at %.4g %.4g %.4g m/s; likely cause: a body much "
-                                  "lighter than the fluid it displaces, or too large a time step (lower time.cfl)",
-                                  (unsigned long long)sim->step, sim->time, pfsph_bodies_name(sim->bodies, i),
-                                  bs.x[0], bs.x[1], bs.x[2], bs.v[0], bs.v[1], bs.v[2]);
+static int st_diffuse(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_diffuse_step(sim->df, &sim->ctx);
+    return PFSPH_OK;
+}
+
+static int st_bodies(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    pfsph_bodies_step(sim->bodies, &sim->boundary, sim->time, sim->ctx.dt);
+    for (int i = 0; i < pfsph_bodies_count(sim->bodies); i++) {
+        pfsph_body_state bs;
+        pfsph_bodies_get_state(sim->bodies, i, &bs);
+        double q = bs.x[0] + bs.x[1] + bs.x[2] + bs.v[0] + bs.v[1] + bs.v[2] + bs.w[0] + bs.w[1] + bs.w[2];
+        if (!isfinite(q) || sqrt(bs.v[0] * bs.v[0] + bs.v[1] * bs.v[1] + bs.v[2] * bs.v[2]) > sim->vbound) {
+            bad->particle = SIZE_MAX;
+            snprintf(bad->what, sizeof bad->what, "body \"%s\" at %.4g %.4g %.4g moves at %.4g %.4g %.4g m/s",
+                     pfsph_bodies_name(sim->bodies, i), bs.x[0], bs.x[1], bs.x[2], bs.v[0], bs.v[1], bs.v[2]);
+            bad->hint = "a body much lighter than the fluid it displaces, or too large a time step (lower time.cfl)";
+            return PFSPH_EUNSTABLE;
         }
-        if (pfsph_grid_sort(&sim->bgrid, &sim->boundary, NULL))
-            return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sorting the boundary particles");
-        t1 = now();
-        sim->stage_s[PFSPH_STAGE_BODIES] += t1 - t0;
     }
-    sim->time += dt;
+    if (pfsph_grid_sort(&sim->bgrid, &sim->boundary, NULL))
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sorting the boundary particles");
+    return PFSPH_OK;
+}
+
+/* The step as data: only the stages this scene needs, in order. */
+static void build_stages(pfsph_sim *sim)
+{
+    int n = 0;
+#define ADD(nm, sl, fn) sim->stages[n++] = (stage){nm, sl, fn}
+    ADD("grid", PFSPH_STAGE_GRID, st_grid);
+    if (sim->pw) ADD("pairwise", PFSPH_STAGE_PAIRWISE, st_shift);
+    ADD("density", PFSPH_STAGE_DENSITY, st_density);
+    ADD("timestep", PFSPH_STAGE_FORCES, st_timestep);
+    if (sim->solver->pre_forces) ADD("divergence", PFSPH_STAGE_PRESSURE, st_divergence);
+    ADD("forces", PFSPH_STAGE_FORCES, st_forces);
+    if (sim->pw) ADD("pairwise", PFSPH_STAGE_PAIRWISE, st_pairwise);
+    ADD("pressure", PFSPH_STAGE_PRESSURE, st_pressure);
+    if (sim->bodies) ADD("bodies", PFSPH_STAGE_BODIES, st_body_forces);
+    ADD("integrate", PFSPH_STAGE_INTEGRATE, st_integrate);
+    if (sim->df) ADD("diffuse", PFSPH_STAGE_DIFFUSE, st_diffuse);
+    if (sim->bodies) ADD("bodies", PFSPH_STAGE_BODIES, st_bodies);
+#undef ADD
+    sim->nstages = n;
+}
+
+int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
+{
+    sim->t_limit = t_limit;
+    double t0 = now();
+    for (int k = 0; k < sim->nstages; k++) {
+        const stage *st = &sim->stages[k];
+        blowup_info bad = {SIZE_MAX, "", NULL};
+        int rc = st->run(sim, &bad, err);
+        double t1 = now();
+        sim->stage_s[st->slot] += t1 - t0;
+        t0 = t1;
+        if (rc == PFSPH_EUNSTABLE && bad.what[0]) return report_blowup(sim, st->name, &bad, err);
+        if (rc) return rc;
+    }
+    sim->time += sim->ctx.dt;
     sim->step++;
     return PFSPH_OK;
 }
@@ -634,6 +709,7 @@ int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err)
 double pfsph_sim_time(const pfsph_sim *sim) { return sim->time; }
 uint64_t pfsph_sim_steps(const pfsph_sim *sim) { return sim->step; }
 const pfsph_ctx *pfsph_sim_ctx(const pfsph_sim *sim) { return &sim->ctx; }
+const pfsph_scene *pfsph_sim_scene(const pfsph_sim *sim) { return &sim->scene; }
 const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim) { return &sim->stats; }
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim) { return sim->stage_s; }
 size_t pfsph_sim_removed(const pfsph_sim *sim) { return sim->removed; }

@@ -7,10 +7,9 @@
 #define PFSPH_BODIES_H
 
 #include "pfsph/mesh.h"
-#include "pfsph/particles.h"
+#include "pfsph/ctx.h"
 #include "pfsph/scene.h"
 
-struct pfsph_ctx;
 typedef struct pfsph_bodies pfsph_bodies;
 
 /* Pose and velocity of one body: centre of mass, unit quaternion (w, x, y, z), linear and
@@ -36,7 +35,7 @@ double pfsph_bodies_distance(const pfsph_bodies *b, int i, const double p[3]);
  * nd of the fluid at the current positions, viscous friction with ctx->nu), summed into
  * each body's force and torque: exactly the opposite of what the fluid receives from the body
  * particles in pfsph__pressure_accel and pfsph__nonpressure. */
-void pfsph_bodies_fluid_forces(pfsph_bodies *b, const struct pfsph_ctx *ctx);
+void pfsph_bodies_fluid_forces(pfsph_bodies *b, const pfsph_ctx *ctx);
 
 /* Advance the bodies from t to t + dt with the fluid forces, gravity and contacts; move their
  * particles (positions and velocities) in `boundary`. */

@@ -29,4 +29,9 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
 /* Atomic whole-file write: data goes to "<path>.tmp.<pid>", fsync, rename. */
 int pfsph_write_file_atomic(const char *path, const void *data, size_t len, pfsph_error *err);
 
+/* Plot n_spray, n_foam, n_bubble (and their sum) over time from a stats CSV with a header line
+ * naming the columns "time", "n_spray", "n_foam", "n_bubble", as a PNG like the paper's Fig. 14.
+ * Written atomically. */
+int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error *err);
+
 #endif

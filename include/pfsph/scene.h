@@ -5,20 +5,19 @@
 #define PFSPH_SCENE_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "pfsph/types.h"
-#include "pfsph/pairwise.h"
-#include "pfsph/diffuse.h"
+#include "pfsph/params.h"
 
 #define PFSPH_MAX_BLOCKS 64
 #define PFSPH_MAX_SOLIDS 64
-#define PFSPH_NAME_LEN 64
 #define PFSPH_PATH_LEN 1024
 #define PFSPH_MAX_BODIES 32
 #define PFSPH_MAX_KEYFRAMES 16
 
+/* Pressure solvers (src/physics/solver.h); names as in the scene: pfsph_scene_solver_name. */
 enum pfsph_solver { PFSPH_SOLVER_WCSPH = 0, PFSPH_SOLVER_PCISPH = 1 };
-enum pfsph_phase_kind { PFSPH_PHASE_FLUID = 0, PFSPH_PHASE_GAS = 1, PFSPH_PHASE_SOLID = 2 };
 enum pfsph_shape {
     PFSPH_SHAPE_BOX = 0,
     PFSPH_SHAPE_SPHERE,    /* a disc in 2D */
@@ -33,14 +32,6 @@ enum pfsph_shape {
  * and the time step shrinks by that factor; needed at density ratios of about 100 and more). */
 enum pfsph_pressure_scale { PFSPH_PRESSURE_PHASE = 0, PFSPH_PRESSURE_COMMON };
 
-typedef struct pfsph_phase {
-    char name[PFSPH_NAME_LEN];
-    int kind;              /* enum pfsph_phase_kind */
-    double rest_density;   /* kg/m^3 */
-    double viscosity;      /* kinematic, m^2/s */
-    float color[3];        /* 0..1 */
-    bool color_set;        /* "color" given in the scene (walls are drawn grey otherwise) */
-} pfsph_phase;
 
 /* A region of fluid particles. */
 typedef struct pfsph_block {
@@ -173,10 +164,30 @@ int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err);
 /* The embedded default scene (a small 3D dam break against an obstacle), as JSON text. */
 const char *pfsph_scene_default_json(void);
 
+/* The solver's name as the scene writes it ("wcsph", "pcisph"). */
+const char *pfsph_scene_solver_name(const pfsph_scene *s);
+
 /* Index of the phase called name, or -1. */
 int pfsph_scene_phase_index(const pfsph_scene *s, const char *name);
 
 /* Smallest and largest rest density of the fluid and gas phases; returns 0 when there is none. */
 int pfsph_scene_density_range(const pfsph_scene *s, double *lo, double *hi);
+
+/* ---- pair-force targets (scene_pairwise.c) ---- */
+
+/* Radius the pair forces need: k*h if enabled, else 0. The core sizes grid cells to
+ * max(h, this). */
+pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h);
+
+/* Turn sigma and contact-angle targets into c[a][b] (Eqs. 13-16, 21) for particles at the given
+ * spacing [m] and SPH support h [m]; fills s->pairwise.resolved/radius/lambda. Idempotent.
+ * Returns PFSPH_EINPUT with a message for impossible targets (a cross surface tension larger
+ * than the cohesions allow, a contact angle on a fluid without cohesion, ...). */
+int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h,
+                           pfsph_error *err);
+
+/* Print the coefficient matrix, each target with the coefficient it produced, and the surface
+ * tensions and contact angles the final matrix predicts (for `pfsph check`). */
+void pfsph_pairwise_report(const pfsph_scene *s, FILE *out);
 
 #endif

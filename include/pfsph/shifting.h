@@ -8,21 +8,10 @@
 #ifndef PFSPH_SHIFTING_H
 #define PFSPH_SHIFTING_H
 
-#include "pfsph/types.h"
+#include "pfsph/ctx.h"
 
-struct pfsph_ctx;
 
-typedef struct pfsph_shift_params {
-    double D;        /* shifting diffusivity [m^2/s]; the shift of one step is
-                        -(D + A h |v_i|) dt grad C; D = A = 0 switches shifting off */
-    double A;        /* speed-proportional part (Skillen et al. 2013: D_i = A h |v_i|) */
-    double surface;  /* C_i below this marks a free-surface particle (C = 1 in the bulk):
-                        only the tangential part of its shift is kept */
-    double max_frac; /* largest shift in one step, as a fraction of the spacing */
-} pfsph_shift_params;
 
-/* Default: off (D = 0, A = 0), surface 0.9, max_frac 0.05. */
-void pfsph_shift_defaults(pfsph_shift_params *p);
 
 /* Shift ctx->fluid positions in place for a step of length dt [s]. The fluid arrays must be in
  * the order of ctx->grid and its cells at least h + max_frac d (the shift is applied after the
@@ -31,11 +20,11 @@ void pfsph_shift_defaults(pfsph_shift_params *p);
  * ctx->fluid->n entries each. normal_radius [m] (at least h, at most the grid cell): support
  * of the concentration gradient whose direction is the surface normal. Deterministic for any thread count. Returns the largest shift
  * [m]. */
-double pfsph_shift_apply(const struct pfsph_ctx *ctx, const pfsph_shift_params *p, double dt,
+double pfsph_shift_apply(const pfsph_ctx *ctx, const pfsph_shift_params *p, double dt,
                          double normal_radius, pfsph_real *sx, pfsph_real *sy, pfsph_real *sz);
 
 /* Particle concentration C_i = V0 sum_j W_ij + sum_b V_b W_ib (self term included) of fluid
  * particle i, and its gradient (with the anti-clumping weight) in g[3]; for tests. */
-double pfsph_shift_concentration(const struct pfsph_ctx *ctx, size_t i, double g[3]);
+double pfsph_shift_concentration(const pfsph_ctx *ctx, size_t i, double g[3]);
 
 #endif

@@ -4,32 +4,9 @@
 #ifndef PFSPH_SIM_H
 #define PFSPH_SIM_H
 
-#include "pfsph/grid.h"
-#include "pfsph/kernel.h"
-#include "pfsph/particles.h"
+#include "pfsph/ctx.h"
 #include "pfsph/scene.h"
 
-/* What every stage may read. Fluid arrays are in grid order (grid sorted this step). */
-typedef struct pfsph_ctx {
-    int dim;
-    pfsph_real spacing;  /* initial particle spacing d = 2 r [m] */
-    pfsph_real h;        /* SPH support radius [m] */
-    pfsph_real V0;       /* rest particle volume d^dim */
-    pfsph_real nd0;      /* rest number density 1 / V0 */
-    pfsph_kernel kern;   /* support h */
-    pfsph_particles *fluid;    /* fluid and gas particles */
-    pfsph_particles *boundary; /* static solid particles; aux = Akinci volume [m^d] */
-    pfsph_grid *grid;          /* fluid grid; cell >= max radius in use */
-    pfsph_grid *bgrid;         /* boundary grid, same geometry */
-    pfsph_real mass[PFSPH_MAX_PHASES];         /* particle mass per phase: rho0 * V0 */
-    pfsph_real rest_density[PFSPH_MAX_PHASES];
-    pfsph_real nu[PFSPH_MAX_PHASES];           /* kinematic viscosity per phase */
-    pfsph_real *ax, *ay, *az; /* per-step non-pressure acceleration of fluid particles */
-    pfsph_real *nd;           /* per-step number density of fluid particles (Eq. 23) */
-    const pfsph_scene *scene;
-    double time, dt;
-    uint64_t step;
-} pfsph_ctx;
 
 enum pfsph_stage {
     PFSPH_STAGE_GRID, PFSPH_STAGE_DENSITY, PFSPH_STAGE_FORCES, PFSPH_STAGE_PAIRWISE,
@@ -45,7 +22,8 @@ typedef struct pfsph_step_stats {
     double density_err_avg; /* mean of (rho - rho0) / rho0 over fluid, compressed side only */
     double density_err_max;
     double ekin;            /* J */
-    int iterations;         /* PCISPH iterations of the last step */
+    int iterations;         /* pressure iterations of the last step (PCISPH) */
+    int div_iterations;     /* divergence-solve iterations of the last step (0 without one) */
 } pfsph_step_stats;
 
 typedef struct pfsph_sim pfsph_sim;
@@ -61,6 +39,12 @@ int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err);
 double pfsph_sim_time(const pfsph_sim *sim);
 uint64_t pfsph_sim_steps(const pfsph_sim *sim);
 const pfsph_ctx *pfsph_sim_ctx(const pfsph_sim *sim);
+/* The scene as the simulation runs it (pair-force targets resolved). */
+const pfsph_scene *pfsph_sim_scene(const pfsph_sim *sim);
+/* Point the model part of a context (gravity, domain, seed, phases, pair-force and diffuse
+ * parameters) at a scene, which must outlive it: the simulation does this, and so can a test
+ * that builds a context by hand. */
+void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s);
 const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim);
 /* Seconds spent per stage so far. */
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);

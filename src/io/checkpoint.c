@@ -262,7 +262,7 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
     w_i32(&w, frame);
     w_i32(&w, omp_get_max_threads());
     w_i32(&w, c->dim);
-    w_u32(&w, (uint32_t)c->scene->nphases);
+    w_u32(&w, (uint32_t)c->nphases);
     w_f64(&w, st.time);
     w_u64(&w, st.step);
     w_f64(&w, st.amax);
@@ -316,7 +316,7 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
     w.len = 8;
     w_u32(&w, PFSPH_CHECKPOINT_VERSION);
     w_u32(&w, (uint32_t)sizeof(pfsph_real));
-    w_u64(&w, pfsph_scene_hash(c->scene));
+    w_u64(&w, pfsph_scene_hash(pfsph_sim_scene(sim)));
     w_u64(&w, payload);
     w_u32(&w, pcrc);
     uint32_t hcrc = (uint32_t)crc32(crc32(0L, Z_NULL, 0), buf, 36);
@@ -435,10 +435,10 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
     if (crc != pcrc)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: checksum mismatch (CRC32 %08x, expected %08x)",
                           name, crc, pcrc);
-    if (hash != pfsph_scene_hash(c->scene))
+    if (hash != pfsph_scene_hash(pfsph_sim_scene(sim)))
         return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint belongs to another scene (scene hash %016llx, "
                           "this scene %016llx)", name, (unsigned long long)hash,
-                          (unsigned long long)pfsph_scene_hash(c->scene));
+                          (unsigned long long)pfsph_scene_hash(pfsph_sim_scene(sim)));
 
     int32_t fr = r_i32(&r);
     int32_t threads = r_i32(&r);
@@ -462,7 +462,7 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
         double v = r_f64(&r);
         if (k < PFSPH_NSTAGES) st.stage_s[k] = v;
     }
-    if (r.bad || fr < 0 || dim != c->dim || nph != (uint32_t)c->scene->nphases || nst > 64)
+    if (r.bad || fr < 0 || dim != c->dim || nph != (uint32_t)c->nphases || nst > 64)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: bad frame, dimension or phase count", name);
     pfsph_particles fluid, diff;
     memset(&diff, 0, sizeof diff);

@@ -8,7 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "pfsph/diffuse.h"
+#include "pfsph/io.h"
 
 enum { W = 900, H = 540, ML = 80, MR = 30, MT = 40, MB = 60 };
 

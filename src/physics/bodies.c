@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "physics/stages.h"
+#include "physics/boundary.h"
 #include "scene/shapes.h"
 
 _Static_assert(sizeof(dTriIndex) == sizeof(uint32_t), "ODE built with 32-bit trimesh indices");
@@ -721,13 +721,13 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
     const pfsph_real visc_c = (pfsph_real)(2 * (ctx->dim + 2));
     const uint32_t first = B->first_id;
     const size_t nb = b->n;
-    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    const pfsph_pairwise_params *pp = ctx->pairwise;
     const bool pw_on = pp->enabled;
     const double Rk = pw_on ? pp->k * (double)ctx->h : 0, U_R = pw_on ? 1.5 * PI / Rk : 0;
     const pfsph_real R2 = (pfsph_real)(Rk * Rk);
     double cm[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES]; /* c m_a m_b, once per call */
-    for (int a = 0; pw_on && a < ctx->scene->nphases; a++)
-        for (int q = 0; q < ctx->scene->nphases; q++)
+    for (int a = 0; pw_on && a < ctx->nphases; a++)
+        for (int q = 0; q < ctx->nphases; q++)
             cm[a][q] = pp->c[a][q] * (double)ctx->mass[a] * (double)ctx->mass[q];
     /* particles dropped from the boundary set (a body that left the grid) must not keep their
      * last force: only the present ones are written below */

@@ -9,7 +9,6 @@
 #include <string.h>
 
 #include "pfsph/rng.h"
-#include "pfsph/sim.h"
 
 #define TWO_PI 6.283185307179586
 
@@ -39,56 +38,19 @@ struct pfsph_diffuse {
     size_t tmp_cap;
 };
 
-void pfsph_diffuse_defaults(pfsph_diffuse_params *p)
-{
-    memset(p, 0, sizeof(*p));
-    p->enabled = false;
-    p->max_particles = 1000000;
-    p->sampling_rate = 200.0; /* Table 1 "sampling frequency" */
-    p->phi_v_min = 2.0;       /* Table 3 */
-    p->phi_v_max = 8.0;
-    p->phi_e_min = 2.0;
-    p->phi_e_max = 8.0;
-    p->energy_mass = 0.0;
-    p->emit_radius = 0.0;
-    p->emit_radius_scale = 1.0;
-    p->emit_height_scale = 1.0;
-    p->lifetime_min = 0.0;
-    p->lifetime_max = 3.0;    /* Tables 1-3 "survival time (max)" */
-    p->foam_min_neighbors = -1;
-    p->foam_max_neighbors = -1;
-    /* Section 4.2: spray k_b = k_cp = 0; foam k_ext = k_b = 0; Section 6.2: k_b = 5.6,
-     * k_cp = 0.5, k_t = 0.5 / 1.0 / 0.33. */
-    p->type[PFSPH_DIFFUSE_SPRAY] = (pfsph_diffuse_coupling){1.0, 0.0, 0.0, 0.5};
-    p->type[PFSPH_DIFFUSE_FOAM] = (pfsph_diffuse_coupling){0.0, 0.0, 0.5, 1.0};
-    p->type[PFSPH_DIFFUSE_BUBBLE] = (pfsph_diffuse_coupling){1.0, 5.6, 0.5, 0.33};
-}
-
-void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing,
-                              int *foam_min, int *foam_max)
-{
-    /* Fluid neighbours of a point inside a full support: support volume / particle volume. */
-    double q = h / spacing;
-    double full = dim == 3 ? 4.0 / 3.0 * 3.141592653589793 * q * q * q
-                           : 3.141592653589793 * q * q;
-    *foam_min = p->foam_min_neighbors >= 0 ? p->foam_min_neighbors : (int)lround(0.2 * full);
-    *foam_max = p->foam_max_neighbors >= 0 ? p->foam_max_neighbors
-                                           : (int)lround(2.0 / 3.0 * full);
-}
-
 int pfsph_diffuse_create(pfsph_diffuse **out, const pfsph_ctx *ctx, pfsph_error *err)
 {
     *out = NULL;
-    if (!ctx || !ctx->scene)
+    if (!ctx || !ctx->diffuse)
         return pfsph_fail(err, PFSPH_EINPUT, "diffuse: no scene in the context");
     pfsph_diffuse *d = calloc(1, sizeof(*d));
     if (!d) return pfsph_fail(err, PFSPH_ENOMEM, "diffuse: out of memory");
-    d->p = ctx->scene->diffuse;
+    d->p = *ctx->diffuse;
     if (d->p.max_particles < 0) d->p.max_particles = 0;
     pfsph_diffuse_thresholds(&d->p, ctx->dim, (double)ctx->h, (double)ctx->spacing,
                              &d->foam_min, &d->foam_max);
     for (int k = 0; k < PFSPH_MAX_PHASES; k++)
-        d->liquid[k] = k >= ctx->scene->nphases || ctx->scene->phases[k].kind != PFSPH_PHASE_GAS;
+        d->liquid[k] = k >= ctx->nphases || ctx->phases[k].kind != PFSPH_PHASE_GAS;
     d->all_liquid = true;
     for (int k = 0; k < PFSPH_MAX_PHASES; k++) d->all_liquid = d->all_liquid && d->liquid[k];
     size_t cap = (size_t)d->p.max_particles < 4096 ? (size_t)d->p.max_particles : 4096;
@@ -238,7 +200,7 @@ static uint32_t emit_count(const pfsph_diffuse *d, const pfsph_ctx *ctx, size_t 
      * v_diff is: the neighbour loop of Eqs. 10-13 is skipped and the count (0) is the same bit
      * for bit. With k_max dt ~ 0.01-0.1 this skips the loop for 90-99% of the candidates. */
     uint32_t u[4];
-    pfsph_rng_u32x4(ctx->scene->seed, f->id[i], ctx->step, STREAM_COUNT, u);
+    pfsph_rng_u32x4(ctx->seed, f->id[i], ctx->step, STREAM_COUNT, u);
     const double un = pfsph_rng_to_unit(u[0]);
     const double nmax = pe * d->p.sampling_rate * ctx->dt;
     if (nmax < 1.0 && un >= nmax) return 0;
@@ -257,7 +219,7 @@ static void emit_one(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i, uint32_t 
     const pfsph_particles *f = ctx->fluid;
     const double dt = ctx->dt;
     double u[4];
-    pfsph_rng_uniform4(ctx->scene->seed, f->id[i], ctx->step, STREAM_EMIT + k, u);
+    pfsph_rng_uniform4(ctx->seed, f->id[i], ctx->step, STREAM_EMIT + k, u);
     const double xf[3] = {d->ox[i], d->oy[i], d->oz[i]};
     double vf[3] = {f->vx[i], f->vy[i], f->vz[i]};
     double sp = sqrt(vf[0] * vf[0] + vf[1] * vf[1] + vf[2] * vf[2]);
@@ -400,8 +362,8 @@ static void advect(pfsph_diffuse *d, const pfsph_ctx *ctx)
 {
     pfsph_particles *ps = &d->ps;
     const double dt = ctx->dt;
-    const double *g = ctx->scene->gravity;
-    const double *lo = ctx->scene->domain_min, *hi = ctx->scene->domain_max;
+    const double *g = ctx->gravity;
+    const double *lo = ctx->domain_min, *hi = ctx->domain_max;
     const long n = (long)ps->n;
 #pragma omp parallel for schedule(dynamic, 256)
     for (long i = 0; i < n; i++) {

@@ -9,8 +9,6 @@
 #include <string.h>
 
 #include "pfsph/eigen.h"
-#include "pfsph/scene.h"
-#include "pfsph/sim.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -21,12 +19,6 @@ struct pfsph_pairwise {
     size_t cap;
     double shift_max; /* largest shift of the last step [m] */
 };
-
-double pfsph_pairwise_shape(double r, double R)
-{
-    if (r > R) return 0.0;
-    return cos(1.5 * PI * r / R); /* Eq. 6 */
-}
 
 void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, double eps_min,
                                   double T[3][3])
@@ -70,7 +62,7 @@ void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, dou
 int pfsph_pairwise_create(pfsph_pairwise **out, const pfsph_ctx *ctx, pfsph_error *err)
 {
     *out = NULL;
-    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    const pfsph_pairwise_params *pp = ctx->pairwise;
     double R = pp->k * (double)ctx->h;
     if (ctx->grid && (double)ctx->grid->cell * ctx->grid->reach_far < R * (1.0 - 1e-6))
         return pfsph_fail(err, PFSPH_EINPUT,
@@ -96,7 +88,7 @@ void pfsph_pairwise_destroy(pfsph_pairwise *pw)
 
 void pfsph_pairwise_shift(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 {
-    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    const pfsph_pairwise_params *pp = ctx->pairwise;
     if (!pw || !pp->enabled || !(pp->shift.D > 0 || pp->shift.A > 0) || !(ctx->dt > 0)) return;
     const size_t n = ctx->fluid->n;
     if (n > pw->cap) {
@@ -130,7 +122,7 @@ typedef struct pw_job {
 
 static void job_init(pw_job *J, const pfsph_ctx *ctx)
 {
-    const pfsph_pairwise_params *pp = &ctx->scene->pairwise;
+    const pfsph_pairwise_params *pp = ctx->pairwise;
     J->ctx = ctx;
     for (int a = 0; a < PFSPH_MAX_PHASES; a++)
         for (int b = 0; b < PFSPH_MAX_PHASES; b++)
@@ -259,7 +251,7 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
 void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 {
     (void)pw;
-    if (!ctx->scene->pairwise.enabled) return;
+    if (!ctx->pairwise->enabled) return;
     pw_job J;
     job_init(&J, ctx);
     const size_t n = ctx->fluid->n;
@@ -285,7 +277,7 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
     (void)pw;
     pw_job J;
     job_init(&J, ctx);
-    if (!ctx->scene->pairwise.enabled)
+    if (!ctx->pairwise->enabled)
         for (int a = 0; a < PFSPH_MAX_PHASES; a++)
             for (int b = 0; b < PFSPH_MAX_PHASES; b++) J.coef[a][b] = 0;
     const size_t n = ctx->fluid->n;
@@ -297,191 +289,3 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
     }
 }
 
-/* ---------------------------------------------------------------------------------------- */
-/* Parameters and targets */
-
-void pfsph_pairwise_defaults(pfsph_pairwise_params *p)
-{
-    memset(p, 0, sizeof(*p));
-    p->k = cbrt(80.0 / 30.0); /* Eq. 5 */
-    p->filter = true;
-    p->eta = 0.2;
-    p->eps_min = 0.5;
-    p->center = PFSPH_PW_CENTER_PARTICLE; /* Eq. 7 as written */
-    pfsph_shift_defaults(&p->shift);
-}
-
-double pfsph_pairwise_lambda(int dim, double R)
-{
-    const double U = 1.5 * PI;
-    if (dim == 2) {
-        /* sigma = -(n^2/3) int_0^R r^3 F(r) dr with F = s cos(U r / R). */
-        return R * R * R * R * (U * U * U - 6.0 * U - 6.0) / (3.0 * U * U * U * U);
-    }
-    /* sigma = -(pi n^2/8) int_0^R r^4 F(r) dr (NOTES item 6). */
-    double U2 = U * U;
-    return PI / 8.0 * R * R * R * R * R * (U2 * U2 - 12.0 * U2 + 24.0) / (U2 * U2 * U);
-}
-
-pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h)
-{
-    if (!s->pairwise.enabled) return 0;
-    return (pfsph_real)(s->pairwise.k * (double)h);
-}
-
-static bool is_solid(const pfsph_scene *s, int a) { return s->phases[a].kind == PFSPH_PHASE_SOLID; }
-
-int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfsph_error *err)
-{
-    pfsph_pairwise_params *pp = &s->pairwise;
-    pp->resolved = false;
-    if (!pp->enabled) return PFSPH_OK;
-    if (!(spacing > 0) || !(h > 0) || !(pp->k >= 1.0))
-        return pfsph_fail(err, PFSPH_EINPUT,
-                          "pairwise: need spacing > 0, h > 0 and k >= 1 (got %g, %g, %g)",
-                          (double)spacing, (double)h, pp->k);
-    const int np = s->nphases;
-    const double R = pp->k * (double)h;
-    const double lam = pfsph_pairwise_lambda(s->dim, R);
-    double rho[PFSPH_MAX_PHASES];
-    for (int a = 0; a < np; a++) rho[a] = s->phases[a].rest_density;
-
-    /* 1. Cohesion from a surface tension against the (unsimulated) air: Eq. 13 with
-     * c_beta = 0, sigma = lambda c rho^2 (Eq. 14 with n m = rho). */
-    for (int a = 0; a < np; a++) {
-        if (!pp->sigma_set[a][a]) continue;
-        if (is_solid(s, a) || !(rho[a] > 0))
-            return pfsph_fail(err, PFSPH_EINPUT,
-                              "pairwise: surface tension target on phase \"%s\" needs a fluid "
-                              "phase with rest_density > 0",
-                              s->phases[a].name);
-        pp->c[a][a] = pp->sigma[a][a] / (lam * rho[a] * rho[a]);
-    }
-    /* 2. Interfacial tension between two fluids: Eq. 13 solved for c_ab. */
-    for (int a = 0; a < np; a++)
-        for (int b = a + 1; b < np; b++) {
-            if (!pp->sigma_set[a][b]) continue;
-            if (is_solid(s, a) || is_solid(s, b) || !(rho[a] > 0) || !(rho[b] > 0))
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: surface tension between \"%s\" and \"%s\": both "
-                                  "must be fluid phases with rest_density > 0 (use "
-                                  "contact_angle for a solid)",
-                                  s->phases[a].name, s->phases[b].name);
-            double self = pp->c[a][a] * rho[a] * rho[a] + pp->c[b][b] * rho[b] * rho[b];
-            double cab = (self - pp->sigma[a][b] / lam) / (2.0 * rho[a] * rho[b]);
-            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]))
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
-                                  "more than their cohesions give with c = 0 (at most %g N/m); "
-                                  "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
-                                  pp->sigma[a][b], s->phases[a].name, s->phases[b].name,
-                                  lam * self, s->phases[a].name, s->phases[b].name);
-            pp->c[a][b] = pp->c[b][a] = cab > 0 ? cab : 0.0;
-        }
-    /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. */
-    for (int a = 0; a < np; a++)
-        for (int b = a + 1; b < np; b++) {
-            if (!pp->angle_set[a][b]) continue;
-            int fl = is_solid(s, a) ? b : a, so = is_solid(s, a) ? a : b;
-            if (!is_solid(s, so) || is_solid(s, fl))
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: contact angle between \"%s\" and \"%s\" needs one "
-                                  "fluid and one solid phase",
-                                  s->phases[a].name, s->phases[b].name);
-            if (!(pp->c[fl][fl] > 0))
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: contact angle of \"%s\" on \"%s\" needs a cohesion "
-                                  "(c or sigma of \"%s\" with itself) > 0 (Eq. 21)",
-                                  s->phases[fl].name, s->phases[so].name, s->phases[fl].name);
-            if (!(rho[so] > 0))
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: contact angle on \"%s\" needs its rest_density > 0 "
-                                  "(boundary particle mass)",
-                                  s->phases[so].name);
-            double th = pp->angle_deg[a][b] * PI / 180.0;
-            double cw = 0.5 * (1.0 + cos(th)) * pp->c[fl][fl] * rho[fl] / rho[so];
-            if (cw < 0) cw = 0; /* cos(180 deg) rounding */
-            pp->c[a][b] = pp->c[b][a] = cw;
-        }
-    for (int a = 0; a < np; a++)
-        for (int b = 0; b < np; b++) {
-            if (pp->c[a][b] != pp->c[b][a]) pp->c[b][a] = pp->c[a][b] = 0.5 * (pp->c[a][b] + pp->c[b][a]);
-            if (!isfinite(pp->c[a][b]) || pp->c[a][b] < 0)
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: coefficient between \"%s\" and \"%s\" is %g; it "
-                                  "must be finite and >= 0",
-                                  s->phases[a].name, s->phases[b].name, pp->c[a][b]);
-        }
-    pp->radius = R;
-    pp->lambda = lam;
-    pp->resolved = true;
-    return PFSPH_OK;
-}
-
-void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
-{
-    const pfsph_pairwise_params *pp = &s->pairwise;
-    if (!pp->enabled) {
-        fprintf(out, "pairwise forces: off\n");
-        return;
-    }
-    const int np = s->nphases;
-    fprintf(out, "pairwise forces: k = %.4g", pp->k);
-    if (pp->resolved) fprintf(out, ", radius k*h = %.4g m, lambda = %.4g m^%d", pp->radius,
-                              pp->lambda, s->dim + 2);
-    if (pp->filter && pp->eta > 0)
-        fprintf(out, "\n  anisotropic filter on: eta = %g, eps_min = %g, centre = %s\n", pp->eta,
-                pp->eps_min, pp->center == PFSPH_PW_CENTER_MEAN ? "mean" : "particle");
-    else
-        fprintf(out, "\n  anisotropic filter off (momentum conserved exactly)\n");
-    if (pp->shift.D > 0 || pp->shift.A > 0)
-        fprintf(out, "  particle shifting on: diffusivity %g m^2/s, speed factor %g, surface %g, "
-                "max step %g d\n", pp->shift.D, pp->shift.A, pp->shift.surface,
-                pp->shift.max_frac);
-    fprintf(out, "  coefficients c[a][b] (%s):\n  %-14s", s->dim == 2 ? "N m/kg^2, 2D" : "N/kg^2",
-            "");
-    for (int b = 0; b < np; b++) fprintf(out, " %12.12s", s->phases[b].name);
-    fprintf(out, "\n");
-    for (int a = 0; a < np; a++) {
-        fprintf(out, "  %-14.14s", s->phases[a].name);
-        for (int b = 0; b < np; b++) fprintf(out, " %12.5g", pp->c[a][b]);
-        fprintf(out, "\n");
-    }
-    for (int a = 0; a < np; a++)
-        for (int b = a; b < np; b++) {
-            if (pp->sigma_set[a][b])
-                fprintf(out, "  target: sigma(%s, %s) = %g N/m -> c = %.6g\n", s->phases[a].name,
-                        s->phases[b].name, pp->sigma[a][b], pp->c[a][b]);
-            if (pp->angle_set[a][b])
-                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (Eq. 21)\n",
-                        s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b]);
-        }
-    if (!pp->resolved) return;
-    double lam = pp->lambda;
-    for (int a = 0; a < np; a++) {
-        if (s->phases[a].kind == PFSPH_PHASE_SOLID) continue;
-        double ra = s->phases[a].rest_density;
-        if (pp->c[a][a] > 0)
-            fprintf(out, "  predicted: sigma(%s, air) = %.5g N/m (Eq. 16 with c_air = 0)\n",
-                    s->phases[a].name, lam * pp->c[a][a] * ra * ra);
-        for (int b = a + 1; b < np; b++) {
-            double rb = s->phases[b].rest_density;
-            if (s->phases[b].kind == PFSPH_PHASE_SOLID) {
-                if (!(pp->c[a][a] > 0) || !(rb > 0)) continue;
-                double cs = 2.0 * pp->c[a][b] * rb / (pp->c[a][a] * ra) - 1.0;
-                const char *note = cs > 1 ? " (complete wetting)" : "";
-                if (cs > 1) cs = 1;
-                if (cs < -1) cs = -1;
-                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (Eq. 21)\n",
-                        s->phases[a].name, s->phases[b].name, acos(cs) * 180.0 / PI, note);
-            } else {
-                double sg = lam * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb -
-                                   2.0 * pp->c[a][b] * ra * rb);
-                if (pp->c[a][a] > 0 || pp->c[b][b] > 0 || pp->c[a][b] > 0)
-                    fprintf(out, "  predicted: sigma(%s, %s) = %.5g N/m (Eq. 13)%s\n",
-                            s->phases[a].name, s->phases[b].name, sg,
-                            sg < 0 ? " -- negative: the fluids mix" : "");
-            }
-        }
-    }
-}

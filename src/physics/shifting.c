@@ -8,17 +8,8 @@
 
 #include <math.h>
 
-#include "pfsph/sim.h"
 
 #define ANTI_CLUMP_R 0.2
-
-void pfsph_shift_defaults(pfsph_shift_params *p)
-{
-    p->D = 0;
-    p->A = 0;
-    p->surface = 0.9;
-    p->max_frac = 0.05;
-}
 
 /* C_i and grad C_i (anti-clumping weighted) of fluid particle i at (xi, yi, zi); if nk is
  * not NULL, also the gradient of the concentration over nk's (wider) support in gn[3], whose

@@ -907,6 +907,11 @@ void pfsph_scene_defaults(pfsph_scene *s)
     snprintf(s->camera.color_by, sizeof s->camera.color_by, "phase");
 }
 
+const char *pfsph_scene_solver_name(const pfsph_scene *s)
+{
+    return s->solver >= 0 && s->solver <= PFSPH_SOLVER_PCISPH ? solver_names[s->solver] : "?";
+}
+
 int pfsph_scene_phase_index(const pfsph_scene *s, const char *name)
 {
     if (!s || !name) return -1;

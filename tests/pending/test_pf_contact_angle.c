@@ -135,12 +135,12 @@ static void test_contact_angle(void **state)
     if (rc) print_message("%s\n", err.msg);
     assert_int_equal(rc, PFSPH_OK);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
-    const pfsph_pairwise_params *pp = &c->scene->pairwise;
-    const int w = pfsph_scene_phase_index(c->scene, "water");
+    const pfsph_pairwise_params *pp = c->pairwise;
+    const int w = pfsph_scene_phase_index(pfsph_sim_scene(sim), "water");
     for (int q = 0; q < NDROP; q++) { /* the coefficients are the ratios asked for */
         char nm[8];
         snprintf(nm, sizeof nm, "p%d", q);
-        int pq = pfsph_scene_phase_index(c->scene, nm);
+        int pq = pfsph_scene_phase_index(pfsph_sim_scene(sim), nm);
         assert_true(fabs(pp->c[w][pq] / pp->c[w][w] - ratio[q]) < 1e-9);
     }
     const double t_end = getenv("PF_T") ? atof(getenv("PF_T")) : 2.0;

@@ -159,7 +159,7 @@ static double drop_pressure(double R, double t_end, double *R_eff, double *lambd
     if (rc) print_message("%s\n", err.msg);
     assert_int_equal(rc, PFSPH_OK);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
-    const pfsph_pairwise_params *pp = &c->scene->pairwise;
+    const pfsph_pairwise_params *pp = c->pairwise;
     *lambda_c = pp->lambda * pp->c[0][0] * 1000.0 * 1000.0; /* Eq. 16: sigma from c */
     *R_eff = sqrt((double)c->fluid->n * c->V0 / PI);
     double sum = 0, suma = 0;

@@ -45,7 +45,7 @@ static void fx_init(fixture *f, int dim, double spacing, double dt)
     c->grid = &f->grid;
     c->mass[0] = (pfsph_real)(1000 * c->V0);
     c->rest_density[0] = 1000;
-    c->scene = &f->scene;
+    pfsph_ctx_set_model(c, &f->scene);
     c->dt = dt;
     c->step = 1;
 }
@@ -91,6 +91,7 @@ static pfsph_diffuse *mk(fixture *f)
 {
     pfsph_diffuse *d = NULL;
     pfsph_error err;
+    pfsph_ctx_set_model(&f->ctx, &f->scene); /* the tests edit the scene after fx_init */
     assert_int_equal(pfsph_diffuse_create(&d, &f->ctx, &err), PFSPH_OK);
     return d;
 }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "pfsph/diffuse.h"
+#include "pfsph/io.h"
 #include "pfsph/scene.h"
 #include "scene/json_util.h"
 #include "testutil.h"

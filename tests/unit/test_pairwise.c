@@ -98,7 +98,7 @@ static void world_finish(world *w)
     c->ay = calloc(n, sizeof(pfsph_real));
     c->az = calloc(n, sizeof(pfsph_real));
     assert_true(c->ax && c->ay && c->az);
-    c->scene = s;
+    pfsph_ctx_set_model(c, s);
 }
 
 static void zero_acc(world *w)

@@ -68,7 +68,7 @@ static void world_finish(world *w)
     c->grid = &w->grid;
     c->bgrid = &w->bgrid;
     c->mass[0] = (pfsph_real)(1000 * c->V0);
-    c->scene = w->scene;
+    pfsph_ctx_set_model(c, w->scene);
 }
 
 static void world_free(world *w)

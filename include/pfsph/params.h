@@ -1,0 +1,125 @@
+/* The physical model's parameters: phase table, pair forces, particle shifting, diffuse
+ * material. Core data: the scene loader fills them and the physics reads them, so neither the
+ * scene nor the physics includes the other (docs/architecture.md). */
+#ifndef PFSPH_PARAMS_H
+#define PFSPH_PARAMS_H
+
+#include <stdbool.h>
+
+#include "pfsph/types.h"
+
+#define PFSPH_NAME_LEN 64
+
+enum pfsph_phase_kind { PFSPH_PHASE_FLUID = 0, PFSPH_PHASE_GAS = 1, PFSPH_PHASE_SOLID = 2 };
+
+typedef struct pfsph_phase {
+    char name[PFSPH_NAME_LEN];
+    int kind;              /* enum pfsph_phase_kind */
+    double rest_density;   /* kg/m^3 */
+    double viscosity;      /* kinematic, m^2/s */
+    float color[3];        /* 0..1 */
+    bool color_set;        /* "color" given in the scene (walls are drawn grey otherwise) */
+} pfsph_phase;
+
+/* ---- particle shifting (physics/shifting.c, include/pfsph/shifting.h) ---- */
+
+typedef struct pfsph_shift_params {
+    double D;        /* shifting diffusivity [m^2/s]; the shift of one step is
+                        -(D + A h |v_i|) dt grad C; D = A = 0 switches shifting off */
+    double A;        /* speed-proportional part (Skillen et al. 2013: D_i = A h |v_i|) */
+    double surface;  /* C_i below this marks a free-surface particle (C = 1 in the bulk):
+                        only the tangential part of its shift is kept */
+    double max_frac; /* largest shift in one step, as a fraction of the spacing */
+} pfsph_shift_params;
+
+/* Default: off (D = 0, A = 0), surface 0.9, max_frac 0.05. */
+void pfsph_shift_defaults(pfsph_shift_params *p);
+
+/* ---- pair forces (physics/pairwise.c, include/pfsph/pairwise.h) ---- */
+
+/* Where the covariance of Eq. 7 is centred. */
+enum pfsph_pw_center {
+    PFSPH_PW_CENTER_PARTICLE = 0, /* x_i, Eq. 7 as written (default). At k h ~ 2.8 d a particle
+                                     on a flat surface sees C_n/C_t ~ 0.66 (square lattice): the
+                                     surface row counts in C_t only; in the continuum limit the
+                                     moments about x_i are even in the normal and the edge
+                                     particle would look isotropic */
+    PFSPH_PW_CENTER_MEAN = 1,     /* kernel-weighted mean of the neighbourhood (Yu & Turk 2013):
+                                     a stronger, resolution-independent signal at surfaces */
+};
+
+typedef struct pfsph_pairwise_params {
+    bool enabled;
+    double k;         /* radius enlargement, default (80/30)^(1/3) (Eq. 5) */
+    bool filter;      /* anisotropic filter on (Eq. 12) */
+    double eta;       /* Eq. 11, default 0.2 */
+    double eps_min;   /* Eq. 8 clamp on eigenvalues normalised by the largest one, default 0.5 */
+    int center;       /* enum pfsph_pw_center */
+    pfsph_shift_params shift; /* particle shifting stage (off unless the scene asks) */
+    /* Coefficient matrix c[a][b] over scene phases (solids included), symmetric, >= 0.
+     * Pair force c m_i m_j f(r): c in N/kg^2 in 3D; in 2D masses are per metre of depth. */
+    double c[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    /* Which entries the scene stated (c directly, sigma, or contact angle). */
+    bool c_set[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    /* Targets as written in the scene; resolved into c by pfsph_pairwise_resolve. */
+    bool sigma_set[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    double sigma[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];   /* N/m (2D: N/m per metre of depth) */
+    bool angle_set[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    double angle_deg[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    /* Filled by pfsph_pairwise_resolve (for the report). */
+    bool resolved;
+    double radius;    /* k*h [m] */
+    double lambda;    /* Eq. 13 constant for the cosine force [m^(dim+2)] */
+} pfsph_pairwise_params;
+
+void pfsph_pairwise_defaults(pfsph_pairwise_params *p);
+
+/* The pair force shape of Eq. 6: cos(3 pi r / (2 R)) for r <= R, 0 beyond (R = k h). Positive
+ * (repulsive) below R/3, negative (attractive) between R/3 and R. */
+double pfsph_pairwise_shape(double r, double R);
+
+/* lambda of Eq. 13 for the cosine force over radius R, from the Kirkwood-Buff integral for a
+ * step density profile (docs/pairwise.md): sigma = lambda * c * n^2 m^2 = lambda c rho^2.
+ * 3D: (pi/8) R^5 (U^4 - 12 U^2 + 24) / U^5; 2D: (1/3) R^4 (U^3 - 6 U - 6) / U^4; U = 3 pi / 2. */
+double pfsph_pairwise_lambda(int dim, double R);
+
+/* ---- diffuse material (physics/diffuse.c, include/pfsph/diffuse.h) ---- */
+
+/* Diffuse particle types, stored in pfsph_particles.phase. */
+enum pfsph_diffuse_type { PFSPH_DIFFUSE_SPRAY = 0, PFSPH_DIFFUSE_FOAM = 1,
+                          PFSPH_DIFFUSE_BUBBLE = 2, PFSPH_DIFFUSE_NTYPES = 3 };
+
+/* Per-type weights of Eq. 24 and Eq. 29. */
+typedef struct pfsph_diffuse_coupling {
+    double k_ext; /* weight of gravity g dt [-] */
+    double k_b;   /* buoyancy: adds -k_b g dt [-]; a bubble rises when k_b > k_ext */
+    double k_cp;  /* fraction of (v_fluid - v_d) applied per step, in [0, 1] [-] */
+    double k_t;   /* lifetime falls by k_t dt per step [-] */
+} pfsph_diffuse_coupling;
+
+typedef struct pfsph_diffuse_params {
+    bool enabled;
+    long max_particles;    /* cap on live diffuse particles; new ones are refused beyond it */
+    double sampling_rate;  /* k_max of Eq. 16 [1/s]: particles per second per emitter at R_D=1 */
+    double phi_v_min, phi_v_max; /* Eq. 14 limits for v_diff of Eq. 13 [m/s] */
+    double phi_e_min, phi_e_max; /* Eq. 14 limits for E of Eq. 9 [J] */
+    double energy_mass;    /* mass in Eq. 9 [kg]; 0: the fluid particle's own mass */
+    double emit_radius;    /* cylinder radius r of Eq. 19 [m]; 0: the particle radius */
+    double emit_radius_scale; /* s_r (paper's k_r magnification, NOTES 16) [-] */
+    double emit_height_scale; /* s_h (paper's k_h magnification) [-] */
+    double lifetime_min, lifetime_max; /* initial lifetime uniform in [min, max] [s] */
+    int foam_min_neighbors; /* fewer fluid neighbours within h: spray; -1: automatic */
+    int foam_max_neighbors; /* more: bubble; -1: automatic (NOTES 18) */
+    pfsph_diffuse_coupling type[PFSPH_DIFFUSE_NTYPES]; /* spray, foam, bubble */
+} pfsph_diffuse_params;
+
+/* Defaults: docs/diffuse.md (the paper's Section 6 values where it gives them). */
+void pfsph_diffuse_defaults(pfsph_diffuse_params *p);
+
+/* Thresholds after resolving the automatic (-1) ones for a kernel support h and spacing d in
+ * dim dimensions: 0.2 and 2/3 of the fluid neighbour count of a full support (the paper's 6 and
+ * 20 of 30). */
+void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing,
+                              int *foam_min, int *foam_max);
+
+#endif

@@ -1,0 +1,65 @@
+/* The pressure-solver interface. A solver is a table of functions that the time step calls
+ * (src/sim.c walks its stage table and calls these at fixed points); solvers are found by the
+ * scene's solver name in one table (solver.c). Adding a solver: docs/architecture.md. */
+#ifndef PFSPH_SOLVER_H
+#define PFSPH_SOLVER_H
+
+#include "pfsph/ctx.h"
+
+/* The scene's solver settings, resolved by the simulation (sound speed chosen, pressure
+ * scale decided), so that a solver reads no scene. */
+typedef struct pfsph_solver_config {
+    double sound_speed; /* c [m/s] of the densest phase (scene value or automatic) */
+    double c_fast;      /* sound speed of the lightest phase (= sound_speed unless rho_common) */
+    double gamma;       /* Tait exponent */
+    double rho_common;  /* > 0: one Tait pressure scale for all phases [kg/m^3]; 0: per phase */
+    double tolerance;   /* average relative density error a solve stops at (PCISPH) */
+    int min_iter, max_iter;
+    double cfl;
+} pfsph_solver_config;
+
+/* What one solve reports (stats.csv columns). */
+typedef struct pfsph_solve_stats {
+    int iterations;         /* density (pressure) iterations of this step */
+    int div_iterations;     /* iterations of a pre_forces solve (divergence-free solvers) */
+    double density_err_avg; /* mean compression (rho - rho0) / rho0, compressed side only */
+} pfsph_solve_stats;
+
+typedef struct pfsph_solver_ops {
+    const char *name;      /* as in the scene's solver.type */
+    int nscratch;          /* per-fluid-particle scratch arrays the solver needs */
+    const char *hint;      /* likely cause of a blow-up under this solver, for the message */
+    /* Solver state for the fluid of ctx; NULL state is allowed. */
+    int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg,
+                  pfsph_error *err);
+    void (*destroy)(void *state); /* NULL is a no-op */
+    /* Optional (may be NULL): called after the density stage and the choice of ctx->dt, before
+     * the non-pressure forces: where a divergence-free solver (DFSPH) corrects the velocities. */
+    void (*pre_forces)(void *state, const pfsph_ctx *ctx, pfsph_real *const *scratch,
+                       pfsph_solve_stats *out);
+    /* Pressure accelerations a_p for the step ctx->dt, given ctx->nd (number density at x),
+     * ctx->ax.. (non-pressure accelerations); writes fluid->p and ap[0..2]; the integrator then
+     * applies v += dt (a + a_p), x += dt v. */
+    void (*solve)(void *state, const pfsph_ctx *ctx, pfsph_real *const ap[3],
+                  pfsph_real *const *scratch, pfsph_solve_stats *out);
+    /* Largest time step the solver allows [s], from the largest speed vmax of the fluid and
+     * bodies [m/s] and last step's largest total and non-pressure accelerations [m/s^2]. The
+     * simulation adds dt_max, viscous diffusion and the landing on frame times. */
+    double (*dt_limit)(const void *state, const pfsph_ctx *ctx, double vmax, double amax,
+                       double amax_np);
+    /* Speeds above this are a blow-up [m/s]. */
+    double (*speed_bound)(const void *state);
+} pfsph_solver_ops;
+
+/* The solver called name, or NULL. */
+const pfsph_solver_ops *pfsph_solver_find(const char *name);
+/* The i-th solver of the table (NULL past the end): for listings and tests. */
+const pfsph_solver_ops *pfsph_solver_at(int i);
+
+extern const pfsph_solver_ops pfsph_solver_wcsph, pfsph_solver_pcisph;
+
+/* Shared by the solvers: the force criterion 0.25 sqrt(d / a) (Monaghan 1992), infinite for a
+ * = 0. */
+double pfsph__dt_force(double spacing, double a);
+
+#endif

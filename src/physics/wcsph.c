@@ -1,0 +1,73 @@
+/* Weakly compressible SPH: pressure from the Tait equation (DF Eq. 3), one force evaluation
+ * per step, time step limited by the sound speed (Monaghan 1994; Becker & Teschner 2007). */
+#include <math.h>
+#include <stdlib.h>
+
+#include "core/reduce.h"
+#include "physics/eos.h"
+#include "physics/pressure.h"
+#include "physics/solver.h"
+
+typedef struct wcsph {
+    double B, gamma, rho_common; /* Tait: p = B rho0 ((rho/rho0)^gamma - 1), B = c^2 / gamma */
+    double c, c_fast, cfl;
+} wcsph;
+
+static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg, pfsph_error *err)
+{
+    (void)ctx;
+    wcsph *w = calloc(1, sizeof *w);
+    if (!w) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    w->c = cfg->sound_speed;
+    w->gamma = cfg->gamma;
+    w->B = cfg->sound_speed * cfg->sound_speed / cfg->gamma;
+    w->rho_common = cfg->rho_common;
+    w->c_fast = cfg->c_fast;
+    w->cfl = cfg->cfl;
+    *state = w;
+    return PFSPH_OK;
+}
+
+static void destroy(void *state) { free(state); }
+
+static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsph_real *const *scr,
+                  pfsph_solve_stats *out)
+{
+    const wcsph *w = state;
+    pfsph_particles *f = c->fluid;
+    const size_t n = f->n;
+    pfsph__tait(c, c->nd, w->B, w->gamma, w->rho_common, f->p);
+    pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, f->p, ap[0], ap[1], ap[2]);
+    pfsph_real *er = scr[0];
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        pfsph_real e = c->nd[i] / c->nd0 - 1;
+        er[i] = e > 0 ? e : 0;
+    }
+    out->density_err_avg = n ? pfsph__sum(er, n) / (double)n : 0;
+    out->iterations = 0;
+}
+
+/* acoustic CFL with the fastest sound speed, and the force criterion on the total acceleration */
+static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, double amax, double amax_np)
+{
+    (void)amax_np;
+    const wcsph *w = state;
+    const double d = ctx->spacing;
+    double dt = INFINITY, vsig = vmax + w->c_fast;
+    if (vsig > 0) dt = w->cfl * d / vsig;
+    return fmin(dt, pfsph__dt_force(d, amax));
+}
+
+static double speed_bound(const void *state) { return ((const wcsph *)state)->c; }
+
+const pfsph_solver_ops pfsph_solver_wcsph = {
+    .name = "wcsph",
+    .nscratch = 1,
+    .hint = "the time step is too large for the stiffness: lower time.cfl or dt_max, or raise solver.sound_speed",
+    .create = create,
+    .destroy = destroy,
+    .solve = solve,
+    .dt_limit = dt_limit,
+    .speed_bound = speed_bound,
+};
