@@ -27,7 +27,7 @@ const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
 
 /* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
-#define SCR_MAX (SCR_COMMON + 8)
+#define SCR_MAX (SCR_COMMON + 10)
 
 /* What a stage that found a blow-up reports; the step turns it into the one message format. */
 typedef struct blowup_info {
@@ -346,6 +346,8 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     cfg->tolerance = s->pcisph_tolerance;
     cfg->min_iter = s->pcisph_min_iter;
     cfg->max_iter = s->pcisph_max_iter;
+    cfg->div_tolerance = s->div_tolerance;
+    cfg->div_max_iter = s->div_max_iter;
     cfg->cfl = s->cfl;
     if ((rc = sim->solver->create(&sim->solver_state, c, cfg, err))) goto fail;
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
@@ -572,7 +574,10 @@ static int st_body_forces(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     (void)bad;
     (void)err;
-    pfsph_bodies_fluid_forces(sim->bodies, &sim->ctx);
+    const pfsph_real *p = sim->solver->wall_pressure
+                              ? sim->solver->wall_pressure(sim->solver_state, &sim->ctx, sim->scr + SCR_COMMON)
+                              : sim->fluid.p;
+    pfsph_bodies_fluid_forces(sim->bodies, &sim->ctx, p);
     return PFSPH_OK;
 }
 

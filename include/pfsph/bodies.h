@@ -31,11 +31,11 @@ int pfsph_bodies_count(const pfsph_bodies *b);
  * particles are not created inside bodies. */
 double pfsph_bodies_distance(const pfsph_bodies *b, int i, const double p[3]);
 
-/* The forces the fluid exerts on every body particle this step (pressure p and number density
- * nd of the fluid at the current positions, viscous friction with ctx->nu), summed into
+/* The forces the fluid exerts on every body particle this step (pressure p of the fluid,
+ * whose wall term it felt this step (the solver's wall pressure), and number density nd at the current positions, viscous friction with ctx->nu), summed into
  * each body's force and torque: exactly the opposite of what the fluid receives from the body
  * particles in pfsph__pressure_accel and pfsph__nonpressure. */
-void pfsph_bodies_fluid_forces(pfsph_bodies *b, const pfsph_ctx *ctx);
+void pfsph_bodies_fluid_forces(pfsph_bodies *b, const pfsph_ctx *ctx, const pfsph_real *p);
 
 /* Advance the bodies from t to t + dt with the fluid forces, gravity and contacts; move their
  * particles (positions and velocities) in `boundary`. */

@@ -17,7 +17,7 @@
 #define PFSPH_MAX_KEYFRAMES 16
 
 /* Pressure solvers (src/physics/solver.h); names as in the scene: pfsph_scene_solver_name. */
-enum pfsph_solver { PFSPH_SOLVER_WCSPH = 0, PFSPH_SOLVER_PCISPH = 1 };
+enum pfsph_solver { PFSPH_SOLVER_WCSPH = 0, PFSPH_SOLVER_PCISPH = 1, PFSPH_SOLVER_DFSPH = 2 };
 enum pfsph_shape {
     PFSPH_SHAPE_BOX = 0,
     PFSPH_SHAPE_SPHERE,    /* a disc in 2D */
@@ -133,9 +133,13 @@ typedef struct pfsph_scene {
     double sound_speed;        /* m/s; 0 = automatic (10 x estimated max speed) */
     double gamma;              /* Tait exponent, default 7 */
     int pressure_scale;        /* enum pfsph_pressure_scale: the Tait pressure's rho0 */
-    /* PCISPH */
-    double pcisph_tolerance;   /* average relative density error, default 0.005 */
+    /* PCISPH and DFSPH density solve */
+    double pcisph_tolerance;   /* average relative density error; default 0.005 (PCISPH),
+                                  0.001 (DFSPH) */
     int pcisph_min_iter, pcisph_max_iter;
+    /* DFSPH divergence solve */
+    double div_tolerance;      /* mean |D delta/Dt| dt / delta0, default 0.001 */
+    int div_max_iter;          /* 0: no divergence solve; default 100 */
     /* phases */
     int nphases;
     pfsph_phase phases[PFSPH_MAX_PHASES];
@@ -164,7 +168,7 @@ int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err);
 /* The embedded default scene (a small 3D dam break against an obstacle), as JSON text. */
 const char *pfsph_scene_default_json(void);
 
-/* The solver's name as the scene writes it ("wcsph", "pcisph"). */
+/* The solver's name as the scene writes it ("wcsph", "pcisph", "dfsph"). */
 const char *pfsph_scene_solver_name(const pfsph_scene *s);
 
 /* Index of the phase called name, or -1. */

@@ -22,7 +22,7 @@ typedef struct pfsph_step_stats {
     double density_err_avg; /* mean of (rho - rho0) / rho0 over fluid, compressed side only */
     double density_err_max;
     double ekin;            /* J */
-    int iterations;         /* pressure iterations of the last step (PCISPH) */
+    int iterations;         /* pressure iterations of the last step (PCISPH, DFSPH density solve) */
     int div_iterations;     /* divergence-solve iterations of the last step (0 without one) */
 } pfsph_step_stats;
 

@@ -83,6 +83,10 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
     h_f64(h, s->pcisph_tolerance);
     h_int(h, s->pcisph_min_iter);
     h_int(h, s->pcisph_max_iter);
+    if (s->solver == PFSPH_SOLVER_DFSPH) { /* only then, so that older checkpoints stay resumable */
+        h_f64(h, s->div_tolerance);
+        h_int(h, s->div_max_iter);
+    }
     h_int(h, s->nphases);
     for (int i = 0; i < s->nphases && i < PFSPH_MAX_PHASES; i++) {
         const pfsph_phase *p = &s->phases[i];

@@ -712,7 +712,7 @@ double pfsph_bodies_distance(const pfsph_bodies *B, int i, const double p[3])
 /* ------------------------------------------------------------------------------------------ */
 /* Coupling. */
 
-void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
+void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsph_real *p)
 {
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
@@ -748,7 +748,7 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx)
                 if (r2 >= h2) continue;
                 pfsph_real dw = pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
                 pfsph_real s = 0;
-                const pfsph_real pi = f->p[i] / (ctx->nd[i] * ctx->nd[i]);
+                const pfsph_real pi = p[i] / (ctx->nd[i] * ctx->nd[i]);
                 if (pi > 0) s += pi * inv_v0 * vol * dw; /* pressure: -F_i of Akinci Eq. 10 */
                 const pfsph_real nui = ctx->nu[f->phase[i]];
                 if (nui > 0) {

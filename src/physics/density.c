@@ -35,3 +35,43 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
         nd[i] = s;
     }
 }
+
+void pfsph__number_density_rate(const pfsph_ctx *ctx, const pfsph_real *vx, const pfsph_real *vy,
+                                const pfsph_real *vz, pfsph_real *rate)
+{
+    const pfsph_kernel *k = &ctx->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
+    const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
+    const size_t n = f->n;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        pfsph_ranges r;
+        const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+        const pfsph_real vxi = vx[i], vyi = vy[i], vzi = vz[i];
+        pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+        pfsph_real s = 0;
+        for (int q = 0; q < r.n; q++)
+            for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+                if (r2 >= h2 || j == i) continue;
+                pfsph_real vd = (vxi - vx[j]) * dx + (vyi - vy[j]) * dy + (vzi - vz[j]) * dz;
+                s += vd * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+            }
+        if (b->n) {
+            pfsph_real sb = 0;
+            pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
+            for (int q = 0; q < r.n; q++)
+                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+                    pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
+                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+                    if (r2 >= h2) continue;
+                    pfsph_real vd = (vxi - b->vx[j]) * dx + (vyi - b->vy[j]) * dy + (vzi - b->vz[j]) * dz;
+                    sb += b->aux[j] * vd * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                }
+            s += sb * inv_v0;
+        }
+        rate[i] = s;
+    }
+}

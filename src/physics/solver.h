@@ -13,8 +13,10 @@ typedef struct pfsph_solver_config {
     double c_fast;      /* sound speed of the lightest phase (= sound_speed unless rho_common) */
     double gamma;       /* Tait exponent */
     double rho_common;  /* > 0: one Tait pressure scale for all phases [kg/m^3]; 0: per phase */
-    double tolerance;   /* average relative density error a solve stops at (PCISPH) */
+    double tolerance;   /* average relative density error a solve stops at (PCISPH, DFSPH) */
     int min_iter, max_iter;
+    double div_tolerance; /* DFSPH: mean |D delta / Dt| dt / delta0 the divergence solve stops at */
+    int div_max_iter;     /* DFSPH: 0 switches the divergence solve off */
     double cfl;
 } pfsph_solver_config;
 
@@ -42,6 +44,10 @@ typedef struct pfsph_solver_ops {
      * applies v += dt (a + a_p), x += dt v. */
     void (*solve)(void *state, const pfsph_ctx *ctx, pfsph_real *const ap[3],
                   pfsph_real *const *scratch, pfsph_solve_stats *out);
+    /* Optional (may be NULL: fluid->p): the pressure whose wall term (Akinci 2012) the fluid
+     * felt this step, for the reaction on rigid bodies; called after solve. DFSPH returns the
+     * sum of its divergence and density pressures. */
+    const pfsph_real *(*wall_pressure)(void *state, const pfsph_ctx *ctx, pfsph_real *const *scratch);
     /* Largest time step the solver allows [s], from the largest speed vmax of the fluid and
      * bodies [m/s] and last step's largest total and non-pressure accelerations [m/s^2]. The
      * simulation adds dt_max, viscous diffusion and the landing on frame times. */
@@ -56,7 +62,7 @@ const pfsph_solver_ops *pfsph_solver_find(const char *name);
 /* The i-th solver of the table (NULL past the end): for listings and tests. */
 const pfsph_solver_ops *pfsph_solver_at(int i);
 
-extern const pfsph_solver_ops pfsph_solver_wcsph, pfsph_solver_pcisph;
+extern const pfsph_solver_ops pfsph_solver_wcsph, pfsph_solver_pcisph, pfsph_solver_dfsph;
 
 /* Shared by the solvers: the force criterion 0.25 sqrt(d / a) (Monaghan 1992), infinite for a
  * = 0. */

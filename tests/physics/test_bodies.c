@@ -1,4 +1,4 @@
-/* Rigid bodies in water (2D, WCSPH): Archimedes' principle for a floating box, a heavy box at
+/* Rigid bodies in water (2D, WCSPH; Archimedes also with DFSPH): Archimedes' principle for a floating box, a heavy box at
  * rest on the floor, a dense disc that sinks and comes to rest, and momentum exchanged between
  * fluid and body without loss. */
 #include <math.h>
@@ -13,7 +13,7 @@
 static const char *TANK =
     "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, %g],"
     " \"domain\": {\"min\": [-0.05, -0.05], \"max\": [0.85, 0.55]},"
-    " \"solver\": {\"type\": \"wcsph\"}, \"time\": {\"end\": 5, \"fps\": 20},"
+    " \"solver\": {\"type\": \"%s\"}, \"time\": {\"end\": 5, \"fps\": 20},"
     " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": %g},"
     "              {\"name\": \"wall\", \"kind\": \"solid\"},"
     "              {\"name\": \"body\", \"kind\": \"solid\", \"rest_density\": 1000}],"
@@ -21,11 +21,13 @@ static const char *TANK =
     " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.8, 0.5], \"phase\": \"wall\"}],"
     " \"bodies\": [%s]%s}";
 
+static const char *g_solver = "wcsph"; /* of TANK */
+
 static pfsph_sim *make_x(double g, double nu, const char *fluid, const char *body, const char *extra)
 {
     static char json[4096];
     static pfsph_scene s;
-    snprintf(json, sizeof json, TANK, g, nu, fluid, body, extra);
+    snprintf(json, sizeof json, TANK, g, g_solver, nu, fluid, body, extra);
     pfsph_error err = {0};
     int rc = pfsph_scene_parse(&s, json, "bodies", &err);
     if (rc) fprintf(stderr, "%s\n", err.msg);
@@ -89,6 +91,14 @@ static void test_archimedes(void **state)
     assert_true(fabs(frac - 0.5) < 0.05);
     assert_true(tilt_max < 10 * 3.14159265358979 / 180);
     pfsph_sim_destroy(sim);
+}
+
+/* The same with DFSPH: the body feels the density solve's pressure (two-way coupling) */
+static void test_archimedes_dfsph(void **state)
+{
+    g_solver = "dfsph";
+    test_archimedes(state);
+    g_solver = "wcsph";
 }
 
 /* A box twice as dense as water resting on the tank floor under water stays put: it starts
@@ -244,6 +254,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_momentum),
         cmocka_unit_test(test_momentum_pairwise),
         cmocka_unit_test(test_archimedes),
+        cmocka_unit_test(test_archimedes_dfsph),
         cmocka_unit_test(test_rest_on_floor),
         cmocka_unit_test(test_sinking_disc),
         cmocka_unit_test(test_left_domain_feels_nothing),

@@ -1,5 +1,5 @@
 /* 2D dam break: mass is conserved, no particle reaches a wall's boundary particles (or gets a
- * quarter spacing past its face), the average density error stays below 1%, for both solvers;
+ * quarter spacing past its face), the average density error stays below 1%, for each solver;
  * and the same scene gives identical bits with 1 and 2 threads. */
 #include <math.h>
 #include <omp.h>
@@ -76,12 +76,13 @@ static void run(const char *solver, double limit)
 
 static void test_wcsph(void **state) { (void)state; run("wcsph", 0.01); }
 static void test_pcisph(void **state) { (void)state; run("pcisph", 0.01); }
+static void test_dfsph(void **state) { (void)state; run("dfsph", 0.01); }
 
 static void test_threads_identical(void **state)
 {
     (void)state;
-    const char *solvers[2] = {"wcsph", "pcisph"};
-    for (int s = 0; s < 2; s++) {
+    const char *solvers[3] = {"wcsph", "pcisph", "dfsph"};
+    for (int s = 0; s < 3; s++) {
         pfsph_sim *a, *b;
         pfsph_error err = {0};
         omp_set_num_threads(1);
@@ -105,6 +106,7 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_wcsph), cmocka_unit_test(test_pcisph),
+                                       cmocka_unit_test(test_dfsph),
                                        cmocka_unit_test(test_threads_identical)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -115,17 +115,20 @@ static void run_bubble(const char *solver)
 
 static void test_pcisph(void **state) { (void)state; run_bubble("pcisph"); }
 static void test_wcsph(void **state) { (void)state; run_bubble("wcsph"); }
+static void test_dfsph(void **state) { (void)state; run_bubble("dfsph"); }
 
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
 #ifdef __SANITIZE_ADDRESS__
     /* The sanitizer build (CI's asan preset, ~4x slower) runs PCISPH only; the release run
-     * checks both solvers. */
+     * checks all three solvers. */
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_pcisph)};
     (void)test_wcsph;
+    (void)test_dfsph;
 #else
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_pcisph), cmocka_unit_test(test_wcsph)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_pcisph), cmocka_unit_test(test_wcsph),
+                                       cmocka_unit_test(test_dfsph)};
 #endif
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

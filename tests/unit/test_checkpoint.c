@@ -117,6 +117,14 @@ static void test_roundtrip_wcsph(void **st)
     roundtrip("wcsph");
 }
 
+/* DFSPH keeps state between steps in particle fields (pressure: warm start; aux: divergence
+ * pressure): a resumed run must carry it */
+static void test_roundtrip_dfsph(void **st)
+{
+    (void)st;
+    roundtrip("dfsph");
+}
+
 static unsigned char *slurp(const char *path, size_t *len)
 {
     FILE *f = fopen(path, "rb");
@@ -336,6 +344,7 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_roundtrip_pcisph), cmocka_unit_test(test_roundtrip_wcsph),
+        cmocka_unit_test(test_roundtrip_dfsph),
         cmocka_unit_test(test_corrupt_and_truncated), cmocka_unit_test(test_other_scene),
         cmocka_unit_test(test_keep_and_fallback), cmocka_unit_test(test_scene_key),
     };

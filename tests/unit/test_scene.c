@@ -505,7 +505,7 @@ static const bad_case bad_cases[] = {
     {"dt_min_gt_dt_max", SCENE3(",\"time\":{\"dt_min\":0.01,\"dt_max\":0.001}"), "$.time.dt_min",
      "dt_min (0.01 s) is greater than dt_max (0.001 s)"},
     {"solver_unknown", SCENE3(",\"solver\":{\"type\":\"iisph\"}"), "$.solver.type",
-     "unknown value \"iisph\" (expected one of \"wcsph\", \"pcisph\")"},
+     "unknown value \"iisph\" (expected one of \"wcsph\", \"pcisph\", \"dfsph\")"},
     {"solver_pressure_scale", SCENE3(",\"solver\":{\"pressure_scale\":\"water\"}"),
      "$.solver.pressure_scale", "unknown value"},
     {"solver_iterations", SCENE3(",\"solver\":{\"min_iterations\":10,\"max_iterations\":5}"),

@@ -39,7 +39,7 @@ static void every_scene_solver_runs(void **state)
         pfsph_sim_destroy(sim);
         found++;
     }
-    assert_int_equal(found, 2); /* wcsph, pcisph */
+    assert_int_equal(found, 3); /* wcsph, pcisph, dfsph */
     assert_null(pfsph_solver_find("iisph"));
     assert_null(pfsph_solver_find(NULL));
     assert_null(pfsph_solver_at(-1));
