@@ -179,4 +179,8 @@ int pfsph_scene_phase_index(const pfsph_scene *s, const char *name);
 /* Smallest and largest rest density of the fluid and gas phases; returns 0 when there is none. */
 int pfsph_scene_density_range(const pfsph_scene *s, double *lo, double *hi);
 
+/* The most frames (of 1/fps) one run holds: an end time x fps above it is refused (scene and
+ * pfsph_run), and so is a checkpoint whose frame is above it. */
+#define PFSPH_MAX_FRAMES 100000000
+
 #endif
