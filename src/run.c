@@ -274,6 +274,10 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     char path[PFSPH_PATH_LEN + 64];
     int rc;
     double w0 = omp_get_wtime();
+    /* the frame count fits an int (and the file names): refused before anything is written */
+    if (!isfinite(end) || !(end >= 0) || floor(end * s->fps + 1e-9) > PFSPH_MAX_FRAMES)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: end time %g s at %g fps ($.time.fps) makes %.3g frames, more "
+                          "than the %d one run holds", s->source, end, s->fps, end * s->fps, PFSPH_MAX_FRAMES);
     if ((rc = pfsph_mkdirs(dir, err))) return rc;
     snprintf(path, sizeof path, "%s/frames", dir);
     if ((rc = pfsph_mkdirs(path, err))) return rc;

@@ -1,6 +1,7 @@
 /* The pfsph program: run, check, render, bench. Parses the command line, prints progress and
  * errors, maps library status codes to exit statuses (2 bad input, 3 unstable, 1 other). */
 #include <errno.h>
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -172,7 +173,8 @@ static int cmd_run(int argc, char **argv)
             char *e;
             if (++i >= argc) return usage_error("%s needs a time in seconds", a);
             end = strtod(argv[i], &e);
-            if (*e || !(end >= 0)) return usage_error("--end: '%s' is not a time >= 0", argv[i]);
+            if (*e || e == argv[i] || !(end >= 0) || !isfinite(end))
+                return usage_error("--end: '%s' is not a finite time >= 0", argv[i]);
         } else if (!strcmp(a, "--resume")) {
             if (++i >= argc) return usage_error("%s needs a run directory", a);
             resume = argv[i];
@@ -200,6 +202,11 @@ static int cmd_run(int argc, char **argv)
     static pfsph_scene s;
     char *text = NULL;
     int rc = load_scene(scene_path, &s, &text);
+    if (!rc && end >= 0 && floor(end * s.fps + 1e-9) > PFSPH_MAX_FRAMES) {
+        fprintf(stderr, "pfsph: --end %g: at %g fps ($.time.fps of %s) that makes %.3g frames, more than the %d "
+                "one run holds\n", end, s.fps, s.source, end * s.fps, PFSPH_MAX_FRAMES);
+        rc = 2;
+    }
     if (!rc) rc = check_memory(&s, 0);
     if (rc) {
         free(text);

@@ -334,6 +334,10 @@ static int parse_time(parser *p, const cJSON *root)
         return pfsph__json_fail(&p->ctx, "$.time.dt_min",
                                 "dt_min (%g s) is greater than dt_max (%g s)", s->dt_min,
                                 s->dt_max);
+    if (s->end_time * s->fps > PFSPH_MAX_FRAMES)
+        return pfsph__json_fail(&p->ctx, "$.time.end",
+                                "end %g s at %g fps makes %.3g frames, more than the %d one run "
+                                "holds", s->end_time, s->fps, s->end_time * s->fps, PFSPH_MAX_FRAMES);
     return PFSPH_OK;
 }
 

@@ -32,6 +32,10 @@ static const cli_case cases[] = {
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]},{\"shape\":\"box\",\"min\":[0.1,0.1,0.1],"
      "\"max\":[0.3,0.3,0.3]}]}",
      "$.fluid[1]: overlaps $.fluid[0]"},
+    {"frames.json", /* issue 15 item 4: end x fps overflowed the frame count */
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"time\":{\"end\":1e6,\"fps\":1e4}}",
+     "$.time.end: end 1e+06 s at 10000 fps makes 1e+10 frames, more than the 100000000 one run holds"},
 };
 #define NCASES (sizeof cases / sizeof cases[0])
 
@@ -101,6 +105,28 @@ static void test_run_bad_writes_nothing(void **state)
     assert_string_equal(out, "keep me\n");
 }
 
+/* Issue 15 item 4: `--end 1e10` (or inf) overflowed the frame count: the run exited 0 with
+ * nothing simulated. Refused with exit 2, before the run directory is created. */
+static void test_run_end_overflow(void **state)
+{
+    (void)state;
+    char path[512], dir[600], cmd[2048], out[4096];
+    snprintf(path, sizeof path, "%s/small.json", tu_tmpdir());
+    assert_int_equal(tu_write_file(path, "{\"dimension\":2,\"particle_radius\":0.02,"
+                                         "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
+                                         "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"), 0);
+    static const char *const ends[] = {"1e10", "inf", "nan", "1e300", "-1", ""};
+    for (size_t i = 0; i < sizeof ends / sizeof ends[0]; i++) {
+        snprintf(dir, sizeof dir, "%s/end_run_%zu", tu_tmpdir(), i);
+        snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet --end '%s'", tu_pfsph_bin(), path, dir, ends[i]);
+        int st = tu_run(cmd, out, sizeof out);
+        if (st != 2) fail_msg("--end '%s': exit status %d, expected 2; output: %s", ends[i], st, out);
+        if (!strstr(out, "--end")) fail_msg("--end '%s': the message does not name --end: %s", ends[i], out);
+        struct stat sb;
+        assert_int_not_equal(stat(dir, &sb), 0);
+    }
+}
+
 /* The shipped example scenes pass `pfsph check`. */
 static void test_check_good(void **state)
 {
@@ -123,6 +149,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_check_bad),
         cmocka_unit_test(test_check_missing_file),
         cmocka_unit_test(test_run_bad_writes_nothing),
+        cmocka_unit_test(test_run_end_overflow),
         cmocka_unit_test(test_check_good),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
