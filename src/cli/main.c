@@ -158,7 +158,7 @@ static int cmd_run(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *resume = NULL;
     double end = -1;
-    int threads = 0, render = 0, quiet = 0;
+    int threads = 0, render = 0, quiet = 0, force = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
@@ -182,6 +182,8 @@ static int cmd_run(int argc, char **argv)
             render = 1;
         } else if (!strcmp(a, "--quiet")) {
             quiet = 1;
+        } else if (!strcmp(a, "--force")) {
+            force = 1;
         } else if (a[0] == '-') {
             return usage_error("unknown option '%s'", a);
         } else if (!scene_path) {
@@ -194,6 +196,7 @@ static int cmd_run(int argc, char **argv)
     if (resume) {
         if (scene_path) return usage_error("--resume takes the scene from RUN_DIR/scene.json, not '%s'", scene_path);
         if (out) return usage_error("--resume writes into RUN_DIR; drop '%s'", out);
+        if (force) return usage_error("%s", "--force is for a fresh run; --resume continues the run in RUN_DIR");
         if ((size_t)snprintf(resume_scene, sizeof resume_scene, "%s/scene.json", resume) >= sizeof resume_scene)
             return usage_error("--resume: path too long: '%s'", resume);
         scene_path = resume_scene;
@@ -213,11 +216,12 @@ static int cmd_run(int argc, char **argv)
         return rc;
     }
     if (!scene_path) render = 1;
+    if (!scene_path && !out) force = 1; /* the embedded demo into its own directory: rerunnable */
     if (threads > 0) omp_set_num_threads(threads);
     else if (s.threads > 0) omp_set_num_threads(s.threads);
     progress_state ps = {isatty(2), quiet};
     pfsph_run_opts o = {.out_dir = out, .end_time = end, .scene_text = text, .progress = show_progress, .user = &ps,
-                        .resume = resume != NULL, .message = show_message};
+                        .resume = resume != NULL, .message = show_message, .force = force};
     const char *dir = out ? out : s.output.dir;
     if (!quiet) fprintf(stderr, "pfsph %s: %s -> %s (%d threads)%s\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads(),
                         resume ? ", resuming" : "");
