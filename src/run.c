@@ -345,7 +345,7 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
     double t = pfsph_sim_time(sim);
     int rc = write_set(s, dir, "fluid", frame, c->fluid, NULL, t, err);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
-    if (!rc && frame == 0 && c->boundary->n) {
+    if (!rc && frame == 0 && c->boundary->n && s->output.write_boundary) {
         if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
         else /* the static part; body particles go to bodies_NNNNN every frame */
             rc = write_boundary_part(s, dir, "boundary", frame, c->boundary, pfsph_bodies_first_id(B), false,

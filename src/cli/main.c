@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "pfsph/bodies.h"
@@ -44,10 +45,47 @@ static int usage_error(const char *fmt, const char *arg)
     return 2;
 }
 
+/* Messages carry what the input said (keys, names, file names): a control byte or a byte
+ * that is not part of valid UTF-8 is written as \xNN, so random input cannot drive the
+ * terminal. */
+static void put_escaped(FILE *f, const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        int len = *p < 0x80 ? 1 : (*p & 0xe0) == 0xc0 ? 2 : (*p & 0xf0) == 0xe0 ? 3 : (*p & 0xf8) == 0xf0 ? 4 : 0;
+        int ok = len > 0 && !(len == 1 && (*p < 0x20 || *p == 0x7f) && *p != '\n' && *p != '\t');
+        for (int k = 1; ok && k < len; k++) ok = (p[k] & 0xc0) == 0x80;
+        if (ok && len == 2 && *p < 0xc2) ok = 0; /* overlong */
+        if (!ok) {
+            fprintf(f, "\\x%02x", *p++);
+            continue;
+        }
+        fwrite(p, 1, (size_t)len, f);
+        p += len;
+    }
+}
+
+/* "pfsph: <prefix><msg>" on stderr, escaped. */
+static void print_error(const char *prefix, const char *msg)
+{
+    fputs("pfsph: ", stderr);
+    if (prefix) fputs(prefix, stderr);
+    put_escaped(stderr, msg);
+    fputc('\n', stderr);
+}
+
+/* The whole file as a C string; NULL with errno set (EISDIR for a directory, EILSEQ for a
+ * NUL byte, which no scene file holds). */
 static char *read_text(const char *path)
 {
     FILE *f = fopen(path, "rb");
     if (!f) return NULL;
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        fclose(f);
+        errno = EISDIR;
+        return NULL;
+    }
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap);
     while (buf) {
@@ -65,8 +103,19 @@ static char *read_text(const char *path)
             cap *= 2;
         }
     }
+    int rerr = ferror(f) ? errno : 0;
     fclose(f);
+    if (buf && rerr) {
+        free(buf);
+        errno = rerr;
+        return NULL;
+    }
     if (buf) buf[n] = 0;
+    if (buf && memchr(buf, 0, n)) {
+        free(buf);
+        errno = EILSEQ;
+        return NULL;
+    }
     return buf;
 }
 
@@ -81,13 +130,17 @@ static int load_scene(const char *path, pfsph_scene *s, char **text)
     } else {
         *text = read_text(path);
         if (!*text) {
-            fprintf(stderr, "pfsph: %s: cannot read: %s\n", path, strerror(errno));
-            return 2;
+            char msg[PFSPH_PATH_LEN + 128];
+            if (errno == EISDIR) snprintf(msg, sizeof msg, "%s: is a directory, not a scene file", path);
+            else if (errno == EILSEQ) snprintf(msg, sizeof msg, "%s: not a scene file (it holds a NUL byte; scenes are JSON text)", path);
+            else snprintf(msg, sizeof msg, "%s: cannot read: %s", path, strerror(errno));
+            print_error(NULL, msg);
+            return errno == ENOMEM ? 1 : 2;
         }
         rc = pfsph_scene_parse(s, *text, path, &err);
     }
     if (rc) {
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     return 0;
@@ -105,7 +158,7 @@ static int check_memory(const pfsph_scene *s, int verbose)
     pfsph_error err = {0};
     int rc = pfsph_scene_estimate(s, &nf, &nb, &bytes, &err);
     if (rc) {
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     long mem = physical_memory();
@@ -230,7 +283,7 @@ static int cmd_run(int argc, char **argv)
     free(text);
     if (rc) {
         if (ps.tty && !quiet) fputc('\n', stderr);
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     if (render) {
@@ -240,7 +293,7 @@ static int cmd_run(int argc, char **argv)
         int count = 0;
         rc = pfsph_render_run(dir, &ro, &count, &err);
         if (rc) {
-            fprintf(stderr, "pfsph: render: %s\n", err.msg);
+            print_error("render: ", err.msg);
             return exit_code(rc);
         }
         if (!quiet) fprintf(stderr, "rendered %d frames into %s/png\n", count, dir);
@@ -257,8 +310,6 @@ static int cmd_check(int argc, char **argv)
     int rc = load_scene(argv[0], &s, &text);
     free(text);
     if (rc) return rc;
-    printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids\n", s.source, s.dim,
-           s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
     rc = check_memory(&s, 1);
     if (rc) return rc;
     double rho_lo, rho_hi;
@@ -299,11 +350,14 @@ static int cmd_check(int argc, char **argv)
         double d = 2 * s.particle_radius;
         rc = pfsph_pairwise_resolve(&s, (pfsph_real)d, (pfsph_real)(s.support_factor * d), &err);
         if (rc) {
-            fprintf(stderr, "pfsph: %s\n", err.msg);
+            print_error(NULL, err.msg);
             return exit_code(rc);
         }
         pfsph_pairwise_report(&s, stdout);
     }
+    /* the verdict last, once every check has passed */
+    printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids\n", s.source, s.dim,
+           s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
     return 0;
 }
 
@@ -331,7 +385,7 @@ static int cmd_render(int argc, char **argv)
     int count = 0;
     int rc = pfsph_render_run(dir, &o, &count, &err);
     if (rc) {
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     printf("rendered %d frames into %s/png\n", count, dir);
