@@ -17,15 +17,74 @@
 #include "pfsph/sim.h"
 
 static const char *USAGE =
-    "usage: pfsph run [SCENE] [-o DIR] [--threads N] [--end T] [--render] [--quiet]\n"
+    "usage: pfsph run [SCENE] [-o DIR] [--force] [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH]\n"
     "       pfsph --version\n"
-    "Without SCENE, `pfsph run` runs the embedded default scene (a small 3D dam break) into\n"
-    "./pfsph_default_run and renders PNG previews. --resume continues a run from the newest\n"
-    "valid checkpoint in RUN_DIR/checkpoints, with RUN_DIR/scene.json.\n";
+    "       pfsph help [COMMAND]    (or pfsph COMMAND --help)\n";
+
+static const char *HELP =
+    "pfsph: a particle fluid simulator (SPH) for scenes described in JSON.\n"
+    "\n"
+    "commands:\n"
+    "  run      simulate a scene into a run directory (frames, stats.csv, summary.json)\n"
+    "  check    validate a scene: particle counts, memory estimate, coefficients\n"
+    "  render   PNG previews (and an mp4) of a run directory's frames\n"
+    "  help     this text, or a command's: pfsph help run\n"
+    "  --version  the version, precision and OpenMP thread count\n"
+    "\n"
+    "Exit status: 0 done, 2 bad input (scene, options, run directory), 3 the simulation blew\n"
+    "up, 1 anything else (a full disk, out of memory). Scene keys: docs/scene-format.md.\n";
+
+static const char *HELP_RUN =
+    "usage: pfsph run [SCENE] [-o DIR] [--force] [--threads N] [--end T] [--render] [--quiet]\n"
+    "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
+    "\n"
+    "Simulate SCENE (a JSON file) into its run directory: frames/, stats.csv, summary.json,\n"
+    "scene.json, run.json, checkpoints/. Without SCENE, the embedded default scene (a small 3D\n"
+    "dam break) runs into ./pfsph_default_run and is rendered.\n"
+    "\n"
+    "  -o, --output DIR  run directory (default: the scene's output.directory)\n"
+    "  --force           the run directory is not empty: remove pfsph's files there first\n"
+    "                    (frames, checkpoints, PNGs, stats; nothing else) instead of refusing\n"
+    "  --resume RUN_DIR  continue a stopped run from its newest valid checkpoint, with\n"
+    "                    RUN_DIR/scene.json, to the end it was started with (RUN_DIR/run.json)\n"
+    "  --threads N       OpenMP threads, 1..1024; 0 = the default (the scene's \"threads\", else\n"
+    "                    OpenMP's)\n"
+    "  --end T           simulated end time [s], overrides the scene's time.end (and, with\n"
+    "                    --resume, the run's own end)\n"
+    "  --render          render PNG previews after the run (as `pfsph render`)\n"
+    "  --quiet           no progress, no messages but errors\n"
+    "  -h, --help        this text\n"
+    "\n"
+    "A run holds a lock on its directory: a second run into it is refused (exit status 2).\n"
+    "Exit status: 0 finished, 2 bad input, 3 unstable (the last good state is kept as a\n"
+    "checkpoint), 1 other errors.\n";
+
+static const char *HELP_CHECK =
+    "usage: pfsph check SCENE\n"
+    "\n"
+    "Validate SCENE without running it: every key (unknown keys, ranges, JSON paths in the\n"
+    "messages), the particle counts, the memory estimate against 80% of this machine's memory,\n"
+    "mesh files of bodies, density ratios, resolved pairwise coefficients. The verdict\n"
+    "(\"SCENE: valid ...\") is printed last. Exit status 0 valid, 2 not.\n"
+    "\n"
+    "  -h, --help  this text\n";
+
+static const char *HELP_RENDER =
+    "usage: pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure] [--size WxH]\n"
+    "\n"
+    "Render the frames of RUN_DIR/frames into RUN_DIR/png/frame_NNNNN.png with the scene's\n"
+    "camera (RUN_DIR/scene.json).\n"
+    "\n"
+    "  --video                 also RUN_DIR/frames.mp4 (needs ffmpeg on the PATH)\n"
+    "  --color-by FIELD        phase, speed, density or pressure (default: the scene camera's)\n"
+    "  --size WxH              image size in pixels, 16..16384 each (default: the camera's)\n"
+    "  -h, --help              this text\n";
+
+static int is_help(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h"); }
 
 static int exit_code(int rc)
 {
@@ -214,14 +273,18 @@ static int cmd_run(int argc, char **argv)
     int threads = 0, render = 0, quiet = 0, force = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+        if (is_help(a)) {
+            fputs(HELP_RUN, stdout);
+            return 0;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (++i >= argc) return usage_error("%s needs a directory", a);
             out = argv[i];
         } else if (!strcmp(a, "--threads")) {
             char *e;
             if (++i >= argc) return usage_error("%s needs a number", a);
             threads = (int)strtol(argv[i], &e, 10);
-            if (*e || threads < 1 || threads > 1024) return usage_error("--threads: '%s' is not a thread count 1..1024", argv[i]);
+            if (*e || e == argv[i] || threads < 0 || threads > 1024)
+                return usage_error("--threads: '%s' is not a thread count 1..1024 (0: the default)", argv[i]);
         } else if (!strcmp(a, "--end")) {
             char *e;
             if (++i >= argc) return usage_error("%s needs a time in seconds", a);
@@ -304,7 +367,13 @@ static int cmd_run(int argc, char **argv)
 
 static int cmd_check(int argc, char **argv)
 {
+    for (int i = 0; i < argc; i++)
+        if (is_help(argv[i])) {
+            fputs(HELP_CHECK, stdout);
+            return 0;
+        }
     if (argc != 1) return usage_error("%s", "check takes exactly one scene file");
+    if (argv[0][0] == '-') return usage_error("unknown option '%s'", argv[0]);
     static pfsph_scene s;
     char *text = NULL;
     int rc = load_scene(argv[0], &s, &text);
@@ -368,7 +437,10 @@ static int cmd_render(int argc, char **argv)
     o.last = -1;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        if (!strcmp(a, "--video")) o.video = true;
+        if (is_help(a)) {
+            fputs(HELP_RENDER, stdout);
+            return 0;
+        } else if (!strcmp(a, "--video")) o.video = true;
         else if (!strcmp(a, "--color-by")) {
             if (++i >= argc) return usage_error("%s needs a field", a);
             o.color_by = argv[i];
@@ -404,7 +476,12 @@ int main(int argc, char **argv)
         return 0;
     }
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
-        fputs(USAGE, stdout);
+        const char *topic = argc > 2 ? argv[2] : NULL;
+        if (!topic) fputs(HELP, stdout), fputs("\n", stdout), fputs(USAGE, stdout);
+        else if (!strcmp(topic, "run")) fputs(HELP_RUN, stdout);
+        else if (!strcmp(topic, "check")) fputs(HELP_CHECK, stdout);
+        else if (!strcmp(topic, "render")) fputs(HELP_RENDER, stdout);
+        else return usage_error("help: unknown command '%s'", topic);
         return 0;
     }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);

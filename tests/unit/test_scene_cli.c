@@ -245,6 +245,43 @@ static void test_no_boundary(void **state)
     }
 }
 
+/* Issue 15 item 13: every subcommand explains itself; --threads 0 is the default. */
+static void test_help(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *args;
+        const char *want[10];
+    } cases[] = {
+        {"--help", {"run ", "check ", "render ", "help ", "--version", "Exit status", NULL}},
+        {"help", {"run ", "check ", "render ", NULL}},
+        {"run --help", {"usage: pfsph run", "-o, --output DIR", "--force ", "--resume RUN_DIR ", "--threads N ",
+                        "0 = the default", "--end T ", "--render ", "--quiet ", NULL}},
+        {"run -h", {"usage: pfsph run", NULL}},
+        {"help run", {"usage: pfsph run", NULL}},
+        {"check --help", {"usage: pfsph check", "verdict", NULL}},
+        {"render --help", {"usage: pfsph render", "--video ", "--color-by FIELD ", "--size WxH ", NULL}},
+        {"help render", {"usage: pfsph render", NULL}},
+    };
+    char out[8192];
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int st = cli(cases[i].args, out, sizeof out);
+        if (st != 0) fail_msg("pfsph %s: exit status %d", cases[i].args, st);
+        for (int k = 0; cases[i].want[k]; k++)
+            if (!strstr(out, cases[i].want[k])) fail_msg("pfsph %s: lacks \"%s\"", cases[i].args, cases[i].want[k]);
+    }
+    assert_int_equal(cli("help nosuch", out, sizeof out), 2);
+    char path[600], args[2048];
+    snprintf(path, sizeof path, "%s/threads0.json", tu_tmpdir());
+    assert_int_equal(tu_write_file(path, "{\"dimension\":2,\"particle_radius\":0.02,\"time\":{\"end\":0.04},"
+                                         "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
+                                         "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"), 0);
+    snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads 0", path, tu_tmpdir());
+    assert_int_equal(cli(args, out, sizeof out), 0);
+    snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads -1", path, tu_tmpdir());
+    assert_int_equal(cli(args, out, sizeof out), 2);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -255,6 +292,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_run_end_overflow),
         cmocka_unit_test(test_messages),
         cmocka_unit_test(test_no_boundary),
+        cmocka_unit_test(test_help),
         cmocka_unit_test(test_check_good),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
