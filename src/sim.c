@@ -379,6 +379,12 @@ static int blowup(pfsph_sim *sim, const char *stage, size_t i, const char *what,
     const char *hint = sim->scene.solver == PFSPH_SOLVER_WCSPH
                            ? "the time step is too large for the stiffness: lower time.cfl or dt_max, or raise solver.sound_speed"
                            : "lower time.cfl or dt_max; check pairwise coefficients and viscosity";
+    /* PCISPH removes the density error within one step, so its speeds grow as 1/dt: below the
+     * acoustic step a smaller dt_max makes things worse (issue 15 item 5) */
+    if (sim->scene.solver == PFSPH_SOLVER_PCISPH && sim->ctx.dt > 0 &&
+        sim->ctx.dt < sim->scene.cfl * (double)sim->ctx.spacing / sim->sound_speed)
+        hint = "the time step is far below what PCISPH needs (it removes density errors within one step, so "
+               "speeds grow as 1/dt): raise time.dt_max and time.dt_min, do not lower them";
     if (i < f->n)
         return pfsph_fail(err, PFSPH_EUNSTABLE,
                           "simulation unstable at step %llu, t = %.6g s, stage %s: %s %.6g at particle id %u "
@@ -600,7 +606,9 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
     t1 = now();
     sim->stage_s[PFSPH_STAGE_INTEGRATE] += t1 - t0;
     t0 = t1;
-    if (bad || vmax > sim->vbound) {
+    /* PCISPH: a speed above the bound is a blow-up once the particle also moves a good part of
+     * the spacing in the step; with a tiny dt the pressure's 1/dt speeds are not (item 5) */
+    if (bad || (vmax > sim->vbound && (s->solver != PFSPH_SOLVER_PCISPH || vmax * dt > 0.5 * (double)c->spacing))) {
         vmax = max_speed(f, &worst); /* rare: find the particle to name */
         if (!isfinite(vmax)) return blowup(sim, "integrate", worst, "non-finite velocity or position", vmax, err);
         return blowup(sim, "integrate", worst, "speed [m/s]", vmax, err);
