@@ -674,7 +674,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         }
         csv_row(csv, frame, sim);
         if (bcsv) bodies_rows(bcsv, frame, sim);
-        if (!rc && ci > 0 && frame % ci == 0) {
+        /* every ci frames, and at the last one (so that --end can extend the run from there) */
+        if (!rc && ci > 0 && (frame % ci == 0 || frame == nframes)) {
             double c0 = omp_get_wtime();
             rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &ckpt_bytes, err);
             ckpt_s = omp_get_wtime() - c0;

@@ -193,8 +193,7 @@ static void test_resume_end(void **state)
     char dir[700], out[8192], p[1400];
     int rows;
     snprintf(dir, sizeof dir, "%s/ends", tu_tmpdir());
-    /* given --end 0.2 (frame 5); the scene's end is 0.4. Killed after frame 5: its newest
-     * checkpoint (4) is what a resume starts from. */
+    /* given --end 0.2 (frame 5; checkpoints at 4 and 5, the last frame); the scene's end is 0.4 */
     assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.2", g_scene, dir), 0);
     /* a resume without --end runs to the run's own end, not the scene's */
     assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet", dir), 0);
@@ -203,7 +202,7 @@ static void test_resume_end(void **state)
     assert_int_equal(last_frame(dir), 5);
     /* extend to 0.32 (frame 8; checkpoints 6 and 8), then lose checkpoint 8, as if killed
      * just before it: a resume to a shorter end (0.28, frame 7) starts at 6 and must not
-     * leave frame 8 without its row */
+     * leave frame 8 without its row (and checkpoints frame 7, its last) */
     assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.32", dir), 0);
     assert_int_equal(last_frame(dir), 8);
     snprintf(p, sizeof p, "%s/checkpoints/ckpt_00008.bin", dir);
@@ -225,7 +224,7 @@ static void test_resume_end(void **state)
     assert_int_equal(unlink(p), 0);
     assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.32", dir), 0);
     assert_non_null(strstr(out, "warning"));
-    assert_non_null(strstr(out, "stats.csv: the rows of frames 0..6 are missing"));
+    assert_non_null(strstr(out, "stats.csv: the rows of frames 0..7 are missing"));
 }
 
 /* Item 2 through the program: a checkpoint with valid CRCs and frame INT_MAX. */
@@ -263,6 +262,28 @@ static void test_frame_int_max(void **state)
     assert_int_equal(last_frame(dir), 4);
 }
 
+/* Item 11: a checkpoint is written at the last frame too (docs/checkpoints.md), so a later
+ * --end extends the run from there. */
+static void test_checkpoint_at_last_frame(void **state)
+{
+    (void)state;
+    char dir[700], out[8192];
+    snprintf(dir, sizeof dir, "%s/lastckpt", tu_tmpdir());
+    /* checkpoint_interval 2, end at frame 3 */
+    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.12", g_scene, dir), 0);
+    assert_true(exists(dir, "checkpoints/ckpt_00002.bin"));
+    assert_true(exists(dir, "checkpoints/ckpt_00003.bin"));
+    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.16", dir), 0);
+    char p[1400], sum[4096];
+    snprintf(p, sizeof p, "%s/summary.json", dir);
+    FILE *f = fopen(p, "r");
+    assert_non_null(f);
+    size_t n = fread(sum, 1, sizeof sum - 1, f);
+    sum[n] = 0;
+    fclose(f);
+    assert_non_null(strstr(sum, "\"resumed_from_frame\":\t3"));
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -271,6 +292,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_fresh_into_old),
         cmocka_unit_test(test_resume_end),
         cmocka_unit_test(test_frame_int_max),
+        cmocka_unit_test(test_checkpoint_at_last_frame),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
