@@ -653,8 +653,31 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     int good_frame = frame0;
     pfsph_error enc_err;
     if (pfsph_checkpoint_encode(sim, frame0, &good, &good_len, &enc_err) != PFSPH_OK) good = NULL;
+    const double time0 = pfsph_sim_time(sim);
+    double last_report = omp_get_wtime();
+    if (o && o->progress) { /* at once, before the first step */
+        pfsph_progress p = {frame0, nframes, time0, end, pfsph_sim_steps(sim), last_report - w0, 0,
+                            pfsph_sim_ctx(sim)->fluid->n, time0, true};
+        o->progress(&p, o->user);
+    }
+    const uint64_t steps0 = pfsph_sim_steps(sim);
     for (frame = frame0 + 1; frame <= nframes && !rc; frame++) {
-        rc = pfsph_sim_advance(sim, frame / s->fps, err);
+        /* step by step, with pfsph_sim_advance's own test, so that progress is reported within
+         * a frame (at most 4 times a second); advance then only lands the clock on the frame */
+        const double tf = frame / s->fps;
+        while (!rc && o && o->progress && pfsph_sim_time(sim) < tf - 1e-12 * fmax(1.0, fabs(tf))) {
+            rc = pfsph_sim_step(sim, tf, err);
+            double now = omp_get_wtime();
+            if (!rc && now - last_report >= 0.25) {
+                last_report = now;
+                double wall = now - w0;
+                pfsph_progress p = {frame - 1, nframes, pfsph_sim_time(sim), end, pfsph_sim_steps(sim), wall,
+                                    wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
+                                    pfsph_sim_ctx(sim)->fluid->n, time0, true};
+                o->progress(&p, o->user);
+            }
+        }
+        if (!rc) rc = pfsph_sim_advance(sim, tf, err);
         if (rc == PFSPH_EUNSTABLE && good) {
             char cp[PFSPH_PATH_LEN + 64];
             pfsph_error e3;
@@ -693,10 +716,11 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         }
         pfsph_sim_add_stage_time(sim, PFSPH_STAGE_OUTPUT, omp_get_wtime() - t0);
         if (o && o->progress) {
-            double wall = omp_get_wtime() - w0;
+            last_report = omp_get_wtime();
+            double wall = last_report - w0;
             pfsph_progress p = {frame, nframes, pfsph_sim_time(sim), end, pfsph_sim_steps(sim), wall,
-                                wall > 0 ? (double)pfsph_sim_steps(sim) / wall : 0,
-                                pfsph_sim_ctx(sim)->fluid->n};
+                                wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
+                                pfsph_sim_ctx(sim)->fluid->n, time0, false};
             o->progress(&p, o->user);
         }
     }

@@ -15,6 +15,8 @@ typedef struct pfsph_progress {
     double wall_s;        /* seconds since the run started */
     double steps_per_s;
     size_t n_fluid;
+    double time0;         /* simulated time this run started from (a resume's checkpoint) */
+    bool partial;         /* an update within a frame (steps; at most 4 a second), not a frame done */
 } pfsph_progress;
 
 typedef void (*pfsph_progress_fn)(const pfsph_progress *p, void *user);

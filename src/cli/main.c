@@ -237,27 +237,55 @@ static int check_memory(const pfsph_scene *s, int verbose)
 
 typedef struct progress_state {
     int tty, quiet;
+    double last_line; /* wall_s of the last line written without a terminal */
 } progress_state;
 
 static void show_progress(const pfsph_progress *p, void *user)
 {
     progress_state *ps = user;
     if (ps->quiet) return;
-    double frac = p->nframes ? (double)p->frame / p->nframes : 1;
+    /* by simulated time (steps move it within a frame), from where this run started */
+    double span = p->end_time - p->time0;
+    double frac = span > 0 ? (p->time - p->time0) / span : 1;
+    if (frac < 0) frac = 0;
+    if (frac > 1) frac = 1;
     double eta = frac > 0 ? p->wall_s * (1 - frac) / frac : 0;
     if (ps->tty) {
         char bar[31];
         int filled = (int)(frac * 30);
         for (int i = 0; i < 30; i++) bar[i] = i < filled ? '#' : '.';
         bar[30] = 0;
-        fprintf(stderr, "\r[%s] frame %d/%d  t=%.3f/%.3f s  %.0f steps/s  ETA %02d:%02d  ", bar, p->frame,
-                p->nframes, p->time, p->end_time, p->steps_per_s, (int)eta / 60, (int)eta % 60);
-        if (p->frame == p->nframes) fputc('\n', stderr);
+        fprintf(stderr, "\r[%s] frame %d/%d  t=%.4g/%.4g s  %.0f steps/s  ", bar, p->frame, p->nframes, p->time,
+                p->end_time, p->steps_per_s);
+        if (frac > 0) fprintf(stderr, "ETA %02d:%02d  ", (int)eta / 60, (int)eta % 60);
+        else fprintf(stderr, "ETA --:--  ");
+        if (!p->partial && p->frame == p->nframes) fputc('\n', stderr);
     } else {
-        fprintf(stderr, "frame %d/%d t=%.4f s steps=%llu %.0f steps/s fluid=%zu eta=%.0f s\n", p->frame,
-                p->nframes, p->time, (unsigned long long)p->steps, p->steps_per_s, p->n_fluid, eta);
+        /* a log: a line per frame, and within long frames one every 10 s */
+        if (p->partial && p->wall_s - ps->last_line < 10) return;
+        ps->last_line = p->wall_s;
+        fprintf(stderr, "%s %d/%d t=%.4f s steps=%llu %.0f steps/s fluid=%zu eta=%.0f s\n",
+                p->partial ? "in frame" : "frame", p->partial ? p->frame + 1 : p->frame, p->nframes, p->time,
+                (unsigned long long)p->steps, p->steps_per_s, p->n_fluid, eta);
     }
     fflush(stderr);
+}
+
+/* Render progress: on a terminal one line rewritten in place, otherwise nothing per frame (the
+ * command ends with a one-line summary). */
+static void show_render_progress(int done, int total, const char *path, void *user)
+{
+    progress_state *ps = user;
+    if (ps->quiet || !ps->tty) return;
+    fprintf(stderr, "\rrender: frame %d/%d  %s", done, total, path ? path : "");
+    if (done == total) fputc('\n', stderr);
+    fflush(stderr);
+}
+
+static void show_render_message(const char *msg, void *user)
+{
+    progress_state *ps = user;
+    if (!ps->quiet) fprintf(stderr, "render: %s\n", msg);
 }
 
 static void show_message(const char *msg, void *user)
@@ -335,7 +363,7 @@ static int cmd_run(int argc, char **argv)
     if (!scene_path && !out) force = 1; /* the embedded demo into its own directory: rerunnable */
     if (threads > 0) omp_set_num_threads(threads);
     else if (s.threads > 0) omp_set_num_threads(s.threads);
-    progress_state ps = {isatty(2), quiet};
+    progress_state ps = {isatty(2), quiet, -1e9};
     pfsph_run_opts o = {.out_dir = out, .end_time = end, .scene_text = text, .progress = show_progress, .user = &ps,
                         .resume = resume != NULL, .message = show_message, .force = force};
     const char *dir = out ? out : s.output.dir;
@@ -353,6 +381,9 @@ static int cmd_run(int argc, char **argv)
         pfsph_render_opts ro = {0};
         ro.last = -1;
         ro.quiet = quiet;
+        ro.progress = show_render_progress;
+        ro.message = show_render_message;
+        ro.user = &ps;
         int count = 0;
         rc = pfsph_render_run(dir, &ro, &count, &err);
         if (rc) {
@@ -435,6 +466,10 @@ static int cmd_render(int argc, char **argv)
     const char *dir = NULL;
     pfsph_render_opts o = {0};
     o.last = -1;
+    progress_state ps = {isatty(2), 0, -1e9};
+    o.progress = show_render_progress;
+    o.message = show_render_message;
+    o.user = &ps;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         if (is_help(a)) {

@@ -16,6 +16,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include "pfsph/run.h"
 #include "testutil.h"
 
 static const char *SCENE =
@@ -284,6 +285,59 @@ static void test_checkpoint_at_last_frame(void **state)
     assert_non_null(strstr(sum, "\"resumed_from_frame\":\t3"));
 }
 
+/* Item 14: progress by steps, at most 4 times a second, from the start of the run (not only
+ * once a frame is done); `pfsph render` without a terminal writes no \r-joined line. */
+typedef struct prog_log {
+    int partial, frames, first_partial_before_step;
+    double last_wall, min_gap;
+} prog_log;
+
+static void on_progress(const pfsph_progress *p, void *user)
+{
+    prog_log *l = user;
+    if (p->partial) {
+        if (l->partial == 0 && p->steps == 0) l->first_partial_before_step = 1;
+        if (l->partial > 0 && p->wall_s - l->last_wall < l->min_gap) l->min_gap = p->wall_s - l->last_wall;
+        l->last_wall = p->wall_s;
+        l->partial++;
+    } else
+        l->frames++;
+}
+
+static void test_progress(void **state)
+{
+    (void)state;
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    /* one frame of 1.5 s: about 2,700 steps, a second or two */
+    char json[4096];
+    snprintf(json, sizeof json, "%s", SCENE);
+    char *fps = strstr(json, "\"fps\": 25");
+    assert_non_null(fps);
+    memcpy(fps, "\"fps\": 1 ", 9);
+    char *end = strstr(json, "\"end\": 0.4");
+    memcpy(end, "\"end\": 1.5", 10);
+    int rc = pfsph_scene_parse(&s, json, "progress", &err);
+    if (rc) fail_msg("%s", err.msg);
+    char dir[700];
+    snprintf(dir, sizeof dir, "%s/progress", tu_tmpdir());
+    prog_log l = {0, 0, 0, 0, 1e9};
+    pfsph_run_opts o = {.out_dir = dir, .end_time = -1, .scene_text = json, .progress = on_progress, .user = &l};
+    rc = pfsph_run(&s, &o, &err);
+    if (rc) fail_msg("%s", err.msg);
+    printf("%d updates within the frame (smallest gap %.3f s), %d frame updates\n", l.partial, l.min_gap, l.frames);
+    assert_int_equal(l.frames, 1);
+    assert_true(l.first_partial_before_step);
+    assert_true(l.partial >= 3);
+    assert_true(l.min_gap >= 0.24);
+    /* render without a terminal: one summary line, no carriage returns */
+    char out[8192];
+    assert_int_equal(pf(out, sizeof out, "render '%s' --size 64x48", dir), 0);
+    assert_null(strchr(out, '\r'));
+    assert_null(strchr(strchr(out, '\n') + 1, '\n'));
+    assert_non_null(strstr(out, "rendered 2 frames"));
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -293,6 +347,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_resume_end),
         cmocka_unit_test(test_frame_int_max),
         cmocka_unit_test(test_checkpoint_at_last_frame),
+        cmocka_unit_test(test_progress),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
