@@ -106,18 +106,19 @@ static void test_lock(void **state)
     char dir[700], out[8192], cmd[4096], lock[800];
     snprintf(dir, sizeof dir, "%s/locked", tu_tmpdir());
     snprintf(lock, sizeof lock, "%s/.pfsph.lock", dir);
-    /* the first run: about 0.7 s (20 s under the sanitizers) */
-    snprintf(cmd, sizeof cmd, "OMP_NUM_THREADS=1 '%s' run '%s' -o '%s' --quiet --end 4 > '%s.log' 2>&1 & echo $!",
+    /* the first run: about 1 s (30 s under the sanitizers) */
+    snprintf(cmd, sizeof cmd, "OMP_NUM_THREADS=1 '%s' run '%s' -o '%s' --quiet --end 6 > '%s.log' 2>&1 & echo $!",
              tu_pfsph_bin(), g_scene, dir, dir);
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     long pid = atol(out);
     assert_true(pid > 0);
-    /* wait until it holds the lock (at most 10 s) */
+    /* wait until it holds the lock and has written scene.json, which a resume reads before it
+     * asks for the lock (at most 10 s) */
     int held = 0;
     for (int i = 0; i < 1000 && !held; i++) {
         FILE *f = fopen(lock, "r");
         if (f) {
-            held = fgetc(f) != EOF;
+            held = fgetc(f) != EOF && exists(dir, "scene.json");
             fclose(f);
         }
         if (!held) nanosleep(&(struct timespec){0, 10000000}, NULL);
@@ -133,11 +134,11 @@ static void test_lock(void **state)
     assert_non_null(strstr(out, "in use by another pfsph run"));
     snprintf(cmd, sizeof cmd, "while kill -0 %ld 2>/dev/null; do sleep 0.05; done; tail -c 300 '%s.log'", pid, dir);
     tu_run(cmd, out, sizeof out);
-    /* the first run was not disturbed: it finished all 100 frames */
+    /* the first run was not disturbed: it finished all 150 frames */
     int rows;
-    assert_int_equal(last_row(dir, &rows), 100);
-    assert_int_equal(rows, 101);
-    assert_int_equal(last_frame(dir), 100);
+    assert_int_equal(last_row(dir, &rows), 150);
+    assert_int_equal(rows, 151);
+    assert_int_equal(last_frame(dir), 150);
     /* released: the directory can be resumed now (nothing left to do) */
     assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet", dir), 0);
 }
