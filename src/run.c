@@ -5,36 +5,221 @@
 #include "pfsph/surface_io.h"
 
 #include <cjson/cJSON.h>
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
 
+#include "io/io_internal.h"
 #include "pfsph/checkpoint.h"
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
 
-int pfsph_mkdirs(const char *path, pfsph_error *err)
+/* ---- the run directory: lock, what is pfsph's, temporaries, the run's own end ---- */
+
+#define LOCK_NAME ".pfsph.lock"
+#define RUN_JSON "run.json"
+
+/* Take an exclusive flock on RUN/.pfsph.lock (kept open until run_unlock) and write our pid
+ * and start time into it; PFSPH_EINPUT naming the holder when another process has it. */
+static int run_lock(const char *dir, int *fd_out, pfsph_error *err)
 {
-    char buf[PFSPH_PATH_LEN + 64];
-    if (strlen(path) >= sizeof buf) return pfsph_fail(err, PFSPH_EIO, "%s: path too long", path);
-    strcpy(buf, path);
-    for (char *p = buf + 1;; p++) {
-        if (*p == '/' || *p == 0) {
-            char c = *p;
-            *p = 0;
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return pfsph_fail(err, PFSPH_EIO, "%s: cannot create directory: %s", buf, strerror(errno));
-            struct stat st;
-            if (stat(buf, &st) != 0 || !S_ISDIR(st.st_mode))
-                return pfsph_fail(err, PFSPH_EIO, "%s: exists and is not a directory", buf);
-            *p = c;
-            if (!c) break;
+    char path[PFSPH_PATH_LEN + 64];
+    snprintf(path, sizeof path, "%s/" LOCK_NAME, dir);
+    int fd = open(path, O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0) return pfsph_fail(err, PFSPH_EINPUT, "cannot write into it: %s", strerror(errno));
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        int e = errno;
+        char who[128] = "";
+        ssize_t n = pread(fd, who, sizeof who - 1, 0);
+        close(fd);
+        if (e != EWOULDBLOCK)
+            return pfsph_fail(err, PFSPH_EIO, "%s: cannot lock: %s", path, strerror(e));
+        who[n > 0 ? n : 0] = 0;
+        char *nl = strchr(who, '\n');
+        if (nl) *nl = 0;
+        return pfsph_fail(err, PFSPH_EINPUT, "in use by another pfsph run (%s); wait for it to end or choose "
+                          "another directory", who[0] ? who : "holder unknown");
+    }
+    char who[128];
+    time_t now = time(NULL);
+    struct tm tm;
+    char when[32] = "?";
+    if (localtime_r(&now, &tm)) strftime(when, sizeof when, "%Y-%m-%d %H:%M:%S", &tm);
+    int n = snprintf(who, sizeof who, "pid %ld, started %s\n", (long)getpid(), when);
+    if (ftruncate(fd, 0) != 0 || pwrite(fd, who, (size_t)n, 0) != n) {
+        /* the lock holds; only the holder's description is missing */
+    }
+    *fd_out = fd;
+    return PFSPH_OK;
+}
+
+static void run_unlock(int fd)
+{
+    if (fd >= 0) close(fd); /* releases the flock; the file stays (removing it would race) */
+}
+
+/* "<prefix><digits>.<ext>" with prefix one of the frame sets; *num receives the digits. */
+static int frame_file(const char *name, long *num)
+{
+    static const char *const sets[] = {"fluid_", "boundary_", "diffuse_", "bodies_", "surfaces_", "frame_", NULL};
+    for (int k = 0; sets[k]; k++) {
+        size_t l = strlen(sets[k]);
+        if (strncmp(name, sets[k], l) != 0) continue;
+        const char *p = name + l;
+        long v = 0;
+        int digits = 0;
+        while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
+        if (!digits) return 0;
+        if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png")) {
+            *num = v;
+            return 1;
+        }
+        return 0;
+    }
+    return 0;
+}
+
+/* A temporary of the atomic writer: "<name>.tmp.<pid>" (or "frames.tmp.<pid>.mp4"). */
+static int is_temporary(const char *name)
+{
+    const char *t = strstr(name, ".tmp.");
+    if (!t || t == name) return 0;
+    t += 5;
+    if (*t < '0' || *t > '9') return 0;
+    while (*t >= '0' && *t <= '9') t++;
+    return *t == 0 || !strcmp(t, ".mp4");
+}
+
+/* Files pfsph writes at the top of a run directory. */
+static int is_run_file(const char *name)
+{
+    static const char *const names[] = {"scene.json", "summary.json", "stats.csv", "bodies.csv", RUN_JSON,
+                                        "diffuse_counts.png", "frames.mp4", NULL};
+    for (int k = 0; names[k]; k++)
+        if (!strcmp(name, names[k])) return 1;
+    return is_temporary(name);
+}
+
+/* What to remove from a run directory: every file of pfsph (clear), or only temporaries and
+ * the output files of frames after `after_frame` (a resume). */
+typedef struct sweep {
+    int clear;
+    long after;   /* output frame index; frames above it go (resume) */
+    int errors;   /* unlink failures */
+    int err_no;
+    char failed[PFSPH_PATH_LEN + 64];
+} sweep;
+
+static void sweep_dir(const char *dir, const char *sub, sweep *sw)
+{
+    char path[2 * PFSPH_PATH_LEN + 64];
+    snprintf(path, sizeof path, "%s/%s", dir, sub);
+    DIR *d = opendir(path);
+    if (!d) return;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        const char *n = e->d_name;
+        long num;
+        int go;
+        if (!strcmp(sub, "checkpoints"))
+            go = is_temporary(n) || (sw->clear && !strncmp(n, "ckpt_", 5) && strstr(n, ".bin"));
+        else
+            go = is_temporary(n) || (frame_file(n, &num) && (sw->clear || num > sw->after));
+        if (!go) continue;
+        snprintf(path, sizeof path, "%s/%s/%s", dir, sub, n);
+        if (unlink(path) != 0 && errno != ENOENT && !sw->errors++) {
+            sw->err_no = errno;
+            snprintf(sw->failed, sizeof sw->failed, "%s", path);
         }
     }
+    closedir(d);
+}
+
+static int sweep_run(const char *dir, sweep *sw, pfsph_error *err)
+{
+    DIR *d = opendir(dir);
+    if (d) {
+        struct dirent *e;
+        char path[PFSPH_PATH_LEN + 300];
+        while ((e = readdir(d))) {
+            if (!(sw->clear ? is_run_file(e->d_name) : is_temporary(e->d_name))) continue;
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            if (unlink(path) != 0 && errno != ENOENT && !sw->errors++) {
+                sw->err_no = errno;
+                snprintf(sw->failed, sizeof sw->failed, "%s", path);
+            }
+        }
+        closedir(d);
+    }
+    sweep_dir(dir, "frames", sw);
+    sweep_dir(dir, "checkpoints", sw);
+    sweep_dir(dir, "png", sw);
+    if (sw->errors)
+        return pfsph_fail(err, PFSPH_EIO, "%s: cannot remove: %s", sw->failed, strerror(sw->err_no));
+    return PFSPH_OK;
+}
+
+/* Entries of a directory other than ".", ".." and the lock, up to `cap` names listed in buf. */
+static int dir_entries(const char *dir, char *buf, size_t cap)
+{
+    DIR *d = opendir(dir);
+    if (!d) return 0;
+    int n = 0;
+    size_t len = 0;
+    buf[0] = 0;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..") || !strcmp(e->d_name, LOCK_NAME)) continue;
+        if (n < 4 && len + strlen(e->d_name) + 4 < cap)
+            len += (size_t)snprintf(buf + len, cap - len, "%s%s", n ? ", " : "", e->d_name);
+        n++;
+    }
+    closedir(d);
+    if (n > 4 && len + 6 < cap) snprintf(buf + len, cap - len, ", ...");
+    return n;
+}
+
+/* RUN/run.json: what the run itself was asked for (the end time), so that a resume without
+ * an end time continues to the same end. */
+static int write_run_json(const char *dir, double end, double fps, pfsph_error *err)
+{
+    char text[256], path[PFSPH_PATH_LEN + 64];
+    snprintf(text, sizeof text, "{\n\t\"end_time\":\t%.17g,\n\t\"fps\":\t%.17g\n}\n", end, fps);
+    snprintf(path, sizeof path, "%s/" RUN_JSON, dir);
+    return pfsph_write_file_atomic(path, text, strlen(text), err);
+}
+
+/* The end time recorded in RUN/run.json; *end unchanged (and PFSPH_OK) when there is none. */
+static int read_run_end(const char *dir, double *end, pfsph_error *err)
+{
+    char path[PFSPH_PATH_LEN + 64];
+    snprintf(path, sizeof path, "%s/" RUN_JSON, dir);
+    unsigned char *data;
+    size_t len;
+    FILE *f = fopen(path, "rb");
+    if (!f) return errno == ENOENT ? PFSPH_OK : pfsph_fail(err, PFSPH_EIO, "%s: cannot read: %s", path, strerror(errno));
+    fclose(f);
+    int rc = pfsph__read_file(path, &data, &len, err);
+    if (rc) return rc;
+    cJSON *j = cJSON_ParseWithLength((const char *)data, len);
+    free(data);
+    const cJSON *e = cJSON_GetObjectItemCaseSensitive(j, "end_time");
+    if (!cJSON_IsNumber(e) || !(e->valuedouble >= 0) || !isfinite(e->valuedouble)) {
+        cJSON_Delete(j);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: $.end_time: missing or not a time >= 0 (the file is pfsph's; "
+                          "give --end to resume)", path);
+    }
+    *end = e->valuedouble;
+    cJSON_Delete(j);
     return PFSPH_OK;
 }
 
@@ -139,7 +324,7 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
     double t = pfsph_sim_time(sim);
     int rc = write_set(s, dir, "fluid", frame, c->fluid, NULL, t, err);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
-    if (!rc && frame == 0 && c->boundary->n) {
+    if (!rc && frame == 0 && c->boundary->n && s->output.write_boundary) {
         if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
         else /* the static part; body particles go to bodies_NNNNN every frame */
             rc = write_boundary_part(s, dir, "boundary", frame, c->boundary, pfsph_bodies_first_id(B), false,
@@ -222,13 +407,15 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
 }
 
 /* Keep the header and the rows of frames <= last of stats.csv (a resume rewrites the rest);
- * atomic. A missing file gets the header only. */
-static int truncate_csv(const char *path, const char *header, int last, pfsph_error *err)
+ * atomic. A missing file gets the header only. *kept: the frame of the last row kept, -1 for
+ * none. */
+static int truncate_csv(const char *path, const char *header, int last, long *kept, pfsph_error *err)
 {
     FILE *f = fopen(path, "rb");
     char *out = NULL;
     size_t len = 0, cap = 0;
     int rc = PFSPH_OK;
+    *kept = -1;
     if (!f) {
         if (errno != ENOENT) return pfsph_fail(err, PFSPH_EIO, "%s: cannot read: %s", path, strerror(errno));
         return pfsph_write_file_atomic(path, header, strlen(header), err);
@@ -244,6 +431,7 @@ static int truncate_csv(const char *path, const char *header, int last, pfsph_er
             long fr = strtol(line, &e, 10);
             keep = e != line && *e == ',' && fr >= 0 && fr <= last;
             if (!keep) break; /* rows are in frame order */
+            *kept = fr;
         }
         first = 0;
         if (len + n + 1 > cap) {
@@ -267,34 +455,96 @@ static int truncate_csv(const char *path, const char *header, int last, pfsph_er
     return rc;
 }
 
+/* the frame count fits an int (and the file names) */
+static int check_end(const pfsph_scene *s, double end, pfsph_error *err)
+{
+    if (!isfinite(end) || !(end >= 0) || floor(end * s->fps + 1e-9) > PFSPH_MAX_FRAMES)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: end time %g s at %g fps ($.time.fps) makes %.3g frames, more "
+                          "than the %d one run holds", s->source, end, s->fps, end * s->fps, PFSPH_MAX_FRAMES);
+    return PFSPH_OK;
+}
+
+static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0,
+                      pfsph_error *err);
+
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
 {
     const char *dir = o && o->out_dir ? o->out_dir : s->output.dir;
+    const bool resume = o && o->resume;
+    const char *what = resume ? "run directory" : o && o->out_dir ? "output directory" : "$.output.directory";
+    double w0 = omp_get_wtime();
+    int rc;
+    /* refused before anything is written */
+    if (o && o->end_time >= 0 && (rc = check_end(s, o->end_time, err))) return rc;
+    if (!(o && o->end_time >= 0) && (rc = check_end(s, s->end_time, err))) return rc;
+    /* a directory that cannot be made or written is bad input (exit status 2), as is one that
+     * another run holds */
+    pfsph_error e;
+    if (pfsph_mkdirs(dir, &e))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: %s \"%s\": %s", s->source, what, dir, e.msg);
+    int lock = -1;
+    if ((rc = run_lock(dir, &lock, &e))) {
+        pfsph_fail(err, rc, "%s: %s \"%s\": %s", s->source, what, dir, e.msg);
+        return rc;
+    }
+    rc = run_locked(s, o, dir, w0, err);
+    run_unlock(lock);
+    return rc;
+}
+
+static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0,
+                      pfsph_error *err)
+{
     double end = o && o->end_time >= 0 ? o->end_time : s->end_time;
     char path[PFSPH_PATH_LEN + 64];
     int rc;
-    double w0 = omp_get_wtime();
-    if ((rc = pfsph_mkdirs(dir, err))) return rc;
+    bool resume = o && o->resume;
+    if (resume && o->end_time < 0) {
+        /* the run's own end, which may have been given on its command line */
+        if ((rc = read_run_end(dir, &end, err)) || (rc = check_end(s, end, err))) return rc;
+    }
+    if (!resume) {
+        char names[256];
+        int n = dir_entries(dir, names, sizeof names);
+        if (n && !(o && o->force))
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: the run directory is not empty (%s): a fresh run does not "
+                              "mix with what is there; continue it with --resume, or give --force to remove "
+                              "pfsph's files from it first", dir, names);
+        sweep sw = {.clear = 1, .after = -1};
+        if (n && (rc = sweep_run(dir, &sw, err))) return rc;
+    }
     snprintf(path, sizeof path, "%s/frames", dir);
     if ((rc = pfsph_mkdirs(path, err))) return rc;
     if (o && o->scene_text && !(o->resume)) {
         snprintf(path, sizeof path, "%s/scene.json", dir);
         if ((rc = pfsph_write_file_atomic(path, o->scene_text, strlen(o->scene_text), err))) return rc;
     }
+    if ((!resume || o->end_time >= 0) && (rc = write_run_json(dir, end, s->fps, err))) return rc;
     pfsph_sim *sim = NULL;
     if ((rc = pfsph_sim_create(&sim, s, err))) return rc;
 
     int frame0 = 0;
-    bool resume = o && o->resume;
+    int nframes = (int)floor(end * s->fps + 1e-9);
+    const int fi = s->output.frame_interval, ci = s->output.checkpoint_interval;
     if (resume) {
-        pfsph_checkpoint_info ci;
-        rc = pfsph_checkpoint_resume(dir, sim, &ci, o->message, o->user, err);
-        frame0 = ci.frame;
-        if (!rc && frame0 >= 0 && ci.threads != omp_get_max_threads() && o->message) {
+        pfsph_checkpoint_info cki;
+        rc = pfsph_checkpoint_resume(dir, sim, &cki, o->message, o->user, err);
+        frame0 = cki.frame;
+        if (!rc && frame0 > nframes)
+            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: the end time %g s (frame %d) is before the newest checkpoint "
+                            "(frame %d, t = %g s): nothing to resume; give a later --end, or run afresh with --force",
+                            dir, end, nframes, frame0, cki.time);
+        if (!rc) {
+            /* temporaries of a killed writer go, and so do the frames after the checkpoint:
+             * they are written again, and ones beyond a shorter end would outlive their rows */
+            sweep sw = {.clear = 0, .after = frame0 >= 0 ? frame0 / fi : -1};
+            rc = sweep_run(dir, &sw, err);
+        }
+        if (!rc && frame0 >= 0 && cki.threads != omp_get_max_threads() && o->message) {
             char msg[256];
             snprintf(msg, sizeof msg, "the checkpoint of frame %d was written with %d threads, this run has %d: "
                      "frames will not be bit-identical to an uninterrupted run (use --threads %d)",
-                     frame0, ci.threads, omp_get_max_threads(), ci.threads);
+                     frame0, cki.threads, omp_get_max_threads(), cki.threads);
             o->message(msg, o->user);
         }
         if (!rc && frame0 < 0) {
@@ -320,9 +570,17 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
              "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s\n",
              s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "");
     snprintf(path, sizeof path, "%s/stats.csv", dir);
-    if (resume && (rc = truncate_csv(path, header, frame0, err))) {
+    long kept = -1;
+    if (resume && (rc = truncate_csv(path, header, frame0, &kept, err))) {
         pfsph_sim_destroy(sim);
         return rc;
+    }
+    if (resume && kept < frame0 && o->message) {
+        char msg[PFSPH_PATH_LEN + 256];
+        snprintf(msg, sizeof msg, "%s: the rows of frames %ld..%d are missing (the file was deleted or cut); "
+                 "the resumed rows follow without them (a fresh run with --force rewrites them all)", path,
+                 kept + 1, frame0);
+        o->message(msg, o->user);
     }
     FILE *csv = fopen(path, resume ? "a" : "w");
     if (!csv) {
@@ -334,10 +592,16 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     FILE *bcsv = NULL;
     if (pfsph_sim_bodies(sim)) {
         snprintf(path, sizeof path, "%s/bodies.csv", dir);
-        if (resume && (rc = truncate_csv(path, bheader, frame0, err))) {
+        if (resume && (rc = truncate_csv(path, bheader, frame0, &kept, err))) {
             fclose(csv);
             pfsph_sim_destroy(sim);
             return rc;
+        }
+        if (resume && kept < frame0 && o->message) {
+            char msg[PFSPH_PATH_LEN + 256];
+            snprintf(msg, sizeof msg, "%s: the rows of frames %ld..%d are missing (the file was deleted or cut); "
+                     "the resumed rows follow without them", path, kept + 1, frame0);
+            o->message(msg, o->user);
         }
         bcsv = fopen(path, resume ? "a" : "w");
         if (!bcsv) {
@@ -348,8 +612,6 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
         }
         if (!resume) fputs(bheader, bcsv);
     }
-    int nframes = (int)floor(end * s->fps + 1e-9);
-    const int fi = s->output.frame_interval, ci = s->output.checkpoint_interval;
     int frame = frame0, written = 0;
     if (!resume) {
         fputs(header, csv);
@@ -370,8 +632,31 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     int good_frame = frame0;
     pfsph_error enc_err;
     if (pfsph_checkpoint_encode(sim, frame0, &good, &good_len, &enc_err) != PFSPH_OK) good = NULL;
+    const double time0 = pfsph_sim_time(sim);
+    double last_report = omp_get_wtime();
+    if (o && o->progress) { /* at once, before the first step */
+        pfsph_progress p = {frame0, nframes, time0, end, pfsph_sim_steps(sim), last_report - w0, 0,
+                            pfsph_sim_ctx(sim)->fluid->n, time0, true};
+        o->progress(&p, o->user);
+    }
+    const uint64_t steps0 = pfsph_sim_steps(sim);
     for (frame = frame0 + 1; frame <= nframes && !rc; frame++) {
-        rc = pfsph_sim_advance(sim, frame / s->fps, err);
+        /* step by step, with pfsph_sim_advance's own test, so that progress is reported within
+         * a frame (at most 4 times a second); advance then only lands the clock on the frame */
+        const double tf = frame / s->fps;
+        while (!rc && o && o->progress && pfsph_sim_time(sim) < tf - 1e-12 * fmax(1.0, fabs(tf))) {
+            rc = pfsph_sim_step(sim, tf, err);
+            double now = omp_get_wtime();
+            if (!rc && now - last_report >= 0.25) {
+                last_report = now;
+                double wall = now - w0;
+                pfsph_progress p = {frame - 1, nframes, pfsph_sim_time(sim), end, pfsph_sim_steps(sim), wall,
+                                    wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
+                                    pfsph_sim_ctx(sim)->fluid->n, time0, true};
+                o->progress(&p, o->user);
+            }
+        }
+        if (!rc) rc = pfsph_sim_advance(sim, tf, err);
         if (rc == PFSPH_EUNSTABLE && good) {
             char cp[PFSPH_PATH_LEN + 64];
             pfsph_error e3;
@@ -391,7 +676,8 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
         }
         csv_row(csv, frame, sim);
         if (bcsv) bodies_rows(bcsv, frame, sim);
-        if (!rc && ci > 0 && frame % ci == 0) {
+        /* every ci frames, and at the last one (so that --end can extend the run from there) */
+        if (!rc && ci > 0 && (frame % ci == 0 || frame == nframes)) {
             double c0 = omp_get_wtime();
             rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &ckpt_bytes, err);
             ckpt_s = omp_get_wtime() - c0;
@@ -409,10 +695,11 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
         }
         pfsph_sim_add_stage_time(sim, PFSPH_STAGE_OUTPUT, omp_get_wtime() - t0);
         if (o && o->progress) {
-            double wall = omp_get_wtime() - w0;
+            last_report = omp_get_wtime();
+            double wall = last_report - w0;
             pfsph_progress p = {frame, nframes, pfsph_sim_time(sim), end, pfsph_sim_steps(sim), wall,
-                                wall > 0 ? (double)pfsph_sim_steps(sim) / wall : 0,
-                                pfsph_sim_ctx(sim)->fluid->n};
+                                wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
+                                pfsph_sim_ctx(sim)->fluid->n, time0, false};
             o->progress(&p, o->user);
         }
     }

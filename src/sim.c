@@ -182,14 +182,29 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     double cells = 1;
     for (int a = 0; a < s->dim; a++)
         cells *= ceil((s->domain_max[a] - s->domain_min[a]) / cell + 8);
+    /* Per particle: its set at up to twice its size (the arrays grow by doubling), the grid's
+     * sort scratch (key, perm, tmp; 1.25x), and for fluid the step scratch and two encoded
+     * states (the last good frame kept for a blow-up and the next one being encoded). Measured:
+     * tests/unit/test_estimate.c. In double: the estimate may exceed size_t, so it saturates. */
+    const double P = (double)pfsph_particles_bytes_per_particle();
+    const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
-    size_t per_fluid = pfsph_particles_bytes_per_particle() +
-                       (size_t)(SCR_COMMON + (ops ? ops->nscratch : 0)) * sizeof(pfsph_real) +
-                       2 * sizeof(uint32_t) + sizeof(pfsph_real);
-    size_t per_boundary = pfsph_particles_bytes_per_particle() + 2 * sizeof(uint32_t) + sizeof(pfsph_real);
+    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0)) * sizeof(pfsph_real) + sort + 2 * P;
+    const double per_boundary = 2 * P + sort;
+    const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
+    const double part_bytes = (double)nf * per_fluid + (double)nb * per_boundary;
     if (n_fluid) *n_fluid = (size_t)nf;
     if (n_boundary) *n_boundary = (size_t)nb;
-    if (bytes) *bytes = (size_t)nf * per_fluid + (size_t)nb * per_boundary + (size_t)(2 * cells * 4);
+    if (bytes) *bytes = part_bytes + grid_bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)(part_bytes + grid_bytes);
+    if (nf + nb > (long)UINT32_MAX)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: the scene makes %ld particles (%ld fluid), more than the %u one run "
+                          "can index; enlarge particle_radius or shrink the fluid", s->source, nf + nb, nf, UINT32_MAX);
+    /* a grid the program cannot index, or one that dwarfs the particles: the domain is to blame */
+    if (cells > (double)((size_t)1 << 31) || (grid_bytes > (double)(1u << 30) && grid_bytes > 16 * part_bytes))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: $.domain: the neighbour grids over the domain need %.3g cells of "
+                          "%.3g m (%.3g GiB) for %ld particles; shrink $.domain to where the fluid can go (a grid "
+                          "holds at most 2^31 cells, and at most 16x the particles' memory above 1 GiB)",
+                          s->source, cells, cell, grid_bytes / 1073741824.0, nf + nb);
     return PFSPH_OK;
 }
 
@@ -355,7 +370,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     sim->amax_np = g;
     size_t worst0;
     sim->stats.vmax = max_speed(&sim->fluid, &worst0);
-    sim->vbound = sim->solver->speed_bound(sim->solver_state);
+    sim->vbound = sim->solver->speed_bound(sim->solver_state, c);
 
     if (s->pairwise.enabled && (rc = pfsph_pairwise_create(&sim->pw, c, err))) goto fail;
     if (s->diffuse.enabled && (rc = pfsph_diffuse_create(&sim->df, c, err))) goto fail;
@@ -425,7 +440,7 @@ static double max_speed(const pfsph_particles *f, size_t *worst)
 static int report_blowup(pfsph_sim *sim, const char *stage_name, const blowup_info *b, pfsph_error *err)
 {
     const pfsph_particles *f = &sim->fluid;
-    const char *hint = b->hint ? b->hint : sim->solver->hint;
+    const char *hint = b->hint ? b->hint : sim->solver->hint(sim->solver_state, &sim->ctx);
     size_t i = b->particle;
     if (i < f->n)
         return pfsph_fail(err, PFSPH_EUNSTABLE,
@@ -528,6 +543,7 @@ static int st_timestep(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     c->dt = dt;
     c->time = sim->time;
     c->step = sim->step;
+    sim->vbound = sim->solver->speed_bound(sim->solver_state, c);
     return PFSPH_OK;
 }
 

@@ -31,7 +31,8 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
                             pfsph_error *err);
 /* Check and restore a buffer produced by pfsph_checkpoint_encode into sim (info may be NULL), which must have been
  * created from the same scene (hash compared). `name` names the source in messages. The buffer
- * is fully checked (length, magic, version, precision, CRC32, scene hash, counts) before sim is
+ * is fully checked (length, magic, version, precision, CRC32, scene hash, counts, the frame
+ * against PFSPH_MAX_FRAMES and the time against frame / fps, finite values) before sim is
  * touched. Returns PFSPH_OK, PFSPH_EINPUT (corrupt, truncated, other scene) or PFSPH_ENOMEM. */
 int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const char *name,
                             pfsph_checkpoint_info *info, pfsph_error *err);
@@ -40,7 +41,8 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
  * receives its size. */
 int pfsph_checkpoint_save(const char *path, const pfsph_sim *sim, int frame, size_t *bytes,
                           pfsph_error *err);
-/* Read and restore a checkpoint file; messages name the file. */
+/* Read and restore a checkpoint file; messages name the file. A file named ckpt_NNNNN.bin must
+ * hold frame NNNNN. */
 int pfsph_checkpoint_load(const char *path, pfsph_sim *sim, pfsph_checkpoint_info *info,
                           pfsph_error *err);
 

@@ -34,4 +34,7 @@ int pfsph_write_file_atomic(const char *path, const void *data, size_t len, pfsp
  * Written atomically. */
 int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error *err);
 
+/* mkdir -p; PFSPH_EIO with a message on failure. */
+int pfsph_mkdirs(const char *path, pfsph_error *err);
+
 #endif

@@ -11,7 +11,12 @@ typedef struct pfsph_render_opts {
     const char *color_by;  /* NULL: scene camera's, else "phase" */
     bool video;            /* also frames.mp4 via ffmpeg when present */
     int first, last;       /* frame range, last < 0 for all */
-    bool quiet;
+    bool quiet;            /* kept for callers; the library never prints (see progress) */
+    /* After each PNG: done of total frames, the file written (may be NULL); and a message
+     * (the video written). Either may be NULL; both get `user`. */
+    void (*progress)(int done, int total, const char *path, void *user);
+    void (*message)(const char *msg, void *user);
+    void *user;
 } pfsph_render_opts;
 
 /* Render every frame of RUN_DIR/frames into RUN_DIR/png/frame_NNNNN.png. Returns the number of

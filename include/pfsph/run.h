@@ -15,6 +15,8 @@ typedef struct pfsph_progress {
     double wall_s;        /* seconds since the run started */
     double steps_per_s;
     size_t n_fluid;
+    double time0;         /* simulated time this run started from (a resume's checkpoint) */
+    bool partial;         /* an update within a frame (steps; at most 4 a second), not a frame done */
 } pfsph_progress;
 
 typedef void (*pfsph_progress_fn)(const pfsph_progress *p, void *user);
@@ -30,14 +32,21 @@ typedef struct pfsph_run_opts {
      * scene must be the one of the checkpoint (scene hash). */
     bool resume;
     pfsph_message_fn message; /* warnings (a checkpoint skipped); may be NULL; gets `user` */
+    /* A fresh run into a directory that is not empty: remove pfsph's files there (frames,
+     * checkpoints, PNGs, scene.json, stats and summary; nothing else) and run. Without it such
+     * a run is refused (PFSPH_EINPUT). */
+    bool force;
 } pfsph_run_opts;
 
 /* Run the scene, writing a checkpoint every scene->output.checkpoint_interval frames into
- * RUN/checkpoints (a fresh run first deletes old ones there). Returns PFSPH_OK, PFSPH_EIO (output directory), PFSPH_EUNSTABLE (blow-up;
- * frames written so far are kept) or PFSPH_ENOMEM. */
+ * RUN/checkpoints. The run holds an exclusive flock on RUN/.pfsph.lock throughout; a second
+ * run into the same directory is refused (PFSPH_EINPUT, naming the holder's pid). A fresh run
+ * refuses a non-empty directory unless opts->force; it records its end time in RUN/run.json,
+ * which a resume without an end time uses. A resume removes temporaries left by a killed
+ * writer and the frame files after its checkpoint. Returns PFSPH_OK, PFSPH_EINPUT (bad end
+ * time, a directory that cannot be made, written or locked, not empty), PFSPH_EIO (writing
+ * output), PFSPH_EUNSTABLE (blow-up; frames written so far are kept) or PFSPH_ENOMEM. */
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err);
 
-/* mkdir -p; PFSPH_EIO with a message on failure. */
-int pfsph_mkdirs(const char *path, pfsph_error *err);
 
 #endif

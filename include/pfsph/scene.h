@@ -12,7 +12,6 @@
 
 #define PFSPH_MAX_BLOCKS 64
 #define PFSPH_MAX_SOLIDS 64
-#define PFSPH_PATH_LEN 1024
 #define PFSPH_MAX_BODIES 32
 #define PFSPH_MAX_KEYFRAMES 16
 
@@ -193,5 +192,9 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h,
 /* Print the coefficient matrix, each target with the coefficient it produced, and the surface
  * tensions and contact angles the final matrix predicts (for `pfsph check`). */
 void pfsph_pairwise_report(const pfsph_scene *s, FILE *out);
+
+/* The most frames (of 1/fps) one run holds: an end time x fps above it is refused (scene and
+ * pfsph_run), and so is a checkpoint whose frame is above it. */
+#define PFSPH_MAX_FRAMES 100000000
 
 #endif

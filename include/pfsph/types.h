@@ -19,6 +19,7 @@ typedef float pfsph_real;
 #endif
 
 #define PFSPH_MAX_PHASES 16
+#define PFSPH_PATH_LEN 1024 /* file paths, including the terminating zero */
 
 /* Status codes: the library never exits; programs map these to exit statuses. */
 enum {

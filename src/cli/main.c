@@ -1,10 +1,12 @@
 /* The pfsph program: run, check, render, bench. Parses the command line, prints progress and
  * errors, maps library status codes to exit statuses (2 bad input, 3 unstable, 1 other). */
 #include <errno.h>
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "pfsph/bodies.h"
@@ -15,15 +17,74 @@
 #include "pfsph/sim.h"
 
 static const char *USAGE =
-    "usage: pfsph run [SCENE] [-o DIR] [--threads N] [--end T] [--render] [--quiet]\n"
+    "usage: pfsph run [SCENE] [-o DIR] [--force] [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH]\n"
     "       pfsph --version\n"
-    "Without SCENE, `pfsph run` runs the embedded default scene (a small 3D dam break) into\n"
-    "./pfsph_default_run and renders PNG previews. --resume continues a run from the newest\n"
-    "valid checkpoint in RUN_DIR/checkpoints, with RUN_DIR/scene.json.\n";
+    "       pfsph help [COMMAND]    (or pfsph COMMAND --help)\n";
+
+static const char *HELP =
+    "pfsph: a particle fluid simulator (SPH) for scenes described in JSON.\n"
+    "\n"
+    "commands:\n"
+    "  run      simulate a scene into a run directory (frames, stats.csv, summary.json)\n"
+    "  check    validate a scene: particle counts, memory estimate, coefficients\n"
+    "  render   PNG previews (and an mp4) of a run directory's frames\n"
+    "  help     this text, or a command's: pfsph help run\n"
+    "  --version  the version, precision and OpenMP thread count\n"
+    "\n"
+    "Exit status: 0 done, 2 bad input (scene, options, run directory), 3 the simulation blew\n"
+    "up, 1 anything else (a full disk, out of memory). Scene keys: docs/scene-format.md.\n";
+
+static const char *HELP_RUN =
+    "usage: pfsph run [SCENE] [-o DIR] [--force] [--threads N] [--end T] [--render] [--quiet]\n"
+    "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
+    "\n"
+    "Simulate SCENE (a JSON file) into its run directory: frames/, stats.csv, summary.json,\n"
+    "scene.json, run.json, checkpoints/. Without SCENE, the embedded default scene (a small 3D\n"
+    "dam break) runs into ./pfsph_default_run and is rendered.\n"
+    "\n"
+    "  -o, --output DIR  run directory (default: the scene's output.directory)\n"
+    "  --force           the run directory is not empty: remove pfsph's files there first\n"
+    "                    (frames, checkpoints, PNGs, stats; nothing else) instead of refusing\n"
+    "  --resume RUN_DIR  continue a stopped run from its newest valid checkpoint, with\n"
+    "                    RUN_DIR/scene.json, to the end it was started with (RUN_DIR/run.json)\n"
+    "  --threads N       OpenMP threads, 1..1024; 0 = the default (the scene's \"threads\", else\n"
+    "                    OpenMP's)\n"
+    "  --end T           simulated end time [s], overrides the scene's time.end (and, with\n"
+    "                    --resume, the run's own end)\n"
+    "  --render          render PNG previews after the run (as `pfsph render`)\n"
+    "  --quiet           no progress, no messages but errors\n"
+    "  -h, --help        this text\n"
+    "\n"
+    "A run holds a lock on its directory: a second run into it is refused (exit status 2).\n"
+    "Exit status: 0 finished, 2 bad input, 3 unstable (the last good state is kept as a\n"
+    "checkpoint), 1 other errors.\n";
+
+static const char *HELP_CHECK =
+    "usage: pfsph check SCENE\n"
+    "\n"
+    "Validate SCENE without running it: every key (unknown keys, ranges, JSON paths in the\n"
+    "messages), the particle counts, the memory estimate against 80% of this machine's memory,\n"
+    "mesh files of bodies, density ratios, resolved pairwise coefficients. The verdict\n"
+    "(\"SCENE: valid ...\") is printed last. Exit status 0 valid, 2 not.\n"
+    "\n"
+    "  -h, --help  this text\n";
+
+static const char *HELP_RENDER =
+    "usage: pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure] [--size WxH]\n"
+    "\n"
+    "Render the frames of RUN_DIR/frames into RUN_DIR/png/frame_NNNNN.png with the scene's\n"
+    "camera (RUN_DIR/scene.json).\n"
+    "\n"
+    "  --video                 also RUN_DIR/frames.mp4 (needs ffmpeg on the PATH)\n"
+    "  --color-by FIELD        phase, speed, density or pressure (default: the scene camera's)\n"
+    "  --size WxH              image size in pixels, 16..16384 each (default: the camera's)\n"
+    "  -h, --help              this text\n";
+
+static int is_help(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h"); }
 
 static int exit_code(int rc)
 {
@@ -43,10 +104,47 @@ static int usage_error(const char *fmt, const char *arg)
     return 2;
 }
 
+/* Messages carry what the input said (keys, names, file names): a control byte or a byte
+ * that is not part of valid UTF-8 is written as \xNN, so random input cannot drive the
+ * terminal. */
+static void put_escaped(FILE *f, const char *s)
+{
+    const unsigned char *p = (const unsigned char *)s;
+    while (*p) {
+        int len = *p < 0x80 ? 1 : (*p & 0xe0) == 0xc0 ? 2 : (*p & 0xf0) == 0xe0 ? 3 : (*p & 0xf8) == 0xf0 ? 4 : 0;
+        int ok = len > 0 && !(len == 1 && (*p < 0x20 || *p == 0x7f) && *p != '\n' && *p != '\t');
+        for (int k = 1; ok && k < len; k++) ok = (p[k] & 0xc0) == 0x80;
+        if (ok && len == 2 && *p < 0xc2) ok = 0; /* overlong */
+        if (!ok) {
+            fprintf(f, "\\x%02x", *p++);
+            continue;
+        }
+        fwrite(p, 1, (size_t)len, f);
+        p += len;
+    }
+}
+
+/* "pfsph: <prefix><msg>" on stderr, escaped. */
+static void print_error(const char *prefix, const char *msg)
+{
+    fputs("pfsph: ", stderr);
+    if (prefix) fputs(prefix, stderr);
+    put_escaped(stderr, msg);
+    fputc('\n', stderr);
+}
+
+/* The whole file as a C string; NULL with errno set (EISDIR for a directory, EILSEQ for a
+ * NUL byte, which no scene file holds). */
 static char *read_text(const char *path)
 {
     FILE *f = fopen(path, "rb");
     if (!f) return NULL;
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        fclose(f);
+        errno = EISDIR;
+        return NULL;
+    }
     size_t cap = 1 << 16, n = 0;
     char *buf = malloc(cap);
     while (buf) {
@@ -64,8 +162,19 @@ static char *read_text(const char *path)
             cap *= 2;
         }
     }
+    int rerr = ferror(f) ? errno : 0;
     fclose(f);
+    if (buf && rerr) {
+        free(buf);
+        errno = rerr;
+        return NULL;
+    }
     if (buf) buf[n] = 0;
+    if (buf && memchr(buf, 0, n)) {
+        free(buf);
+        errno = EILSEQ;
+        return NULL;
+    }
     return buf;
 }
 
@@ -80,13 +189,17 @@ static int load_scene(const char *path, pfsph_scene *s, char **text)
     } else {
         *text = read_text(path);
         if (!*text) {
-            fprintf(stderr, "pfsph: %s: cannot read: %s\n", path, strerror(errno));
-            return 2;
+            char msg[PFSPH_PATH_LEN + 128];
+            if (errno == EISDIR) snprintf(msg, sizeof msg, "%s: is a directory, not a scene file", path);
+            else if (errno == EILSEQ) snprintf(msg, sizeof msg, "%s: not a scene file (it holds a NUL byte; scenes are JSON text)", path);
+            else snprintf(msg, sizeof msg, "%s: cannot read: %s", path, strerror(errno));
+            print_error(NULL, msg);
+            return errno == ENOMEM ? 1 : 2;
         }
         rc = pfsph_scene_parse(s, *text, path, &err);
     }
     if (rc) {
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     return 0;
@@ -104,7 +217,7 @@ static int check_memory(const pfsph_scene *s, int verbose)
     pfsph_error err = {0};
     int rc = pfsph_scene_estimate(s, &nf, &nb, &bytes, &err);
     if (rc) {
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     long mem = physical_memory();
@@ -124,27 +237,55 @@ static int check_memory(const pfsph_scene *s, int verbose)
 
 typedef struct progress_state {
     int tty, quiet;
+    double last_line; /* wall_s of the last line written without a terminal */
 } progress_state;
 
 static void show_progress(const pfsph_progress *p, void *user)
 {
     progress_state *ps = user;
     if (ps->quiet) return;
-    double frac = p->nframes ? (double)p->frame / p->nframes : 1;
+    /* by simulated time (steps move it within a frame), from where this run started */
+    double span = p->end_time - p->time0;
+    double frac = span > 0 ? (p->time - p->time0) / span : 1;
+    if (frac < 0) frac = 0;
+    if (frac > 1) frac = 1;
     double eta = frac > 0 ? p->wall_s * (1 - frac) / frac : 0;
     if (ps->tty) {
         char bar[31];
         int filled = (int)(frac * 30);
         for (int i = 0; i < 30; i++) bar[i] = i < filled ? '#' : '.';
         bar[30] = 0;
-        fprintf(stderr, "\r[%s] frame %d/%d  t=%.3f/%.3f s  %.0f steps/s  ETA %02d:%02d  ", bar, p->frame,
-                p->nframes, p->time, p->end_time, p->steps_per_s, (int)eta / 60, (int)eta % 60);
-        if (p->frame == p->nframes) fputc('\n', stderr);
+        fprintf(stderr, "\r[%s] frame %d/%d  t=%.4g/%.4g s  %.0f steps/s  ", bar, p->frame, p->nframes, p->time,
+                p->end_time, p->steps_per_s);
+        if (frac > 0) fprintf(stderr, "ETA %02d:%02d  ", (int)eta / 60, (int)eta % 60);
+        else fprintf(stderr, "ETA --:--  ");
+        if (!p->partial && p->frame == p->nframes) fputc('\n', stderr);
     } else {
-        fprintf(stderr, "frame %d/%d t=%.4f s steps=%llu %.0f steps/s fluid=%zu eta=%.0f s\n", p->frame,
-                p->nframes, p->time, (unsigned long long)p->steps, p->steps_per_s, p->n_fluid, eta);
+        /* a log: a line per frame, and within long frames one every 10 s */
+        if (p->partial && p->wall_s - ps->last_line < 10) return;
+        ps->last_line = p->wall_s;
+        fprintf(stderr, "%s %d/%d t=%.4f s steps=%llu %.0f steps/s fluid=%zu eta=%.0f s\n",
+                p->partial ? "in frame" : "frame", p->partial ? p->frame + 1 : p->frame, p->nframes, p->time,
+                (unsigned long long)p->steps, p->steps_per_s, p->n_fluid, eta);
     }
     fflush(stderr);
+}
+
+/* Render progress: on a terminal one line rewritten in place, otherwise nothing per frame (the
+ * command ends with a one-line summary). */
+static void show_render_progress(int done, int total, const char *path, void *user)
+{
+    progress_state *ps = user;
+    if (ps->quiet || !ps->tty) return;
+    fprintf(stderr, "\rrender: frame %d/%d  %s", done, total, path ? path : "");
+    if (done == total) fputc('\n', stderr);
+    fflush(stderr);
+}
+
+static void show_render_message(const char *msg, void *user)
+{
+    progress_state *ps = user;
+    if (!ps->quiet) fprintf(stderr, "render: %s\n", msg);
 }
 
 static void show_message(const char *msg, void *user)
@@ -157,22 +298,27 @@ static int cmd_run(int argc, char **argv)
 {
     const char *scene_path = NULL, *out = NULL, *resume = NULL;
     double end = -1;
-    int threads = 0, render = 0, quiet = 0;
+    int threads = 0, render = 0, quiet = 0, force = 0;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+        if (is_help(a)) {
+            fputs(HELP_RUN, stdout);
+            return 0;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (++i >= argc) return usage_error("%s needs a directory", a);
             out = argv[i];
         } else if (!strcmp(a, "--threads")) {
             char *e;
             if (++i >= argc) return usage_error("%s needs a number", a);
             threads = (int)strtol(argv[i], &e, 10);
-            if (*e || threads < 1 || threads > 1024) return usage_error("--threads: '%s' is not a thread count 1..1024", argv[i]);
+            if (*e || e == argv[i] || threads < 0 || threads > 1024)
+                return usage_error("--threads: '%s' is not a thread count 1..1024 (0: the default)", argv[i]);
         } else if (!strcmp(a, "--end")) {
             char *e;
             if (++i >= argc) return usage_error("%s needs a time in seconds", a);
             end = strtod(argv[i], &e);
-            if (*e || !(end >= 0)) return usage_error("--end: '%s' is not a time >= 0", argv[i]);
+            if (*e || e == argv[i] || !(end >= 0) || !isfinite(end))
+                return usage_error("--end: '%s' is not a finite time >= 0", argv[i]);
         } else if (!strcmp(a, "--resume")) {
             if (++i >= argc) return usage_error("%s needs a run directory", a);
             resume = argv[i];
@@ -180,6 +326,8 @@ static int cmd_run(int argc, char **argv)
             render = 1;
         } else if (!strcmp(a, "--quiet")) {
             quiet = 1;
+        } else if (!strcmp(a, "--force")) {
+            force = 1;
         } else if (a[0] == '-') {
             return usage_error("unknown option '%s'", a);
         } else if (!scene_path) {
@@ -192,6 +340,7 @@ static int cmd_run(int argc, char **argv)
     if (resume) {
         if (scene_path) return usage_error("--resume takes the scene from RUN_DIR/scene.json, not '%s'", scene_path);
         if (out) return usage_error("--resume writes into RUN_DIR; drop '%s'", out);
+        if (force) return usage_error("%s", "--force is for a fresh run; --resume continues the run in RUN_DIR");
         if ((size_t)snprintf(resume_scene, sizeof resume_scene, "%s/scene.json", resume) >= sizeof resume_scene)
             return usage_error("--resume: path too long: '%s'", resume);
         scene_path = resume_scene;
@@ -200,17 +349,23 @@ static int cmd_run(int argc, char **argv)
     static pfsph_scene s;
     char *text = NULL;
     int rc = load_scene(scene_path, &s, &text);
+    if (!rc && end >= 0 && floor(end * s.fps + 1e-9) > PFSPH_MAX_FRAMES) {
+        fprintf(stderr, "pfsph: --end %g: at %g fps ($.time.fps of %s) that makes %.3g frames, more than the %d "
+                "one run holds\n", end, s.fps, s.source, end * s.fps, PFSPH_MAX_FRAMES);
+        rc = 2;
+    }
     if (!rc) rc = check_memory(&s, 0);
     if (rc) {
         free(text);
         return rc;
     }
     if (!scene_path) render = 1;
+    if (!scene_path && !out) force = 1; /* the embedded demo into its own directory: rerunnable */
     if (threads > 0) omp_set_num_threads(threads);
     else if (s.threads > 0) omp_set_num_threads(s.threads);
-    progress_state ps = {isatty(2), quiet};
+    progress_state ps = {isatty(2), quiet, -1e9};
     pfsph_run_opts o = {.out_dir = out, .end_time = end, .scene_text = text, .progress = show_progress, .user = &ps,
-                        .resume = resume != NULL, .message = show_message};
+                        .resume = resume != NULL, .message = show_message, .force = force};
     const char *dir = out ? out : s.output.dir;
     if (!quiet) fprintf(stderr, "pfsph %s: %s -> %s (%d threads)%s\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads(),
                         resume ? ", resuming" : "");
@@ -219,17 +374,20 @@ static int cmd_run(int argc, char **argv)
     free(text);
     if (rc) {
         if (ps.tty && !quiet) fputc('\n', stderr);
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     if (render) {
         pfsph_render_opts ro = {0};
         ro.last = -1;
         ro.quiet = quiet;
+        ro.progress = show_render_progress;
+        ro.message = show_render_message;
+        ro.user = &ps;
         int count = 0;
         rc = pfsph_render_run(dir, &ro, &count, &err);
         if (rc) {
-            fprintf(stderr, "pfsph: render: %s\n", err.msg);
+            print_error("render: ", err.msg);
             return exit_code(rc);
         }
         if (!quiet) fprintf(stderr, "rendered %d frames into %s/png\n", count, dir);
@@ -240,14 +398,18 @@ static int cmd_run(int argc, char **argv)
 
 static int cmd_check(int argc, char **argv)
 {
+    for (int i = 0; i < argc; i++)
+        if (is_help(argv[i])) {
+            fputs(HELP_CHECK, stdout);
+            return 0;
+        }
     if (argc != 1) return usage_error("%s", "check takes exactly one scene file");
+    if (argv[0][0] == '-') return usage_error("unknown option '%s'", argv[0]);
     static pfsph_scene s;
     char *text = NULL;
     int rc = load_scene(argv[0], &s, &text);
     free(text);
     if (rc) return rc;
-    printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids\n", s.source, s.dim,
-           s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
     rc = check_memory(&s, 1);
     if (rc) return rc;
     double rho_lo, rho_hi;
@@ -288,11 +450,14 @@ static int cmd_check(int argc, char **argv)
         double d = 2 * s.particle_radius;
         rc = pfsph_pairwise_resolve(&s, (pfsph_real)d, (pfsph_real)(s.support_factor * d), &err);
         if (rc) {
-            fprintf(stderr, "pfsph: %s\n", err.msg);
+            print_error(NULL, err.msg);
             return exit_code(rc);
         }
         pfsph_pairwise_report(&s, stdout);
     }
+    /* the verdict last, once every check has passed */
+    printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids\n", s.source, s.dim,
+           s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
     return 0;
 }
 
@@ -301,9 +466,16 @@ static int cmd_render(int argc, char **argv)
     const char *dir = NULL;
     pfsph_render_opts o = {0};
     o.last = -1;
+    progress_state ps = {isatty(2), 0, -1e9};
+    o.progress = show_render_progress;
+    o.message = show_render_message;
+    o.user = &ps;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
-        if (!strcmp(a, "--video")) o.video = true;
+        if (is_help(a)) {
+            fputs(HELP_RENDER, stdout);
+            return 0;
+        } else if (!strcmp(a, "--video")) o.video = true;
         else if (!strcmp(a, "--color-by")) {
             if (++i >= argc) return usage_error("%s needs a field", a);
             o.color_by = argv[i];
@@ -320,7 +492,7 @@ static int cmd_render(int argc, char **argv)
     int count = 0;
     int rc = pfsph_render_run(dir, &o, &count, &err);
     if (rc) {
-        fprintf(stderr, "pfsph: %s\n", err.msg);
+        print_error(NULL, err.msg);
         return exit_code(rc);
     }
     printf("rendered %d frames into %s/png\n", count, dir);
@@ -339,7 +511,12 @@ int main(int argc, char **argv)
         return 0;
     }
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
-        fputs(USAGE, stdout);
+        const char *topic = argc > 2 ? argv[2] : NULL;
+        if (!topic) fputs(HELP, stdout), fputs("\n", stdout), fputs(USAGE, stdout);
+        else if (!strcmp(topic, "run")) fputs(HELP_RUN, stdout);
+        else if (!strcmp(topic, "check")) fputs(HELP_CHECK, stdout);
+        else if (!strcmp(topic, "render")) fputs(HELP_RENDER, stdout);
+        else return usage_error("help: unknown command '%s'", topic);
         return 0;
     }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);

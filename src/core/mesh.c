@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* Limits that keep any input (including fuzzed bytes) within a bounded amount of memory. */
 #define MESH_MAX_TRIS 10000000u
@@ -276,6 +277,12 @@ int pfsph_mesh_load_obj(pfsph_mesh *m, const char *path, pfsph_error *err)
     memset(m, 0, sizeof *m);
     FILE *f = fopen(path, "rb");
     if (!f) return pfsph_fail(err, PFSPH_EINPUT, "%s: cannot open: %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0 && !S_ISREG(sb.st_mode)) {
+        fclose(f);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: %s, not an OBJ file", path,
+                          S_ISDIR(sb.st_mode) ? "is a directory" : "is not a regular file");
+    }
     size_t cap = 1 << 16, n = 0, r;
     char *buf = malloc(cap);
     int rc = PFSPH_OK;
@@ -297,7 +304,7 @@ int pfsph_mesh_load_obj(pfsph_mesh *m, const char *path, pfsph_error *err)
         }
     }
     if (!buf) rc = pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory reading the file", path);
-    else if (!rc && ferror(f)) rc = pfsph_fail(err, PFSPH_EINPUT, "%s: read error", path);
+    else if (!rc && ferror(f)) rc = pfsph_fail(err, PFSPH_EINPUT, "%s: cannot read: %s", path, strerror(errno));
     fclose(f);
     if (!rc) rc = pfsph_mesh_parse_obj(m, buf, n, path, err);
     free(buf);

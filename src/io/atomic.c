@@ -6,6 +6,7 @@
 #include <fcntl.h>
 #include <stdarg.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -239,4 +240,25 @@ double pfsph__get_as_double(int type, const unsigned char *src)
     case PFSPH__T_F64: { double v; pfsph__get_le(&v, src, 8); return v; }
     default: return 0;
     }
+}
+
+int pfsph_mkdirs(const char *path, pfsph_error *err)
+{
+    char buf[PFSPH_PATH_LEN + 64];
+    if (strlen(path) >= sizeof buf) return pfsph_fail(err, PFSPH_EIO, "%s: path too long", path);
+    strcpy(buf, path);
+    for (char *p = buf + 1;; p++) {
+        if (*p == '/' || *p == 0) {
+            char c = *p;
+            *p = 0;
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return pfsph_fail(err, PFSPH_EIO, "%s: cannot create directory: %s", buf, strerror(errno));
+            struct stat st;
+            if (stat(buf, &st) != 0 || !S_ISDIR(st.st_mode))
+                return pfsph_fail(err, PFSPH_EIO, "%s: exists and is not a directory", buf);
+            *p = c;
+            if (!c) break;
+        }
+    }
+    return PFSPH_OK;
 }

@@ -7,6 +7,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,7 +17,6 @@
 
 #include "io/io_internal.h"
 #include "pfsph/io.h"
-#include "pfsph/run.h"
 
 static const unsigned char MAGIC[8] = {'P', 'F', 'S', 'P', 'H', 'C', 'K', 'P'};
 enum { HEADER_LEN = 40 };
@@ -394,16 +394,68 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
     ps->next_id = next_id;
     for (size_t i = 0; i < ps->n; i++)
         if (ps->id[i] >= next_id) {
+            const uint32_t id = ps->id[i]; /* read before the arrays go */
             pfsph_particles_free(ps);
             return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle id %u not below next id %u",
-                              name, what, ps->id[i], next_id);
+                              name, what, id, next_id);
         }
+    for (int k = 0; k < PFSPH_NFIELDS; k++)
+        for (size_t i = 0; i < ps->n; i++)
+            if (!isfinite((double)ps->f[k][i])) {
+                const double v = (double)ps->f[k][i];
+                pfsph_particles_free(ps);
+                return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle %zu has a non-finite "
+                                  "field (%g)", name, what, i, v);
+            }
     return PFSPH_OK;
 }
 
-int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const char *name,
-                            pfsph_checkpoint_info *info, pfsph_error *err)
+/* The clock and counters against the scene: the frame within what a run can hold (and the
+ * file name's frame when there is one), the time on that frame, finite non-negative rates. */
+static int check_clock(const pfsph_scene *s, int32_t fr, long expect_frame, int32_t threads,
+                       const pfsph_sim_state *st, const char *name, pfsph_error *err)
 {
+    if (fr < 0 || fr > PFSPH_MAX_FRAMES)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: frame %d is outside 0..%d", name, (int)fr,
+                          PFSPH_MAX_FRAMES);
+    if (expect_frame >= 0 && fr != expect_frame)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: it holds frame %d, its name says %ld", name,
+                          (int)fr, expect_frame);
+    if (!isfinite(st->time) || !(fabs(st->time * s->fps - fr) <= 1e-6 * (1 + fr)))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: time %g s is not the time of frame %d at "
+                          "%g fps", name, st->time, (int)fr, s->fps);
+    if (threads < 1 || threads > 65536)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: thread count %d", name, (int)threads);
+    /* steps are at least dt_min long, except one shortened step per frame */
+    if (s->dt_min > 0 && (double)st->step > st->time / s->dt_min + fr + 1)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %llu steps in %g s with dt_min %g s", name,
+                          (unsigned long long)st->step, st->time, s->dt_min);
+    const struct {
+        const char *what;
+        double v;
+    } rates[] = {{"amax", st->amax}, {"amax_np", st->amax_np}, {"dt", st->stats.dt}, {"vmax", st->stats.vmax},
+                 {"density_err_avg", st->stats.density_err_avg},
+                 {"density_err_max", st->stats.density_err_max}, {"ekin", st->stats.ekin}};
+    for (size_t k = 0; k < sizeof rates / sizeof rates[0]; k++)
+        if (!(rates[k].v >= 0) || !isfinite(rates[k].v))
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s is %g", name, rates[k].what,
+                              rates[k].v);
+    if (st->stats.dt > s->dt_max * (1 + 1e-9))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: dt %g s above time.dt_max %g s", name,
+                          st->stats.dt, s->dt_max);
+    if (st->stats.iterations < 0 || st->stats.iterations > s->pcisph_max_iter)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %d PCISPH iterations", name,
+                          (int)st->stats.iterations);
+    for (int k = 0; k < PFSPH_NSTAGES; k++)
+        if (!(st->stage_s[k] >= 0) || !isfinite(st->stage_s[k]))
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: stage seconds %g", name, st->stage_s[k]);
+    return PFSPH_OK;
+}
+
+static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name, long expect_frame,
+                  pfsph_checkpoint_info *info, pfsph_error *err)
+{
+    int rc;
     const unsigned char *b = data;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     if (len < HEADER_LEN)
@@ -466,12 +518,21 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
         double v = r_f64(&r);
         if (k < PFSPH_NSTAGES) st.stage_s[k] = v;
     }
-    if (r.bad || fr < 0 || dim != c->dim || nph != (uint32_t)c->nphases || nst > 64)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: bad frame, dimension or phase count", name);
+    if (r.bad || dim != c->dim || nph != (uint32_t)c->nphases || nst > 64)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: bad dimension (%d) or phase count (%u)", name,
+                          (int)dim, nph);
+    if ((rc = check_clock(pfsph_sim_scene(sim), fr, expect_frame, threads, &st, name, err))) return rc;
     pfsph_particles fluid, diff;
     memset(&diff, 0, sizeof diff);
-    int rc = r_set(&r, &fluid, name, "fluid", err);
+    rc = r_set(&r, &fluid, name, "fluid", err);
     if (rc) return rc;
+    /* fluid particles are never added: the ids are those the scene made */
+    if (fluid.next_id != c->fluid->next_id || st.removed > fluid.next_id) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: fluid next id %u and %zu removed, the scene "
+                        "makes %u fluid particles", name, fluid.next_id, st.removed, c->fluid->next_id);
+        pfsph_particles_free(&fluid);
+        return rc;
+    }
     uint8_t has_d = r_u8(&r);
     uint64_t created = 0, refused = 0;
     if (has_d) {
@@ -538,7 +599,15 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
     return rc;
 }
 
+int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const char *name,
+                            pfsph_checkpoint_info *info, pfsph_error *err)
+{
+    return decode(sim, data, len, name, -1, info, err);
+}
+
 /* ---- files ---- */
+
+static long name_frame(const char *name);
 
 int pfsph_checkpoint_save(const char *path, const pfsph_sim *sim, int frame, size_t *bytes,
                           pfsph_error *err)
@@ -560,7 +629,8 @@ int pfsph_checkpoint_load(const char *path, pfsph_sim *sim, pfsph_checkpoint_inf
     size_t len;
     int rc = pfsph__read_file(path, &data, &len, err);
     if (rc) return rc;
-    rc = pfsph_checkpoint_decode(sim, data, len, path, info, err);
+    const char *base = strrchr(path, '/');
+    rc = decode(sim, data, len, path, name_frame(base ? base + 1 : path), info, err);
     free(data);
     return rc;
 }

@@ -747,7 +747,7 @@ static int run_wait(char *const argv[])
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-static int make_video(const char *run_dir, int first, double fps, bool quiet, pfsph_error *err)
+static int make_video(const char *run_dir, int first, double fps, const pfsph_render_opts *o, pfsph_error *err)
 {
     char pattern[PFSPH_PATH_LEN + 64], out[PFSPH_PATH_LEN + 64], tmp[PFSPH_PATH_LEN + 96];
     snprintf(pattern, sizeof pattern, "%s/png/frame_%%05d.png", run_dir);
@@ -780,7 +780,11 @@ static int make_video(const char *run_dir, int first, double fps, bool quiet, pf
         unlink(tmp);
         return pfsph_fail(err, PFSPH_EIO, "%s: rename failed: %s", out, strerror(e));
     }
-    if (!quiet) fprintf(stderr, "render: wrote %s\n", out);
+    if (o->message) {
+        char msg[PFSPH_PATH_LEN + 96];
+        snprintf(msg, sizeof msg, "wrote %s", out);
+        o->message(msg, o->user);
+    }
     return PFSPH_OK;
 }
 
@@ -915,6 +919,8 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
         goto out;
     }
     int first_num = fl.num[i0];
+    int total = 0;
+    for (int i = i0; i < fl.n && (o->last < 0 || fl.num[i] <= o->last); i++) total++;
     for (int i = i0; i < fl.n; i++) {
         int f = fl.num[i];
         if (o->last >= 0 && f > o->last) break;
@@ -951,10 +957,9 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
                           t, path, err);
         if (rc != PFSPH_OK) goto out;
         rendered++;
-        if (!o->quiet) fprintf(stderr, "\rrender: %s", path);
+        if (o->progress) o->progress(rendered, total, path, o->user);
     }
-    if (!o->quiet && rendered) fprintf(stderr, "\n"); /* ends the progress line */
-    if (o->video) rc = make_video(run_dir, first_num, sc->fps, o->quiet, err);
+    if (o->video) rc = make_video(run_dir, first_num, sc->fps, o, err);
 
 out:
     if (count) *count = rendered;

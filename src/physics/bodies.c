@@ -165,7 +165,9 @@ static int body_mesh(const pfsph_scene *s, body *bd, pfsph_error *err)
             (rc = pfsph_mesh_validate_closed(&bd->mesh, d->mesh, err))) {
             char msg[sizeof err->msg];
             snprintf(msg, sizeof msg, "%s", err->msg);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: body \"%s\": %s", s->source, d->name, msg);
+            int bi = 0; /* the body's index, for its JSON path */
+            while (bi < s->nbodies - 1 && strcmp(s->bodies[bi].name, d->name) != 0) bi++;
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.bodies[%d].file (body \"%s\"): %s", s->source, bi, d->name, msg);
         }
         double vol, com[3], I[9];
         pfsph_mesh_transform(&bd->mesh, d->scale, NULL, NULL);

@@ -236,12 +236,22 @@ static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, dou
     return dt;
 }
 
-static double speed_bound(const void *state) { return 20 * ((const dfsph *)state)->c; }
+static double speed_bound(const void *state, const pfsph_ctx *ctx)
+{
+    (void)ctx;
+    return 20 * ((const dfsph *)state)->c;
+}
+
+static const char *hint(const void *state, const pfsph_ctx *ctx)
+{
+    (void)state;
+    (void)ctx;
+    return "lower time.cfl or dt_max, or tighten solver.tolerance; check pairwise coefficients and viscosity";
+}
 
 const pfsph_solver_ops pfsph_solver_dfsph = {
     .name = "dfsph",
     .nscratch = NSCR,
-    .hint = "lower time.cfl or dt_max, or tighten solver.tolerance; check pairwise coefficients and viscosity",
     .create = create,
     .destroy = destroy,
     .pre_forces = pre_forces,
@@ -249,4 +259,5 @@ const pfsph_solver_ops pfsph_solver_dfsph = {
     .wall_pressure = wall_pressure,
     .dt_limit = dt_limit,
     .speed_bound = speed_bound,
+    .hint = hint,
 };

@@ -104,17 +104,34 @@ static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, dou
     return dt;
 }
 
-static double speed_bound(const void *state) { return 20 * ((const pcisph *)state)->c; }
+/* PCISPH removes the density error within one step, so with a tiny dt its pressure speeds
+ * grow as 1/dt without harm: a speed is a blow-up only above 20 c and once the particle also
+ * moves half a spacing in the step (issue 15 item 5). */
+static double speed_bound(const void *state, const pfsph_ctx *ctx)
+{
+    const double b = 20 * ((const pcisph *)state)->c;
+    return ctx->dt > 0 ? fmax(b, 0.5 * (double)ctx->spacing / ctx->dt) : b;
+}
+
+/* below the acoustic step a smaller dt_max makes things worse */
+static const char *hint(const void *state, const pfsph_ctx *ctx)
+{
+    const pcisph *P = state;
+    if (ctx->dt > 0 && ctx->dt < P->cfl * (double)ctx->spacing / P->c)
+        return "the time step is far below what PCISPH needs (it removes density errors within one step, so "
+               "speeds grow as 1/dt): raise time.dt_max and time.dt_min, do not lower them";
+    return "lower time.cfl or dt_max; check pairwise coefficients and viscosity";
+}
 
 const pfsph_solver_ops pfsph_solver_pcisph = {
     .name = "pcisph",
     .nscratch = NSCR,
-    .hint = "lower time.cfl or dt_max; check pairwise coefficients and viscosity",
     .create = create,
     .destroy = destroy,
     .solve = solve,
     .dt_limit = dt_limit,
     .speed_bound = speed_bound,
+    .hint = hint,
 };
 
 static double prototype(const pfsph_kernel *k, int dim, pfsph_real spacing)

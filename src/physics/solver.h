@@ -30,7 +30,6 @@ typedef struct pfsph_solve_stats {
 typedef struct pfsph_solver_ops {
     const char *name;      /* as in the scene's solver.type */
     int nscratch;          /* per-fluid-particle scratch arrays the solver needs */
-    const char *hint;      /* likely cause of a blow-up under this solver, for the message */
     /* Solver state for the fluid of ctx; NULL state is allowed. */
     int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg,
                   pfsph_error *err);
@@ -53,8 +52,10 @@ typedef struct pfsph_solver_ops {
      * simulation adds dt_max, viscous diffusion and the landing on frame times. */
     double (*dt_limit)(const void *state, const pfsph_ctx *ctx, double vmax, double amax,
                        double amax_np);
-    /* Speeds above this are a blow-up [m/s]. */
-    double (*speed_bound)(const void *state);
+    /* Speeds above this are a blow-up [m/s], for the step ctx->dt (0 before the first). */
+    double (*speed_bound)(const void *state, const pfsph_ctx *ctx);
+    /* The likely cause of a blow-up under this solver at ctx's step, for the message. */
+    const char *(*hint)(const void *state, const pfsph_ctx *ctx);
 } pfsph_solver_ops;
 
 /* The solver called name, or NULL. */

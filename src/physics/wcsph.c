@@ -59,15 +59,26 @@ static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, dou
     return fmin(dt, pfsph__dt_force(d, amax));
 }
 
-static double speed_bound(const void *state) { return ((const wcsph *)state)->c; }
+static double speed_bound(const void *state, const pfsph_ctx *ctx)
+{
+    (void)ctx;
+    return ((const wcsph *)state)->c;
+}
+
+static const char *hint(const void *state, const pfsph_ctx *ctx)
+{
+    (void)state;
+    (void)ctx;
+    return "the time step is too large for the stiffness: lower time.cfl or dt_max, or raise solver.sound_speed";
+}
 
 const pfsph_solver_ops pfsph_solver_wcsph = {
     .name = "wcsph",
     .nscratch = 1,
-    .hint = "the time step is too large for the stiffness: lower time.cfl or dt_max, or raise solver.sound_speed",
     .create = create,
     .destroy = destroy,
     .solve = solve,
     .dt_limit = dt_limit,
     .speed_bound = speed_bound,
+    .hint = hint,
 };

@@ -340,6 +340,10 @@ static int parse_time(parser *p, const cJSON *root)
         return pfsph__json_fail(&p->ctx, "$.time.dt_min",
                                 "dt_min (%g s) is greater than dt_max (%g s)", s->dt_min,
                                 s->dt_max);
+    if (s->end_time * s->fps > PFSPH_MAX_FRAMES)
+        return pfsph__json_fail(&p->ctx, "$.time.end",
+                                "end %g s at %g fps makes %.3g frames, more than the %d one run "
+                                "holds", s->end_time, s->fps, s->end_time * s->fps, PFSPH_MAX_FRAMES);
     return PFSPH_OK;
 }
 
@@ -1037,12 +1041,31 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
         int line, col;
         const char *pos = end ? end : json;
         line_col(json, pos, &line, &col);
-        char near[24];
+        /* the bytes there, printable: control and non-ASCII bytes as \xNN */
+        char near[16 * 4 + 1];
         size_t n = 0;
-        for (const char *c = pos; *c && n < 16; c++)
-            near[n++] = (*c == '\n' || *c == '\t' || *c == '\r') ? ' ' : *c;
+        for (const char *c = pos; *c && c - pos < 16; c++) {
+            unsigned char u = (unsigned char)*c;
+            if (*c == '\n' || *c == '\t' || *c == '\r') near[n++] = ' ';
+            else if (u < 0x20 || u >= 0x7f || u == '"' || u == '\\')
+                n += (size_t)snprintf(near + n, sizeof near - n, "\\x%02x", u);
+            else near[n++] = *c;
+        }
         near[n] = 0;
+        /* cJSON stops at CJSON_NESTING_LIMIT levels: say so rather than "invalid" */
+        int depth = 0, in_str = 0;
+        for (const char *c = json; c < pos; c++) {
+            if (in_str) {
+                if (*c == '\\' && c + 1 < pos) c++;
+                else if (*c == '"') in_str = 0;
+            } else if (*c == '"') in_str = 1;
+            else if (*c == '[' || *c == '{') depth++;
+            else if (*c == ']' || *c == '}') depth--;
+        }
         free(s);
+        if (depth >= CJSON_NESTING_LIMIT)
+            return pfsph__json_fail(&ctx, "$", "JSON nested too deep: more than %d arrays and objects within "
+                                    "each other at line %d, column %d", CJSON_NESTING_LIMIT, line, col);
         if (!*pos)
             return pfsph__json_fail(&ctx, "$",
                                     "invalid JSON: unexpected end of text at line %d, column %d "

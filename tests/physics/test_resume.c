@@ -103,7 +103,7 @@ static void test_resume_library(void **st)
     char part[1024];
     snprintf(part, sizeof part, "%s/part", tu_tmpdir());
     run(&s, part, 0.2, false); /* frames 0..5, checkpoint at 5 */
-    run(&s, part, -1, true);   /* 6..10 */
+    run(&s, part, 0.4, true);  /* 6..10 (without an end time it would keep its own, 0.2) */
     compare_runs(full_dir, part);
     /* the diffuse set is not empty at frame 10 (so its restore was exercised) */
     size_t len;
@@ -144,7 +144,7 @@ static void test_resume_fallback_cli(void **st)
     assert_int_equal(fwrite(b, 1, len, f), len);
     fclose(f);
     free(b);
-    snprintf(cmd, sizeof cmd, "%s run --resume %s --quiet --threads %d", tu_pfsph_bin(), dir,
+    snprintf(cmd, sizeof cmd, "%s run --resume %s --quiet --end 0.4 --threads %d", tu_pfsph_bin(), dir,
              omp_get_max_threads());
     rc = tu_run(cmd, out, sizeof out);
     fprintf(stderr, "%s", out);

@@ -6,7 +6,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <limits.h>
 #include <sys/stat.h>
+#include <zlib.h>
 
 #include "pfsph/checkpoint.h"
 #include "pfsph/sim.h"
@@ -169,7 +171,7 @@ static void test_corrupt_and_truncated(void **st)
     (void)st;
     pfsph_error err = {0};
     pfsph_sim *a = make_sim("-9.81", "pcisph");
-    assert_int_equal(pfsph_sim_advance(a, 0.1, &err), PFSPH_OK);
+    assert_int_equal(pfsph_sim_advance(a, 0.08, &err), PFSPH_OK);
     char path[512], bad[512];
     snprintf(path, sizeof path, "%s/good.bin", tu_tmpdir());
     size_t bytes = 0;
@@ -339,6 +341,115 @@ static void test_keep_and_fallback(void **st)
     pfsph_sim_destroy(ref);
 }
 
+/* ---- crafted checkpoints: valid CRCs over bad contents (issue 15, items 1 and 2) ---- */
+
+enum { OFF_FRAME = 40, OFF_TIME = 56, OFF_NST = 140 };
+
+static uint32_t get_u32(const unsigned char *b) { return b[0] | b[1] << 8 | b[2] << 16 | (uint32_t)b[3] << 24; }
+static void put_u32(unsigned char *b, uint32_t v)
+{
+    for (int k = 0; k < 4; k++) b[k] = (unsigned char)(v >> 8 * k);
+}
+
+/* Recompute the payload and header CRC32s after an edit. */
+static void reseal(unsigned char *b, size_t len)
+{
+    put_u32(b + 32, (uint32_t)crc32(crc32(0L, Z_NULL, 0), b + 40, (uInt)(len - 40)));
+    put_u32(b + 36, (uint32_t)crc32(crc32(0L, Z_NULL, 0), b, 36));
+}
+
+/* Offset of the fluid set's next_id (after u64 n). */
+static size_t off_fluid_next_id(const unsigned char *b) { return OFF_NST + 4 + 8 * (size_t)get_u32(b + OFF_NST) + 8; }
+
+static unsigned char *good_checkpoint(int frame, size_t *len)
+{
+    pfsph_error err = {0};
+    pfsph_sim *a = make_sim("-9.81", "pcisph");
+    assert_int_equal(pfsph_sim_advance(a, frame / 25.0, &err), PFSPH_OK);
+    void *data;
+    assert_int_equal(pfsph_checkpoint_encode(a, frame, &data, len, &err), PFSPH_OK);
+    pfsph_sim_destroy(a);
+    return data;
+}
+
+/* Decoding must refuse with PFSPH_EINPUT and a message containing `what`, sim untouched. */
+static void expect_reject_mem(const unsigned char *b, size_t len, const char *what)
+{
+    pfsph_sim *s = make_sim("-9.81", "pcisph");
+    pfsph_error err = {0};
+    int rc = pfsph_checkpoint_decode(s, b, len, "crafted", NULL, &err);
+    fprintf(stderr, "  rejected as expected: %s\n", err.msg);
+    assert_int_equal(rc, PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "crafted"));
+    assert_non_null(strstr(err.msg, what));
+    assert_true(pfsph_sim_time(s) == 0.0);
+    pfsph_sim_destroy(s);
+}
+
+/* Item 1: an id >= next_id used to crash (the message read the freed id array). */
+static void test_crafted_ids(void **st)
+{
+    (void)st;
+    size_t len;
+    unsigned char *b = good_checkpoint(2, &len);
+    const size_t o = off_fluid_next_id(b);
+    const uint32_t next = get_u32(b + o);
+    put_u32(b + o, 0);
+    reseal(b, len);
+    expect_reject_mem(b, len, "particle id 0 not below next id 0");
+    /* ids all below a larger next id, but the scene never made that many */
+    put_u32(b + o, next + 1000);
+    reseal(b, len);
+    expect_reject_mem(b, len, "fluid next id");
+    put_u32(b + o, next);
+    reseal(b, len);
+    pfsph_sim *s = make_sim("-9.81", "pcisph");
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_checkpoint_decode(s, b, len, "crafted", NULL, &err), PFSPH_OK);
+    pfsph_sim_destroy(s);
+    free(b);
+}
+
+/* Item 2: frame INT_MAX made the run loop's frame0 + 1 overflow and write frames until the
+ * disk filled. The frame is bounded, the time must be that frame's, a file's name must match
+ * the frame it holds, and the clock's rates must be finite. */
+static void test_crafted_clock(void **st)
+{
+    (void)st;
+    size_t len;
+    unsigned char *b = good_checkpoint(2, &len);
+    put_u32(b + OFF_FRAME, INT_MAX);
+    reseal(b, len);
+    expect_reject_mem(b, len, "frame 2147483647 is outside");
+    put_u32(b + OFF_FRAME, (uint32_t)-5);
+    reseal(b, len);
+    expect_reject_mem(b, len, "frame -5 is outside");
+    put_u32(b + OFF_FRAME, 3); /* the time is frame 2's */
+    reseal(b, len);
+    expect_reject_mem(b, len, "is not the time of frame 3");
+    put_u32(b + OFF_FRAME, 2);
+    double t;
+    memcpy(&t, b + OFF_TIME + 8 * 2, 8); /* amax */
+    double inf = INFINITY;
+    memcpy(b + OFF_TIME + 8 * 2, &inf, 8);
+    reseal(b, len);
+    expect_reject_mem(b, len, "amax is inf");
+    memcpy(b + OFF_TIME + 8 * 2, &t, 8);
+    reseal(b, len);
+    /* a file named for frame 7 that holds frame 2 */
+    char path[600];
+    snprintf(path, sizeof path, "%s/ckpt_00007.bin", tu_tmpdir());
+    spit(path, b, len);
+    expect_reject(path, "its name says 7");
+    snprintf(path, sizeof path, "%s/ckpt_00002.bin", tu_tmpdir());
+    spit(path, b, len);
+    pfsph_sim *s = make_sim("-9.81", "pcisph");
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_checkpoint_load(path, s, NULL, &err), PFSPH_OK);
+    pfsph_sim_destroy(s);
+    free(b);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -347,6 +458,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_roundtrip_dfsph),
         cmocka_unit_test(test_corrupt_and_truncated), cmocka_unit_test(test_other_scene),
         cmocka_unit_test(test_keep_and_fallback), cmocka_unit_test(test_scene_key),
+        cmocka_unit_test(test_crafted_ids), cmocka_unit_test(test_crafted_clock),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -32,6 +32,10 @@ static const cli_case cases[] = {
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]},{\"shape\":\"box\",\"min\":[0.1,0.1,0.1],"
      "\"max\":[0.3,0.3,0.3]}]}",
      "$.fluid[1]: overlaps $.fluid[0]"},
+    {"frames.json", /* issue 15 item 4: end x fps overflowed the frame count */
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"time\":{\"end\":1e6,\"fps\":1e4}}",
+     "$.time.end: end 1e+06 s at 10000 fps makes 1e+10 frames, more than the 100000000 one run holds"},
 };
 #define NCASES (sizeof cases / sizeof cases[0])
 
@@ -101,6 +105,28 @@ static void test_run_bad_writes_nothing(void **state)
     assert_string_equal(out, "keep me\n");
 }
 
+/* Issue 15 item 4: `--end 1e10` (or inf) overflowed the frame count: the run exited 0 with
+ * nothing simulated. Refused with exit 2, before the run directory is created. */
+static void test_run_end_overflow(void **state)
+{
+    (void)state;
+    char path[512], dir[600], cmd[2048], out[4096];
+    snprintf(path, sizeof path, "%s/small.json", tu_tmpdir());
+    assert_int_equal(tu_write_file(path, "{\"dimension\":2,\"particle_radius\":0.02,"
+                                         "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
+                                         "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"), 0);
+    static const char *const ends[] = {"1e10", "inf", "nan", "1e300", "-1", ""};
+    for (size_t i = 0; i < sizeof ends / sizeof ends[0]; i++) {
+        snprintf(dir, sizeof dir, "%s/end_run_%zu", tu_tmpdir(), i);
+        snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet --end '%s'", tu_pfsph_bin(), path, dir, ends[i]);
+        int st = tu_run(cmd, out, sizeof out);
+        if (st != 2) fail_msg("--end '%s': exit status %d, expected 2; output: %s", ends[i], st, out);
+        if (!strstr(out, "--end")) fail_msg("--end '%s': the message does not name --end: %s", ends[i], out);
+        struct stat sb;
+        assert_int_not_equal(stat(dir, &sb), 0);
+    }
+}
+
 /* The shipped example scenes pass `pfsph check`. */
 static void test_check_good(void **state)
 {
@@ -116,6 +142,146 @@ static void test_check_good(void **state)
     }
 }
 
+/* Issue 15 item 12: messages that name the JSON path, the right exit status, escaped bytes,
+ * the verdict of `pfsph check` last. */
+#define BASE3 "\"dimension\":3,\"particle_radius\":0.02,\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]}," \
+              "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}]"
+#define BODY "\"phases\":[{\"name\":\"water\"},{\"name\":\"s\",\"kind\":\"solid\"}],\"bodies\":[{\"name\":\"b\"," \
+             "\"shape\":\"box\",\"half_extents\":[0.05,0.05,0.05],\"position\":[0.8,0.8,0.8],\"phase\":\"s\"}," \
+             "{\"name\":\"m\",\"shape\":\"mesh\",\"file\":\"%s\",\"phase\":\"s\",\"position\":[0.5,0.5,0.5]}]"
+
+static int cli(const char *args, char *out, size_t cap)
+{
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "'%s' %s", tu_pfsph_bin(), args);
+    int st = tu_run(cmd, out, cap);
+    printf("$ pfsph %s\n-> %d: %s", args, st, out);
+    return st;
+}
+
+static void expect(const char *name, const char *json, const char *cmd, int status, const char *want)
+{
+    char path[600], args[2048], out[8192];
+    snprintf(path, sizeof path, "%s/%s", tu_tmpdir(), name);
+    assert_int_equal(tu_write_file(path, json), 0);
+    snprintf(args, sizeof args, cmd, path);
+    int st = cli(args, out, sizeof out);
+    if (st != status) fail_msg("%s: exit status %d, expected %d: %s", name, st, status, out);
+    if (!strstr(out, want)) fail_msg("%s: output lacks \"%s\": %s", name, want, out);
+    if (status && strstr(out, ": valid ")) fail_msg("%s: \"valid\" printed before the failure: %s", name, out);
+}
+
+static void test_messages(void **state)
+{
+    (void)state;
+    char json[4096], out[8192], args[2048];
+    snprintf(json, sizeof json, "{" BASE3 "," BODY "}", "no_such_mesh.obj");
+    expect("mesh_missing.json", json, "check '%s'", 2, "$.bodies[1].file (body \"m\"): ");
+    expect("mesh_missing2.json", json, "check '%s'", 2, "no_such_mesh.obj: cannot open: No such file");
+    snprintf(json, sizeof json, "{" BASE3 "," BODY "}", tu_tmpdir());
+    expect("mesh_dir.json", json, "check '%s'", 2, "is a directory, not an OBJ file");
+    /* a directory as the scene */
+    snprintf(args, sizeof args, "check '%s'", tu_tmpdir());
+    assert_int_equal(cli(args, out, sizeof out), 2);
+    assert_non_null(strstr(out, "is a directory, not a scene file"));
+    /* nested past cJSON's limit */
+    static char deep[3000];
+    memset(deep, '[', 2000);
+    deep[2000] = 0;
+    expect("deep.json", deep, "check '%s'", 2, "$: JSON nested too deep: more than 1000");
+    /* bytes that would drive the terminal come back escaped */
+    expect("bytes.json", "{\"\x1b[31mred\xff\xfe\": 1}", "check '%s'", 2, "\\x1b[31mred\\xff\\xfe");
+    snprintf(args, sizeof args, "check '%s/bytes.json'", tu_tmpdir());
+    cli(args, out, sizeof out);
+    for (const char *c = out; *c; c++)
+        if ((unsigned char)*c == 0x1b || (unsigned char)*c >= 0x80) fail_msg("raw byte 0x%02x in: %s", (unsigned char)*c, out);
+    expect("garbage.json", "\x01\x02\x9b\x1b]0;title\x07", "check '%s'", 2, "near \"\\x9b\\x1b]0;title\\x07\"");
+    /* an output directory that is a file: bad input, exit 2, the JSON path named */
+    char file[700];
+    snprintf(file, sizeof file, "%s/a_file", tu_tmpdir());
+    assert_int_equal(tu_write_file(file, "x"), 0);
+    snprintf(json, sizeof json, "{" BASE3 ",\"output\":{\"directory\":\"%s/sub\"}}", file);
+    expect("out_file.json", json, "run '%s' --quiet", 2, "$.output.directory");
+    snprintf(json, sizeof json, "{" BASE3 "}");
+    snprintf(args, sizeof args, "%s/plain.json", tu_tmpdir());
+    assert_int_equal(tu_write_file(args, json), 0);
+    snprintf(args, sizeof args, "run '%s/plain.json' -o '%s' --quiet", tu_tmpdir(), file);
+    assert_int_equal(cli(args, out, sizeof out), 2);
+    assert_non_null(strstr(out, "output directory"));
+    assert_non_null(strstr(out, "exists and is not a directory"));
+    /* the verdict last */
+    snprintf(args, sizeof args, "check '%s/scenes/dam_break_2d.json'", tu_source_dir());
+    assert_int_equal(cli(args, out, sizeof out), 0);
+    size_t n = strlen(out);
+    while (n && out[n - 1] == '\n') out[--n] = 0;
+    const char *last = strrchr(out, '\n');
+    last = last ? last + 1 : out;
+    assert_non_null(strstr(last, ": valid 2D scene"));
+}
+
+/* Issue 15 item 12: "output": {"boundary": false} writes no boundary frame. */
+static void test_no_boundary(void **state)
+{
+    (void)state;
+    char path[600], args[2048], out[8192], dir[700], b[800];
+    struct stat sb;
+    const char *json = "{\"dimension\":2,\"particle_radius\":0.02,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
+                       "\"time\":{\"end\":0.04},\"phases\":[{\"name\":\"w\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
+                       "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}],"
+                       "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[0.8,0.8],\"phase\":\"wall\"}],"
+                       "\"output\":{\"formats\":[\"vtp\"],\"boundary\":%s}}";
+    for (int on = 0; on < 2; on++) {
+        char text[2048];
+        snprintf(text, sizeof text, json, on ? "true" : "false");
+        snprintf(path, sizeof path, "%s/boundary_%d.json", tu_tmpdir(), on);
+        assert_int_equal(tu_write_file(path, text), 0);
+        snprintf(dir, sizeof dir, "%s/boundary_run_%d", tu_tmpdir(), on);
+        snprintf(args, sizeof args, "run '%s' -o '%s' --quiet", path, dir);
+        assert_int_equal(cli(args, out, sizeof out), 0);
+        snprintf(b, sizeof b, "%s/frames/boundary_00000.vtp", dir);
+        assert_int_equal(stat(b, &sb) == 0, on);
+        snprintf(b, sizeof b, "%s/frames/fluid_00001.vtp", dir);
+        assert_int_equal(stat(b, &sb), 0);
+    }
+}
+
+/* Issue 15 item 13: every subcommand explains itself; --threads 0 is the default. */
+static void test_help(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *args;
+        const char *want[10];
+    } cases[] = {
+        {"--help", {"run ", "check ", "render ", "help ", "--version", "Exit status", NULL}},
+        {"help", {"run ", "check ", "render ", NULL}},
+        {"run --help", {"usage: pfsph run", "-o, --output DIR", "--force ", "--resume RUN_DIR ", "--threads N ",
+                        "0 = the default", "--end T ", "--render ", "--quiet ", NULL}},
+        {"run -h", {"usage: pfsph run", NULL}},
+        {"help run", {"usage: pfsph run", NULL}},
+        {"check --help", {"usage: pfsph check", "verdict", NULL}},
+        {"render --help", {"usage: pfsph render", "--video ", "--color-by FIELD ", "--size WxH ", NULL}},
+        {"help render", {"usage: pfsph render", NULL}},
+    };
+    char out[8192];
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        int st = cli(cases[i].args, out, sizeof out);
+        if (st != 0) fail_msg("pfsph %s: exit status %d", cases[i].args, st);
+        for (int k = 0; cases[i].want[k]; k++)
+            if (!strstr(out, cases[i].want[k])) fail_msg("pfsph %s: lacks \"%s\"", cases[i].args, cases[i].want[k]);
+    }
+    assert_int_equal(cli("help nosuch", out, sizeof out), 2);
+    char path[600], args[2048];
+    snprintf(path, sizeof path, "%s/threads0.json", tu_tmpdir());
+    assert_int_equal(tu_write_file(path, "{\"dimension\":2,\"particle_radius\":0.02,\"time\":{\"end\":0.04},"
+                                         "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
+                                         "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"), 0);
+    snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads 0", path, tu_tmpdir());
+    assert_int_equal(cli(args, out, sizeof out), 0);
+    snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads -1", path, tu_tmpdir());
+    assert_int_equal(cli(args, out, sizeof out), 2);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -123,6 +289,10 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_check_bad),
         cmocka_unit_test(test_check_missing_file),
         cmocka_unit_test(test_run_bad_writes_nothing),
+        cmocka_unit_test(test_run_end_overflow),
+        cmocka_unit_test(test_messages),
+        cmocka_unit_test(test_no_boundary),
+        cmocka_unit_test(test_help),
         cmocka_unit_test(test_check_good),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -62,11 +62,14 @@ static void dt_limits(void **state)
     /* WCSPH: min(cfl d / (v + c_fast), 0.25 sqrt(d / a)) with the total acceleration */
     double want = fmin(0.4 * d / (v + 30), 0.25 * sqrt(d / a));
     assert_true(fabs(pfsph_solver_wcsph.dt_limit(w, &c, v, a, anp) - want) <= 1e-12 * want);
-    assert_true(pfsph_solver_wcsph.speed_bound(w) == 20);
+    assert_true(pfsph_solver_wcsph.speed_bound(w, &c) == 20);
     /* PCISPH: min(cfl d / v, 0.25 sqrt(d / a_np), 0.2 sqrt(tol d / a_np)) */
     want = fmin(fmin(0.4 * d / v, 0.25 * sqrt(d / anp)), 0.2 * sqrt(0.005 * d / anp));
     assert_true(fabs(pfsph_solver_pcisph.dt_limit(p, &c, v, a, anp) - want) <= 1e-12 * want);
-    assert_true(pfsph_solver_pcisph.speed_bound(p) == 400);
+    assert_true(pfsph_solver_pcisph.speed_bound(p, &c) == 400);
+    c.dt = 1e-8; /* a tiny step: the bound follows half a spacing per step (issue 15 item 5) */
+    assert_true(fabs(pfsph_solver_pcisph.speed_bound(p, &c) - 0.5 * d / 1e-8) <= 1e-6 * 0.5 * d / 1e-8);
+    c.dt = 0;
     /* at rest and without forces a solver sets no limit of its own */
     assert_true(isinf(pfsph_solver_pcisph.dt_limit(p, &c, 0, 0, 0)));
     pfsph_solver_wcsph.destroy(w);
