@@ -143,6 +143,45 @@ static void test_bad_obj_cli(void **st)
 
 /* A kinematic body is where its keyframes put it: linear in position, slerp in rotation, the
  * last key held; its particles move with it at the keyed velocity. */
+/* Overlapping bodies are refused with both JSON paths (issue 15 item 15: they were pushed
+ * apart at 0.5 m/s each); bodies that only touch, and keyframed bodies, are accepted. */
+static void test_overlap(void **st)
+{
+    (void)st;
+    static const char *A = "{\"name\": \"a\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.5],"
+                           " \"density\": 600, \"phase\": \"wood\"}";
+    const struct {
+        const char *b;
+        int overlap;
+    } cases[] = {
+        {"{\"name\": \"b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.65, 0.5], \"density\": 600, \"phase\": \"wood\"}", 1},
+        {"{\"name\": \"b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.7, 0.5], \"density\": 600, \"phase\": \"wood\"}", 0},
+        {"{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.7], \"density\": 600, \"phase\": \"wood\"}", 0},
+        {"{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.65], \"density\": 600, \"phase\": \"wood\"}", 1},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        char bodies[1024];
+        snprintf(bodies, sizeof bodies, "%s, %s", A, cases[k].b);
+        static pfsph_scene s;
+        pfsph_error err;
+        assert_int_equal(parse(2, bodies, &s, &err), PFSPH_OK);
+        pfsph_sim *sim = NULL;
+        int rc = pfsph_sim_create(&sim, &s, &err);
+        if (cases[k].overlap) {
+            if (rc != PFSPH_EINPUT) fprintf(stderr, "case %zu: rc %d\n", k, rc);
+            assert_int_equal(rc, PFSPH_EINPUT);
+            assert_non_null(strstr(err.msg, "bodies.json"));
+            assert_non_null(strstr(err.msg, "$.bodies[0]"));
+            assert_non_null(strstr(err.msg, "$.bodies[1]"));
+            assert_non_null(strstr(err.msg, "overlap"));
+        } else {
+            if (rc) fprintf(stderr, "case %zu: %s\n", k, err.msg);
+            assert_int_equal(rc, PFSPH_OK);
+        }
+        pfsph_sim_destroy(sim);
+    }
+}
+
 static void test_keyframes(void **st)
 {
     (void)st;
@@ -195,6 +234,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_parse_errors),
         cmocka_unit_test(test_bad_obj_cli),
         cmocka_unit_test(test_keyframes),
+        cmocka_unit_test(test_overlap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
