@@ -14,8 +14,9 @@
 
 #define OMEGA 0.5
 /* a_np dt^2 / d per step. On the 2D tank at tolerance 0.001: 0.004 settles to vmax 0.004 m/s
- * in 2 s (40 sweeps a step at rest); 0.001 to 0.010 m/s (10 sweeps, half the step). At 0.004
- * the 7k dam break's steps are limited by the CFL condition after the first 0.1 s. */
+ * in 2 s (40 sweeps a step at rest); 0.001 to 0.010 m/s (10 sweeps, half the step). 0.01 made
+ * the 7k dam break 19 % faster but the density-ratio-10 bubble of test_pf_rising_bubble rose
+ * unsteadily (0.246 then 0.304 m/s, gas compressed 4.4 %); at 0.004: 0.309, 0.307 m/s, 1.4 %. */
 #define EPS_STEP 0.004
 
 enum { FAC, VX, VY, VZ, RATE, ERR, PV, AX, AY, AZ, NSCR };
@@ -116,36 +117,72 @@ static void corrected_velocity(const pfsph_ctx *c, const pfsph_real *p, const pf
     }
 }
 
-/* One Jacobi update of the clamped pressure p from the residual: density mode (res = predicted
- * delta - delta0, over dt^2) or divergence mode (res = D delta / Dt, over dt). Returns the mean
- * compression the residual stands for, relative to delta0 and over one step. */
-static double update(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
-                     pfsph_real *p, pfsph_real *err)
+/* The residual of particle i: density mode (predicted delta - delta0) or divergence mode
+ * (dt D delta / Dt, none for a deficient neighbourhood), a compression over the step [1/m^d],
+ * and the factor that turns it into a pressure update. */
+static inline double residual_of(const pfsph_ctx *c, int divergence, const pfsph_real *rate,
+                                 const pfsph_real *fac, size_t i, double *fi)
 {
-    const pfsph_particles *f = c->fluid;
-    const size_t n = f->n;
-    const double dt = c->dt, nd0 = c->nd0;
+    const double f = fac[i];
+    if (divergence) {
+        *fi = f > 0 ? f : 0;
+        return f > 0 ? c->dt * (double)rate[i] : 0;
+    }
+    *fi = fabs(f);
+    return (double)c->nd[i] + c->dt * (double)rate[i] - (double)c->nd0;
+}
+
+/* Mean compression over one step, relative to delta0, that the residuals stand for. */
+static double residual(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
+                       pfsph_real *err)
+{
+    const size_t n = c->fluid->n;
+    const double nd0 = c->nd0;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
-        double fi = fac[i];
-        double res; /* compression over the step [1/m^d] */
-        if (divergence) {
-            res = fi > 0 ? dt * (double)rate[i] : 0; /* deficient neighbourhoods: no constraint */
-            if (fi < 0) fi = 0;
-        } else {
-            res = (double)c->nd[i] + dt * (double)rate[i] - nd0;
-            fi = fabs(fi);
-        }
-        /* p_i / delta_i^2 grows by omega res / (dt^2 A_i) (Bender & Koschier 2017, Eqs. 9,
-         * 12). A_i counts only particle i's own pressure; in a Jacobi sweep the neighbours push
-         * too, and omega = 1 overshot: a 2D tank at rest diverged at step 3. omega = 0.5, as
-         * IISPH and our PCISPH relax. */
-        double nd = c->nd[i];
-        double pn = (double)p[i] + OMEGA * nd * nd * res * fi / (dt * dt);
-        p[i] = (pfsph_real)(pn > 0 ? pn : 0);
+        double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
         err[i] = (pfsph_real)(res > 0 ? res / nd0 : 0);
     }
     return n ? pfsph__sum(err, n) / (double)n : 0;
+}
+
+/* One Jacobi update of the clamped pressure p: p_i / delta_i^2 grows by omega res / (dt^2 A_i)
+ * (Bender & Koschier 2017, Eqs. 9, 12; the divergence residual already carries one dt). A_i
+ * counts only particle i's own pressure; in a Jacobi sweep the neighbours push too, and
+ * omega = 1 overshot: a 2D tank at rest diverged at step 3. omega = 0.5, as IISPH and our PCISPH
+ * relax. */
+static void update(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
+                   pfsph_real *p)
+{
+    const size_t n = c->fluid->n;
+    const double dt2 = c->dt * c->dt;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
+        double nd = c->nd[i];
+        double pn = (double)p[i] + OMEGA * nd * nd * res * fi / dt2;
+        p[i] = (pfsph_real)(pn > 0 ? pn : 0);
+    }
+}
+
+/* Jacobi iterations on p (density mode: velocities v + dt (a_np + a_p); divergence mode: v +
+ * dt a_p) until the mean residual is within tol after at least min_it updates, or max_it
+ * updates were made. On return ap and (vx, vy, vz) belong to the final p. Returns the updates
+ * made; *avg the last mean residual. */
+static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const ap[3],
+                   pfsph_real *const *scr, double tol, int min_it, int max_it, double *avg)
+{
+    const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay,
+                     *ez = divergence ? NULL : c->az;
+    int it = 0;
+    for (;;) {
+        corrected_velocity(c, p, ex, ey, ez, ap, scr[VX], scr[VY], scr[VZ]);
+        pfsph__number_density_rate(c, scr[VX], scr[VY], scr[VZ], scr[RATE]);
+        *avg = residual(c, divergence, scr[RATE], scr[FAC], scr[ERR]);
+        if (it >= max_it || (it >= min_it && *avg <= tol)) return it;
+        update(c, divergence, scr[RATE], scr[FAC], p);
+        it++;
+    }
 }
 
 /* Divergence solve: make D delta / Dt = 0 where the fluid compresses, correcting v in place.
@@ -162,19 +199,8 @@ static void pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const *scr, 
     pfsph_real *pv = f->aux;
     pfsph_real *const a[3] = {scr[AX], scr[AY], scr[AZ]};
     for (size_t i = 0; i < n; i++) pv[i] *= (pfsph_real)0.5;
-    int it = 0;
-    for (;;) {
-        corrected_velocity(c, pv, NULL, NULL, NULL, a, scr[VX], scr[VY], scr[VZ]);
-        if (it >= D->div_max_iter) break;
-        pfsph__number_density_rate(c, scr[VX], scr[VY], scr[VZ], scr[RATE]);
-        double avg = update(c, 1, scr[RATE], scr[FAC], pv, scr[ERR]);
-        it++;
-        if (avg <= D->div_tol) {
-            /* the velocities and the kept pressure must agree: apply the last update */
-            corrected_velocity(c, pv, NULL, NULL, NULL, a, scr[VX], scr[VY], scr[VZ]);
-            break;
-        }
-    }
+    double avg;
+    int it = iterate(c, 1, pv, a, scr, D->div_tol, 0, D->div_max_iter, &avg);
     memcpy(f->vx, scr[VX], n * sizeof(pfsph_real));
     memcpy(f->vy, scr[VY], n * sizeof(pfsph_real));
     memcpy(f->vz, scr[VZ], n * sizeof(pfsph_real));
@@ -189,25 +215,12 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
 {
     const dfsph *D = state;
     pfsph_particles *f = c->fluid;
-    int it = 0;
-    double avg = 0;
     /* Half the last pressure, not all of it: a full warm start let pressure modes that move
      * no density (the near-null space of div grad) pile up from step to step; on the 2D tank
      * at rest they drove vmax to 0.5-2 m/s (docs/solvers.md, "DFSPH"). */
     for (size_t i = 0; i < f->n; i++) f->p[i] *= (pfsph_real)0.5;
-    for (;;) {
-        corrected_velocity(c, f->p, c->ax, c->ay, c->az, ap, scr[VX], scr[VY], scr[VZ]);
-        if (it >= D->max_iter) break;
-        pfsph__number_density_rate(c, scr[VX], scr[VY], scr[VZ], scr[RATE]);
-        avg = update(c, 0, scr[RATE], scr[FAC], f->p, scr[ERR]);
-        it++;
-        if (it >= D->min_iter && avg <= D->tol) {
-            /* the last update is already within tolerance: its accelerations are the ones */
-            corrected_velocity(c, f->p, c->ax, c->ay, c->az, ap, scr[VX], scr[VY], scr[VZ]);
-            break;
-        }
-    }
-    out->iterations = it;
+    double avg;
+    out->iterations = iterate(c, 0, f->p, ap, scr, D->tol, D->min_iter, D->max_iter, &avg);
     out->density_err_avg = avg;
 }
 
