@@ -372,7 +372,7 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
     if (message) cJSON_AddStringToObject(j, "message", message);
     cJSON_AddNumberToObject(j, "threads", omp_get_max_threads());
     cJSON_AddNumberToObject(j, "dimension", s->dim);
-    cJSON_AddStringToObject(j, "solver", s->solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph");
+    cJSON_AddStringToObject(j, "solver", pfsph_scene_solver_name(s));
     if (sim) {
         const pfsph_ctx *c = pfsph_sim_ctx(sim);
         cJSON *n = cJSON_AddObjectToObject(j, "particles");

@@ -422,6 +422,9 @@ static int cmd_check(int argc, char **argv)
         else if (s.solver == PFSPH_SOLVER_PCISPH && ratio > 10.0 + 1e-9)
             printf(": PCISPH is tested to 10 and diverged at 100 (docs/pairwise.md, \"Density "
                    "ratios\"); use solver \"wcsph\" with \"pressure_scale\": \"common\"\n");
+        else if (s.solver == PFSPH_SOLVER_DFSPH && ratio > 10.0 + 1e-9)
+            printf(": DFSPH is tested to 10 (test_pf_rising_bubble); higher ratios are untested, "
+                   "solver \"wcsph\" with \"pressure_scale\": \"common\" is tested to 1000\n");
         else if (s.solver == PFSPH_SOLVER_WCSPH && ratio > 100.0 + 1e-9)
             printf(": per-phase pressure scales are tested to 100 and blew up at 1000 "
                    "(docs/pairwise.md, \"Density ratios\"); use \"pressure_scale\": \"common\"\n");
@@ -457,7 +460,7 @@ static int cmd_check(int argc, char **argv)
     }
     /* the verdict last, once every check has passed */
     printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids\n", s.source, s.dim,
-           s.solver == PFSPH_SOLVER_PCISPH ? "pcisph" : "wcsph", s.nphases, s.nblocks, s.nsolids);
+           pfsph_scene_solver_name(&s), s.nphases, s.nblocks, s.nsolids);
     return 0;
 }
 

@@ -37,6 +37,16 @@ static void every_scene_solver_runs(void **state)
         assert_int_equal(pfsph_sim_advance(sim, 0.01, &err), PFSPH_OK);
         assert_true(pfsph_sim_steps(sim) > 0);
         pfsph_sim_destroy(sim);
+        /* the program names the solver from the same list (it once printed "wcsph" for any
+         * solver that was not PCISPH) */
+        char path[1024], cmd[2300], out[4096], want[64];
+        snprintf(path, sizeof path, "%s/solver_%s.json", tu_tmpdir(), ops->name);
+        assert_int_equal(tu_write_file(path, json), 0);
+        snprintf(cmd, sizeof cmd, "'%s' check '%s'", tu_pfsph_bin(), path);
+        assert_int_equal(tu_run(cmd, out, sizeof out), 0);
+        snprintf(want, sizeof want, "solver %s,", ops->name);
+        if (!strstr(out, want)) fprintf(stderr, "%s\n", out);
+        assert_non_null(strstr(out, want));
         found++;
     }
     assert_int_equal(found, 3); /* wcsph, pcisph, dfsph */
