@@ -179,8 +179,11 @@ static double run_peak(const char *scene, const char *dir)
 }
 
 /* Item 7: the estimate is not below what a run holds at its peak (resident size of a run of
- * a 2D scene of 40,000 particles, less that of the same program on 25 particles), nor far
- * above it. Under the sanitizers the run's own size means nothing: only the estimate's. */
+ * a 2D scene of 160,000 particles, less that of the same program on 16 particles), nor far
+ * above it. 160,000 rather than 40,000: the small run's size varies by about 0.2 MiB, which at
+ * 40,000 particles was 2 % of the measurement, as much as the estimate's margin (ratios
+ * 1.01-1.03 over three runs). Under the sanitizers the run's own size means nothing: only the
+ * estimate's. */
 static void test_estimate_vs_run(void **state)
 {
     (void)state;
@@ -192,7 +195,7 @@ static void test_estimate_vs_run(void **state)
         "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[1,1],\"phase\":\"wall\"}],"
         "\"output\":{\"formats\":[\"vtp\"],\"checkpoint_interval\":1}}";
     char json[2048], path[600], dir[600];
-    snprintf(json, sizeof json, fmt, "0.0025", "1", "1");
+    snprintf(json, sizeof json, fmt, "0.00125", "1", "1");
     snprintf(path, sizeof path, "%s/peak.json", tu_tmpdir());
     assert_int_equal(tu_write_file(path, json), 0);
     static pfsph_scene s;
@@ -202,8 +205,8 @@ static void test_estimate_vs_run(void **state)
     assert_int_equal(pfsph_scene_estimate(&s, &nf, &nb, &bytes, &err), PFSPH_OK);
     printf("estimate %.1f MiB (%.0f B per fluid particle) for %zu fluid + %zu boundary\n", bytes / 1048576.0,
            (double)bytes / nf, nf, nb);
-#if defined(__SANITIZE_ADDRESS__)
-    skip();
+#if defined(__SANITIZE_ADDRESS__) || defined(PFSPH_SANITIZED)
+    skip(); /* instrumented: clang's UBSan run measured 239 B per particle against 238 estimated */
 #endif
     /* a forked child starts with this process's size, which under valgrind is tens of MiB */
     struct rusage self;
@@ -215,7 +218,7 @@ static void test_estimate_vs_run(void **state)
     snprintf(dir, sizeof dir, "%s/peak_run", tu_tmpdir());
     double peak = run_peak(path, dir);
     char small[600];
-    snprintf(json, sizeof json, fmt, "0.0025", "0.01", "0.01");
+    snprintf(json, sizeof json, fmt, "0.00125", "0.005", "0.005");
     snprintf(small, sizeof small, "%s/base.json", tu_tmpdir());
     assert_int_equal(tu_write_file(small, json), 0);
     snprintf(dir, sizeof dir, "%s/base_run", tu_tmpdir());
