@@ -5,7 +5,6 @@
  * times each stage and reports blow-ups, once for all (docs/architecture.md). */
 #include "pfsph/sim.h"
 
-#include <float.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -53,7 +52,6 @@ struct pfsph_sim {
     size_t scr_cap;           /* entries in each scratch array */
     const pfsph_solver_ops *solver;
     void *solver_state;
-    pfsph_solver_config solver_cfg;
     double sound_speed;
     double amax;            /* largest acceleration of the last step */
     double amax_np;         /* largest non-pressure acceleration of the last step */
@@ -348,7 +346,8 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     if ((rc = alloc_scratch(sim, sim->fluid.n))) goto nomem;
 
     auto_sound_speed(sim);
-    pfsph_solver_config *cfg = &sim->solver_cfg;
+    pfsph_solver_config cfg_, *cfg = &cfg_; /* the solver keeps what it needs */
+    memset(cfg, 0, sizeof *cfg);
     cfg->sound_speed = sim->sound_speed;
     cfg->gamma = s->gamma;
     cfg->rho_common = 0;
@@ -578,7 +577,7 @@ static int st_pressure(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)bad;
     (void)err;
     pfsph_real *const ap[3] = {sim->scr[SCR_APX], sim->scr[SCR_APY], sim->scr[SCR_APZ]};
-    pfsph_solve_stats out = {0, sim->stats.div_iterations, 0};
+    pfsph_solve_stats out = {0, 0, 0};
     sim->solver->solve(sim->solver_state, &sim->ctx, ap, sim->scr + SCR_COMMON, &out);
     sim->stats.iterations = out.iterations;
     sim->stats.density_err_avg = out.density_err_avg;
