@@ -15,6 +15,7 @@
 #include "pfsph/bodies.h"
 #include "pfsph/diffuse.h"
 #include "pfsph/pairwise.h"
+#include "pfsph/thermostat.h"
 #include "physics/boundary.h"
 #include "physics/density.h"
 #include "physics/solver.h"
@@ -26,7 +27,7 @@ const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
 
 /* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
-#define SCR_MAX (SCR_COMMON + 10)
+#define SCR_MAX (SCR_COMMON + 13) /* + the solver's (at most 10) + the thermostat's 3 */
 
 /* What a stage that found a blow-up reports; the step turns it into the one message format. */
 typedef struct blowup_info {
@@ -49,6 +50,7 @@ struct pfsph_sim {
     pfsph_grid grid, bgrid;
     pfsph_real *scr[SCR_MAX]; /* per-step scratch: SCR_COMMON of ours, then the solver's */
     int nscr;
+    int scr_noise;            /* first of the thermostat's 3 arrays (its accelerations), or -1 */
     size_t scr_cap;           /* entries in each scratch array */
     const pfsph_solver_ops *solver;
     void *solver_state;
@@ -187,7 +189,8 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const double P = (double)pfsph_particles_bytes_per_particle();
     const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
-    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0)) * sizeof(pfsph_real) + sort + 2 * P;
+    const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
+    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort + 2 * P;
     const double per_boundary = 2 * P + sort;
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
     const double part_bytes = (double)nf * per_fluid + (double)nb * per_boundary;
@@ -246,6 +249,16 @@ static void auto_sound_speed(pfsph_sim *sim)
     sim->sound_speed = s->sound_speed > 0 ? s->sound_speed : 10 * vref;
 }
 
+int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out)
+{
+    if (!sim->pw) return PFSPH_EINPUT;
+    double *vir = malloc((sim->fluid.n ? sim->fluid.n : 1) * sizeof(double));
+    if (!vir) return PFSPH_ENOMEM;
+    pfsph_pairwise_mechanical_pressure(sim->pw, &sim->ctx, vir, out);
+    free(vir);
+    return PFSPH_OK;
+}
+
 void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s)
 {
     for (int a = 0; a < 3; a++) {
@@ -284,6 +297,11 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         goto fail;
     }
     sim->nscr = SCR_COMMON + sim->solver->nscratch;
+    sim->scr_noise = -1;
+    if (s->pairwise.enabled && s->pairwise.thermo.enabled) {
+        sim->scr_noise = sim->nscr;
+        sim->nscr += 3;
+    }
     if (sim->nscr > SCR_MAX) {
         rc = pfsph_fail(err, PFSPH_ENOMEM, "solver %s needs %d scratch arrays, at most %d", sim->solver->name,
                         sim->solver->nscratch, SCR_MAX - SCR_COMMON);
@@ -373,6 +391,18 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
 
     if (s->pairwise.enabled && (rc = pfsph_pairwise_create(&sim->pw, c, err))) goto fail;
     if (s->diffuse.enabled && (rc = pfsph_diffuse_create(&sim->df, c, err))) goto fail;
+    /* The first step's force criterion needs the accelerations the pair forces give: from |g|
+     * alone (0 without gravity) PCISPH took dt_max and blew up at step 0 (issue 11). */
+    if (sim->pw && sim->fluid.n) {
+        if (pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed)) goto nomem;
+        pfsph__number_density(c, sim->fluid.x, sim->fluid.y, sim->fluid.z, c->nd);
+        pfsph__nonpressure(c);
+        pfsph_pairwise_apply(sim->pw, c);
+        double a2 = 0;
+        for (size_t i = 0; i < sim->fluid.n; i++)
+            a2 = fmax(a2, (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i]);
+        sim->amax = sim->amax_np = fmax(g, sqrt(a2));
+    }
     build_stages(sim);
     *out = sim;
     return PFSPH_OK;
@@ -572,6 +602,16 @@ static int st_pairwise(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* thermal noise after every deterministic force, before the pressure solve sees them */
+static int st_thermostat(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_real *nz[3] = {sim->scr[sim->scr_noise], sim->scr[sim->scr_noise + 1], sim->scr[sim->scr_noise + 2]};
+    pfsph_thermostat_apply(&sim->ctx, nz);
+    return PFSPH_OK;
+}
+
 static int st_pressure(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     (void)bad;
@@ -610,13 +650,25 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
     int bad_ = 0;
+    /* The thermostat's random accelerations scale as dt^(-1/2) (their velocity kick as
+     * dt^(1/2)): left in the force criteria they would shrink the next step without end. */
+    const bool noise = sim->scr_noise >= 0 && pfsph_thermostat_kT(c) > 0;
+    const pfsph_real *nx = noise ? sim->scr[sim->scr_noise] : NULL, *ny = noise ? sim->scr[sim->scr_noise + 1] : NULL,
+                     *nz = noise ? sim->scr[sim->scr_noise + 2] : NULL;
 #pragma omp parallel for schedule(static) reduction(max : amax2, anp2, emax, v2max) reduction(| : bad_)
     for (size_t i = 0; i < n; i++) {
-        double b2 = (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i];
+        pfsph_real bx = c->ax[i], by = c->ay[i], bz = c->az[i];
+        if (noise) {
+            bx -= nx[i];
+            by -= ny[i];
+            bz -= nz[i];
+        }
+        double b2 = (double)bx * bx + (double)by * by + (double)bz * bz;
         if (b2 > anp2) anp2 = b2;
-        pfsph_real axi = c->ax[i] + apx[i], ayi = c->ay[i] + apy[i], azi = c->az[i] + apz[i];
-        double a2 = (double)axi * axi + (double)ayi * ayi + (double)azi * azi;
+        pfsph_real cx = bx + apx[i], cy = by + apy[i], cz = bz + apz[i];
+        double a2 = (double)cx * cx + (double)cy * cy + (double)cz * cz;
         if (a2 > amax2) amax2 = a2;
+        pfsph_real axi = c->ax[i] + apx[i], ayi = c->ay[i] + apy[i], azi = c->az[i] + apz[i];
         f->vx[i] += fdt * axi;
         f->vy[i] += fdt * ayi;
         f->vz[i] += fdt * azi;
@@ -687,6 +739,7 @@ static void build_stages(pfsph_sim *sim)
     if (sim->solver->pre_forces) ADD("divergence", PFSPH_STAGE_PRESSURE, st_divergence);
     ADD("forces", PFSPH_STAGE_FORCES, st_forces);
     if (sim->pw) ADD("pairwise", PFSPH_STAGE_PAIRWISE, st_pairwise);
+    if (sim->scr_noise >= 0 && pfsph_thermostat_kT(&sim->ctx) > 0) ADD("thermostat", PFSPH_STAGE_PAIRWISE, st_thermostat);
     ADD("pressure", PFSPH_STAGE_PRESSURE, st_pressure);
     if (sim->bodies) ADD("bodies", PFSPH_STAGE_BODIES, st_body_forces);
     ADD("integrate", PFSPH_STAGE_INTEGRATE, st_integrate);

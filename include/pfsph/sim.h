@@ -46,6 +46,9 @@ const pfsph_scene *pfsph_sim_scene(const pfsph_sim *sim);
  * that builds a context by hand. */
 void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s);
 const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim);
+/* Mechanical pressure of every fluid particle (pfsph_pairwise_mechanical_pressure) into out
+ * (fluid->n entries). PFSPH_EINPUT without pair forces, PFSPH_ENOMEM. */
+int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out);
 /* Seconds spent per stage so far. */
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);
 size_t pfsph_sim_removed(const pfsph_sim *sim);

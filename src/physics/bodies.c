@@ -3,6 +3,7 @@
  * the Open Dynamics Engine (ODE). Why ODE: a maintained C library in Debian with quaternion
  * integration, joints and box/sphere/cylinder/trimesh contacts; the fluid coupling stays ours. */
 #include "pfsph/bodies.h"
+#include "pfsph/thermostat.h"
 
 #include <math.h>
 #include <ode/ode.h>
@@ -759,12 +760,15 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
     /* particles dropped from the boundary set (a body that left the grid) must not keep their
      * last force: only the present ones are written below */
     memset(B->fp, 0, 3 * (size_t)B->np * sizeof(double));
+    const double kT = pfsph_thermostat_kT(ctx);
+    const double amp = kT > 0 && ctx->dt > 0 ? 2.0 * kT / ctx->dt * (double)(2 * (ctx->dim + 2)) : 0;
+    const uint64_t wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
 #pragma omp parallel for schedule(static)
     for (size_t j = 0; j < nb; j++) {
         if (b->id[j] < first) continue;
         const uint32_t l = b->id[j] - first;
         const pfsph_real xj = b->x[j], yj = b->y[j], zj = b->z[j], vol = b->aux[j];
-        double fx = 0, fy = 0, fz = 0;
+        double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
         pfsph_ranges r;
         pfsph_grid_ranges(ctx->grid, xj, yj, zj, &r);
         for (int q = 0; q < r.n; q++)
@@ -783,11 +787,30 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
                                      (f->vz[i] - b->vz[j]) * dz;
                     /* friction: the fluid gains m_i nu visc_c V_b (v_ib . x_ib)/(r^2+eps) grad W */
                     s -= ctx->mass[f->phase[i]] * visc_c * nui * vol * vdx / (r2 + eps) * dw;
+                    if (kT > 0 && r2 > 0) {
+                        /* the thermostat's random force on the fluid, reversed (thermostat.c:
+                         * the same expression, same draw) */
+                        double rr = sqrt((double)r2);
+                        double g = (double)nui * (double)ctx->mass[f->phase[i]] * (double)vol *
+                                   (double)r2 * -(double)pfsph_kernel_dw_r(k, (pfsph_real)rr) /
+                                   (double)(r2 + eps);
+                        if (g > 0) {
+                            /* x_ib points from the body particle to the fluid: -e_ib on the body */
+                            double sr = -sqrt(amp * pfsph_thermostat_scale(ctx, f->phase[i]) * g) *
+                                        pfsph_thermo_theta(wkey, f->id[i], b->id[j]) / rr;
+                            tx += sr * (double)dx;
+                            ty += sr * (double)dy;
+                            tz += sr * (double)dz;
+                        }
+                    }
                 }
                 fx += (double)(s * dx);
                 fy += (double)(s * dy);
                 fz += (double)(s * dz);
             }
+        fx += tx;
+        fy += ty;
+        fz += tz;
         if (pw_on) {
             /* the pair forces' reaction (PF Eq. 3): -c m_i m_b f(r) x_ib / r, over k h. The
              * fluid applies its filter T_i (Eq. 12) to its own sum, so with eta > 0 action and
