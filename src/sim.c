@@ -121,7 +121,7 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
     }
     for (int i = 0; i < s->nblocks; i++) {
         size_t first = fluid->n;
-        if (pfsph__sample_block(s, &s->blocks[i], d, fluid) < 0)
+        if (pfsph__sample_scene_block(s, i, d, fluid) < 0)
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
         /* drop fluid particles inside or too close to a solid or a body (their boundary
          * particles sit d/2 inside the surface; one nearer than 0.4 d would start compressed) */
@@ -153,7 +153,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     double d = 2 * s->particle_radius;
     long nf = 0, nb = 0;
     for (int i = 0; i < s->nblocks; i++) {
-        long c = pfsph__sample_block(s, &s->blocks[i], d, NULL);
+        long c = pfsph__sample_scene_block(s, i, d, NULL);
         if (c < 0) return pfsph_fail(err, PFSPH_EINPUT, "cannot sample block %d", i);
         nf += c;
     }

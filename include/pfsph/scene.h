@@ -10,7 +10,9 @@
 #include "pfsph/types.h"
 #include "pfsph/params.h"
 
-#define PFSPH_MAX_BLOCKS 64
+/* Fluid blocks: a fixed array, as the scene is a plain value that is copied (pfsph_sim keeps
+ * its own) and never freed; 1024 of them take 150 kB. */
+#define PFSPH_MAX_BLOCKS 1024
 #define PFSPH_MAX_SOLIDS 64
 #define PFSPH_MAX_BODIES 32
 #define PFSPH_MAX_KEYFRAMES 16

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "scene/json_util.h"
+#include "scene/shapes.h"
 
 /* ---------------------------------------------------------------------------------------- */
 /* Limits of the accepted ranges (documented in docs/scene-format.md). */
@@ -651,12 +652,11 @@ static int check_blocks(parser *p)
     pfsph_scene *s = p->s;
     const double sp = 2.0 * s->particle_radius;
     const double tiny = 1e-9 * sp;
-    geo gs[PFSPH_MAX_BLOCKS];
     for (int i = 0; i < s->nblocks; i++) {
         const pfsph_block *b = &s->blocks[i];
         char P[128], kp[160];
         path_index(P, sizeof P, "$.fluid", i);
-        gs[i] = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
+        const geo gb = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
         /* Empty: fewer than one particle along some axis. */
         if (b->shape == PFSPH_SHAPE_BOX) {
             for (int k = 0; k < s->dim; k++)
@@ -687,29 +687,22 @@ static int check_blocks(parser *p)
         /* Inside the domain. */
         for (int k = 0; k < s->dim; k++) {
             double scale = fmax(1.0, fabs(s->domain_max[k] - s->domain_min[k]));
-            if (gs[i].min[k] < s->domain_min[k] - 1e-9 * scale ||
-                gs[i].max[k] > s->domain_max[k] + 1e-9 * scale) {
+            if (gb.min[k] < s->domain_min[k] - 1e-9 * scale ||
+                gb.max[k] > s->domain_max[k] + 1e-9 * scale) {
                 char a[96], c[96], lo[96], hi[96];
                 fmt_vec(a, sizeof a, s->dim, s->domain_min);
                 fmt_vec(c, sizeof c, s->dim, s->domain_max);
-                fmt_vec(lo, sizeof lo, s->dim, gs[i].min);
-                fmt_vec(hi, sizeof hi, s->dim, gs[i].max);
+                fmt_vec(lo, sizeof lo, s->dim, gb.min);
+                fmt_vec(hi, sizeof hi, s->dim, gb.max);
                 const char *key = b->shape != PFSPH_SHAPE_BOX
                                       ? "center"
-                                      : (gs[i].min[k] < s->domain_min[k] ? "min" : "max");
+                                      : (gb.min[k] < s->domain_min[k] ? "min" : "max");
                 path_key(kp, sizeof kp, P, key);
                 return pfsph__json_fail(
                     &p->ctx, kp, "block %s .. %s extends outside the domain %s .. %s along %s", lo,
                     hi, a, c, axis_names[k]);
             }
         }
-        /* Overlaps with earlier blocks. */
-        for (int j = 0; j < i; j++)
-            if (geo_overlap(&gs[j], &gs[i], sp))
-                return pfsph__json_fail(&p->ctx, P,
-                                        "overlaps $.fluid[%d] by more than half a particle spacing "
-                                        "(%g m); particles there would be created twice",
-                                        j, 0.5 * sp);
         /* Solids: obstacles must not start inside fluid; container walls must not cut blocks. */
         for (int j = 0; j < s->nsolids; j++) {
             const pfsph_solid *so = &s->solids[j];
@@ -718,11 +711,11 @@ static int check_blocks(parser *p)
                 /* Partly inside the container's inner box but not wholly: crosses a wall. */
                 bool touches = true, inside = true;
                 for (int k = 0; k < s->dim; k++) {
-                    double lo = fmax(gs[i].min[k], so->min[k]), hi = fmin(gs[i].max[k], so->max[k]);
+                    double lo = fmax(gb.min[k], so->min[k]), hi = fmin(gb.max[k], so->max[k]);
                     if (hi - lo <= 0.5 * sp) touches = false;
-                    if (gs[i].min[k] < so->min[k] - 0.5 * sp) inside = false;
+                    if (gb.min[k] < so->min[k] - 0.5 * sp) inside = false;
                     bool top = so->open_top && k == 1;
-                    if (!top && gs[i].max[k] > so->max[k] + 0.5 * sp) inside = false;
+                    if (!top && gb.max[k] > so->max[k] + 0.5 * sp) inside = false;
                 }
                 if (touches && !inside)
                     return pfsph__json_fail(&p->ctx, P,
@@ -732,12 +725,20 @@ static int check_blocks(parser *p)
             }
             geo g = geo_of(s->dim, so->shape, so->min, so->max, so->center, so->radius,
                            so->height, so->axis);
-            if (geo_overlap(&g, &gs[i], sp))
+            if (geo_overlap(&g, &gb, sp))
                 return pfsph__json_fail(
                     &p->ctx, P,
                     "overlaps the solid $.solids[%d]; fluid particles would start "
                     "inside it",
                     j);
+        }
+        /* Overlaps with later blocks are what carving is for (shapes.c); a block they cover
+         * wholly adds nothing, which is an ordering mistake (a tank listed after its bubble). */
+        if (i + 1 < s->nblocks && pfsph__sample_scene_block(s, i, sp, NULL) == 0) {
+            return pfsph__json_fail(&p->ctx, P,
+                                    "every particle of this block lies inside later blocks, which replace "
+                                    "earlier ones where they overlap: it would add nothing (list it after "
+                                    "the blocks it should replace)");
         }
     }
     return PFSPH_OK;

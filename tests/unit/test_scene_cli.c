@@ -27,11 +27,11 @@ static const cli_case cases[] = {
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"phase\":\"oil\"}]}",
      "$.fluid[0].phase: unknown phase \"oil\""},
-    {"overlap.json",
+    {"covered.json", /* issue 11: a later block replaces an earlier one where they overlap */
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
-     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]},{\"shape\":\"box\",\"min\":[0.1,0.1,0.1],"
+     "\"min\":[0.1,0.1,0.1],\"max\":[0.2,0.2,0.2]},{\"shape\":\"box\",\"min\":[0,0,0],"
      "\"max\":[0.3,0.3,0.3]}]}",
-     "$.fluid[1]: overlaps $.fluid[0]"},
+     "$.fluid[0]: every particle of this block lies inside later blocks"},
     {"frames.json", /* issue 15 item 4: end x fps overflowed the frame count */
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"time\":{\"end\":1e6,\"fps\":1e4}}",
