@@ -514,15 +514,15 @@ static int parse_solids(parser *p, const cJSON *root)
         pfsph_solid *so = &s->solids[i];
         memset(so, 0, sizeof *so);
         TRY(json_enum(p, e, P, "shape", solid_shapes, &so->shape));
-        static const char *const k_box[] = {"shape", "phase", "layers", "min", "max", "comment",
+        static const char *const k_box[] = {"shape", "phase", "layers", "slip", "viscosity", "min", "max", "comment",
                                             NULL};
-        static const char *const k_cont[] = {"shape", "phase", "layers", "min", "max",
+        static const char *const k_cont[] = {"shape", "phase", "layers", "slip", "viscosity", "min", "max",
                                              "open_top", "comment", NULL};
-        static const char *const k_sph[] = {"shape", "phase", "layers", "center", "radius",
+        static const char *const k_sph[] = {"shape", "phase", "layers", "slip", "viscosity", "center", "radius",
                                             "comment", NULL};
-        static const char *const k_cyl[] = {"shape", "phase", "layers", "center", "radius",
+        static const char *const k_cyl[] = {"shape", "phase", "layers", "slip", "viscosity", "center", "radius",
                                             "height", "axis", "comment", NULL};
-        static const char *const k_plane[] = {"shape", "phase", "layers", "point", "normal",
+        static const char *const k_plane[] = {"shape", "phase", "layers", "slip", "viscosity", "point", "normal",
                                               "comment", NULL};
         const char *const *keys = so->shape == PFSPH_SHAPE_BOX        ? k_box
                                   : so->shape == PFSPH_SHAPE_CONTAINER ? k_cont
@@ -532,6 +532,18 @@ static int parse_solids(parser *p, const cJSON *root)
         TRY(pfsph__json_check_keys(e, P, keys, &p->ctx));
         so->layers = 2;
         TRY(pfsph__json_int(e, P, "layers", 1, 10, &so->layers, &p->ctx));
+        /* wall friction (docs/scene-format.md, "Wall friction"): free slip has none to scale */
+        static const char *const slips[] = {"no-slip", "free-slip", NULL}; /* enum pfsph_slip order */
+        TRY(json_enum(p, e, P, "slip", slips, &so->slip));
+        TRY(pfsph__json_number(e, P, "viscosity", 0.0, 100.0, &so->viscosity, &p->ctx));
+        so->own_viscosity = get(e, "viscosity") != NULL;
+        if (so->slip == PFSPH_FREE_SLIP && get(e, "viscosity")) {
+            char kp[160];
+            path_key(kp, sizeof kp, P, "viscosity");
+            return pfsph__json_fail(&p->ctx, kp,
+                                    "a free-slip wall has no friction: its viscosity would not be used "
+                                    "(remove it, or make the wall \"no-slip\")");
+        }
         TRY(pfsph__json_bool(e, P, "open_top", &so->open_top, &p->ctx));
         if (so->shape == PFSPH_SHAPE_PLANE) {
             TRY(require(p, e, P, "point"));
