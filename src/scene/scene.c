@@ -746,7 +746,7 @@ static int check_blocks(parser *p)
         }
         /* Overlaps with later blocks are what carving is for (shapes.c); a block they cover
          * wholly adds nothing, which is an ordering mistake (a tank listed after its bubble). */
-        if (i + 1 < s->nblocks && pfsph__sample_scene_block(s, i, sp, NULL) == 0) {
+        if (pfsph__scene_block_covered(s, i, sp)) {
             return pfsph__json_fail(&p->ctx, P,
                                     "every particle of this block lies inside later blocks, which replace "
                                     "earlier ones where they overlap: it would add nothing (list it after "

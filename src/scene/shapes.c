@@ -89,45 +89,68 @@ static int site_in(const pfsph_block *b, int dim, double d, const long *k0, cons
     return inside_block(b, dim, p);
 }
 
-/* The sites of one block, without walking them: a box is a product; a sphere or cylinder is
- * convex, so each row along x holds an interval of sites, found in closed form and its ends
- * settled with the exact test (the same decisions as the walk). Rows: about N^(2/3). */
+/* The sites of block b on the row (ky, kz) along x, [*lo, *hi] (empty: *lo > *hi). A box: its
+ * range. A sphere or cylinder is convex, so the row holds an interval of sites, found in
+ * closed form and its ends settled with the exact test (the same decisions as the walk). */
+static void row_interval(const pfsph_block *b, int dim, double d, const long *k0, const long *k1, long ky, long kz,
+                         long *lo, long *hi)
+{
+    *lo = 1;
+    *hi = 0;
+    if (ky < k0[1] || ky >= k1[1] || kz < k0[2] || kz >= k1[2] || k1[0] <= k0[0]) return;
+    if (b->shape == PFSPH_SHAPE_BOX) {
+        *lo = k0[0];
+        *hi = k1[0] - 1;
+        return;
+    }
+    const int cyl3 = b->shape == PFSPH_SHAPE_CYLINDER && dim == 3;
+    long k[3] = {0, ky, kz};
+    /* half-width in x of the shape on this row, about b->center[0] */
+    double w2 = b->radius * b->radius, wx;
+    for (int a = 1; a < dim; a++) {
+        if (cyl3 && a == b->axis) continue;
+        double q = lat_x(d, k[a]) - b->center[a];
+        w2 -= q * q;
+    }
+    if (cyl3 && b->axis == 0) wx = w2 >= 0 ? 0.5 * b->height : 0;
+    else wx = w2 > 0 ? sqrt(w2) : 0;
+    long i0 = clamp_site(ceil((b->center[0] - wx) / d - 0.5));
+    long i1 = clamp_site(floor((b->center[0] + wx) / d - 0.5));
+    if (i0 < k0[0]) i0 = k0[0];
+    if (i1 > k1[0] - 1) i1 = k1[0] - 1;
+    while (i0 <= i1 && (k[0] = i0, !site_in(b, dim, d, k0, k1, k))) i0++;
+    while (i0 <= i1 && (k[0] = i1, !site_in(b, dim, d, k0, k1, k))) i1--;
+    if (i0 > i1) {
+        /* nothing inside by the closed form; the exact test may still take a site or two
+         * next to the centre (contiguous: the shape is convex) */
+        long c = clamp_site(floor(b->center[0] / d - 0.5));
+        for (k[0] = c - 1; k[0] <= c + 2; k[0]++)
+            if (site_in(b, dim, d, k0, k1, k)) {
+                if (*lo > *hi) *lo = k[0];
+                *hi = k[0];
+            }
+        return;
+    }
+    while (i0 > k0[0] && (k[0] = i0 - 1, site_in(b, dim, d, k0, k1, k))) i0--;
+    while (i1 < k1[0] - 1 && (k[0] = i1 + 1, site_in(b, dim, d, k0, k1, k))) i1++;
+    *lo = i0;
+    *hi = i1;
+}
+
+/* The sites of one block, without walking them: a box is a product, a round shape a sum of
+ * row intervals (about N^(2/3) rows for N sites). */
 static long count_block(const pfsph_block *b, int dim, double d, const long *k0, const long *k1)
 {
     double n[3];
     for (int a = 0; a < 3; a++) n[a] = (double)(k1[a] - k0[a]);
     if (n[0] <= 0 || n[1] <= 0 || n[2] <= 0) return 0;
     if (b->shape == PFSPH_SHAPE_BOX) return clamp_count(n[0] * n[1] * n[2]);
-    const int cyl3 = b->shape == PFSPH_SHAPE_CYLINDER && dim == 3;
     double total = 0;
-    long k[3];
-    for (k[2] = k0[2]; k[2] < k1[2]; k[2]++)
-        for (k[1] = k0[1]; k[1] < k1[1]; k[1]++) {
-            /* half-width in x of the shape on this row, about b->center[0] */
-            double w2 = b->radius * b->radius, wx;
-            for (int a = 1; a < dim; a++) {
-                if (cyl3 && a == b->axis) continue;
-                double q = lat_x(d, k[a]) - b->center[a];
-                w2 -= q * q;
-            }
-            if (cyl3 && b->axis == 0) wx = w2 >= 0 ? 0.5 * b->height : 0;
-            else wx = w2 > 0 ? sqrt(w2) : 0;
-            long i0 = clamp_site(ceil((b->center[0] - wx) / d - 0.5));
-            long i1 = clamp_site(floor((b->center[0] + wx) / d - 0.5));
-            if (i0 < k0[0]) i0 = k0[0];
-            if (i1 > k1[0] - 1) i1 = k1[0] - 1;
-            /* settle the ends with the walk's own test */
-            while (i0 <= i1 && (k[0] = i0, !site_in(b, dim, d, k0, k1, k))) i0++;
-            while (i0 <= i1 && (k[0] = i1, !site_in(b, dim, d, k0, k1, k))) i1--;
-            if (i0 > i1) {
-                /* nothing inside by the closed form; the exact test may still take a site or two */
-                long c = clamp_site(floor(b->center[0] / d - 0.5));
-                for (k[0] = c - 1; k[0] <= c + 2; k[0]++) total += site_in(b, dim, d, k0, k1, k);
-                continue;
-            }
-            while (i0 > k0[0] && (k[0] = i0 - 1, site_in(b, dim, d, k0, k1, k))) i0--;
-            while (i1 < k1[0] - 1 && (k[0] = i1 + 1, site_in(b, dim, d, k0, k1, k))) i1++;
-            total += (double)(i1 - i0 + 1);
+    for (long kz = k0[2]; kz < k1[2]; kz++)
+        for (long ky = k0[1]; ky < k1[1]; ky++) {
+            long lo, hi;
+            row_interval(b, dim, d, k0, k1, ky, kz, &lo, &hi);
+            if (lo <= hi) total += (double)(hi - lo + 1);
         }
     return clamp_count(total);
 }
@@ -179,16 +202,28 @@ static long sample(const pfsph_scene *s, const pfsph_block *b, uint32_t stream, 
                 removed += (double)(o1[0] - o0[0]) * (double)(o1[1] - o0[1]) * (double)(o1[2] - o0[2]);
                 continue;
             }
+            /* row by row: the sites of both shapes are an interval (both convex); only
+             * when blocks in between reach into the overlap are its sites tested one by one */
             long k[3];
             for (k[2] = o0[2]; k[2] < o1[2]; k[2]++)
-                for (k[1] = o0[1]; k[1] < o1[1]; k[1]++)
-                    for (k[0] = o0[0]; k[0] < o1[0]; k[0]++) {
-                        if (!site_in(lb[q], dim, d, lr[q], lr[q] + 3, k) || !site_in(b, dim, d, k0, k1, k)) continue;
+                for (k[1] = o0[1]; k[1] < o1[1]; k[1]++) {
+                    long a0, a1, b0, b1;
+                    row_interval(b, dim, d, k0, k1, k[1], k[2], &a0, &a1);
+                    row_interval(lb[q], dim, d, lr[q], lr[q] + 3, k[1], k[2], &b0, &b1);
+                    if (b0 > a0) a0 = b0;
+                    if (b1 < a1) a1 = b1;
+                    if (a0 > a1) continue;
+                    if (!between) {
+                        removed += (double)(a1 - a0 + 1);
+                        continue;
+                    }
+                    for (k[0] = a0; k[0] <= a1; k[0]++) {
                         int first = 1;
                         for (int r = 0; r < q && first; r++)
                             if (site_in(lb[r], dim, d, lr[r], lr[r] + 3, k)) first = 0;
                         removed += first;
                     }
+                }
         }
         free(lr);
         free(lb);
@@ -224,6 +259,17 @@ done:
 long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d, pfsph_particles *ps)
 {
     return sample(s, b, (uint32_t)(b - s->blocks), NULL, 0, d, ps);
+}
+
+int pfsph__scene_block_covered(const pfsph_scene *s, int i, double d)
+{
+    long k0[3], k1[3];
+    block_range(&s->blocks[i], s->dim, d, k0, k1);
+    double sites = 1;
+    for (int a = 0; a < 3; a++) sites *= (double)(k1[a] - k0[a]);
+    /* a bound on the work: the count walks at most the overlaps, within this block's range */
+    if (i + 1 >= s->nblocks || sites > 1e7) return 0;
+    return pfsph__sample_scene_block(s, i, d, NULL) == 0;
 }
 
 long pfsph__sample_scene_block(const pfsph_scene *s, int i, double d, pfsph_particles *ps)

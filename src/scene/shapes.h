@@ -13,6 +13,9 @@ long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d,
 /* The same for s->blocks[i] as the scene makes it: less the sites that later blocks contain
  * (a later block replaces what earlier ones put where they overlap). */
 long pfsph__sample_scene_block(const pfsph_scene *s, int i, double d, pfsph_particles *ps);
+/* 1 when later blocks take every site of s->blocks[i] (it adds nothing). Checked up to 1e7
+ * sites in its bounding box (bounded work for the loader); larger blocks return 0. */
+int pfsph__scene_block_covered(const pfsph_scene *s, int i, double d);
 /* Append the boundary particles of a solid (its `layers` layers at spacing d, the first layer
  * centred d/2 inside the solid surface). ps may be NULL to only count. */
 long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
