@@ -100,7 +100,34 @@ static pfsph_real grid_cell(const pfsph_scene *s, pfsph_real h, int *reach, int 
     return cell;
 }
 
-static int build_particles(const pfsph_scene *s, double d, pfsph_particles *fluid,
+/* The wall models of the solids (ctx.h): model 0 is the default (no slip, the fluid's
+ * viscosity; bodies too), a solid that says otherwise gets the model of its setting, shared
+ * with the solids that say the same. */
+static void wall_models(pfsph_ctx *c, const pfsph_scene *s, uint8_t *of_solid)
+{
+    _Static_assert(PFSPH_MAX_SOLIDS + 1 <= PFSPH_MAX_WALLS, "a wall model per solid");
+    c->nwalls = 1;
+    c->wall_scale[0] = 1;
+    c->wall_nu[0] = 0;
+    c->wall_nu_max = 0;
+    for (int i = 0; i < s->nsolids; i++) {
+        const pfsph_solid *o = &s->solids[i];
+        pfsph_real a = 1, b = 0;
+        if (o->slip == PFSPH_FREE_SLIP) a = 0;
+        else if (o->own_viscosity) a = 0, b = (pfsph_real)o->viscosity;
+        int w = 0;
+        while (w < c->nwalls && !(c->wall_scale[w] == a && c->wall_nu[w] == b)) w++;
+        if (w == c->nwalls) {
+            c->wall_scale[w] = a;
+            c->wall_nu[w] = b;
+            c->nwalls++;
+            if (b > c->wall_nu_max) c->wall_nu_max = b;
+        }
+        of_solid[i] = (uint8_t)w;
+    }
+}
+
+static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_wall, pfsph_particles *fluid,
                            pfsph_particles *boundary, pfsph_bodies **bodies, pfsph_error *err)
 {
     /* Boundary volumes. A wall of two or more layers at the fluid's spacing continues the
@@ -114,7 +141,10 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
         size_t first = boundary->n;
         if (pfsph__sample_solid(s, &s->solids[i], d, boundary) < 0)
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling solids");
-        for (size_t j = first; j < boundary->n; j++) boundary->aux[j] = s->solids[i].layers > 1 ? v0 : -1;
+        for (size_t j = first; j < boundary->n; j++) {
+            boundary->aux[j] = s->solids[i].layers > 1 ? v0 : -1;
+            boundary->wall[j] = solid_wall[i];
+        }
     }
     /* bodies after the static solids: their boundary ids follow (pfsph_bodies_first_id) */
     if (s->nbodies) {
@@ -123,7 +153,7 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
     }
     for (int i = 0; i < s->nblocks; i++) {
         size_t first = fluid->n;
-        if (pfsph__sample_block(s, &s->blocks[i], d, fluid) < 0)
+        if (pfsph__sample_scene_block(s, i, d, fluid) < 0)
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
         /* drop fluid particles inside or too close to a solid or a body (their boundary
          * particles sit d/2 inside the surface; one nearer than 0.4 d would start compressed) */
@@ -155,7 +185,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     double d = 2 * s->particle_radius;
     long nf = 0, nb = 0;
     for (int i = 0; i < s->nblocks; i++) {
-        long c = pfsph__sample_block(s, &s->blocks[i], d, NULL);
+        long c = pfsph__sample_scene_block(s, i, d, NULL);
         if (c < 0) return pfsph_fail(err, PFSPH_EINPUT, "cannot sample block %d", i);
         nf += c;
     }
@@ -319,7 +349,9 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         pfsph_fail(err, rc, "out of memory");
         goto fail;
     }
-    if ((rc = build_particles(s, d, &sim->fluid, &sim->boundary, &sim->bodies, err))) goto fail;
+    uint8_t solid_wall[PFSPH_MAX_SOLIDS];
+    wall_models(c, s, solid_wall);
+    if ((rc = build_particles(s, d, solid_wall, &sim->fluid, &sim->boundary, &sim->bodies, err))) goto fail;
     c->fluid = &sim->fluid;
     c->boundary = &sim->boundary;
 

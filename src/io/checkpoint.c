@@ -122,6 +122,11 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
         h_int(h, b->axis);
         h_int(h, b->layers);
         h_int(h, b->open_top);
+        if (b->slip || b->own_viscosity) { /* only then, so that older checkpoints stay resumable */
+            h_int(h, b->slip);
+            h_int(h, b->own_viscosity);
+            h_f64(h, b->viscosity);
+        }
     }
     /* pairwise: what the scene states (c is filled in by pfsph_pairwise_resolve, c_set is not) */
     const pfsph_pairwise_params *pw = &s->pairwise;
