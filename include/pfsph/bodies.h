@@ -59,4 +59,7 @@ uint32_t pfsph_bodies_particle_count(const pfsph_bodies *b);
 /* First boundary-particle id that belongs to a body (ids below are static solids). */
 uint32_t pfsph_bodies_first_id(const pfsph_bodies *b);
 
+/* Gravity of the body dynamics [m/s^2] (the live viewer changes it; 2D ignores g[2]). */
+void pfsph_bodies_set_gravity(pfsph_bodies *b, int dim, const double g[3]);
+
 #endif

@@ -1002,3 +1002,8 @@ int pfsph_bodies_world_mesh(const pfsph_bodies *B, int i, pfsph_mesh *m)
     pfsph_mesh_transform(m, 1.0, R, t);
     return PFSPH_OK;
 }
+
+void pfsph_bodies_set_gravity(pfsph_bodies *b, int dim, const double g[3])
+{
+    if (b) dWorldSetGravity(b->world, g[0], g[1], dim == 3 ? g[2] : 0);
+}
