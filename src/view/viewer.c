@@ -31,7 +31,8 @@
 const char *const pfsph_view_help =
     "usage: pfsph view [SCENE | RUN_DIR] [--size WxH] [--color-by FIELD] [--frame N]\n"
     "                  [--threads N] [--paused] [--screenshot FILE.png --frames N]\n"
-    "                  [--dump DIR] [--no-overlay] [--bench SECONDS]\n"
+    "                  [--dump DIR] [--hide walls,bodies,diffuse] [--no-overlay]\n"
+    "                  [--bench SECONDS]\n"
     "\n"
     "Live mode (SCENE, a JSON file; none: the embedded default scene): the scene is simulated\n"
     "in the window, step by step, as `pfsph run` does. Replay mode (RUN_DIR, a run directory):\n"
@@ -46,6 +47,7 @@ const char *const pfsph_view_help =
     "                     write the last as a PNG and exit; the window stays hidden\n"
     "  --frames N         frames to draw before the screenshot (default 1)\n"
     "  --dump DIR         with --screenshot: write the particles drawn (fluid.vtp, walls.vtp)\n"
+    "  --hide LIST        start with these hidden: walls, bodies, diffuse (comma separated)\n"
     "  --no-overlay       no text, legend or slider\n"
     "  --bench SECONDS    draw continuously for SECONDS, print frames/s and steps/s, exit\n"
     "\n"
@@ -394,6 +396,7 @@ typedef struct opts {
     int threads;
     bool paused, no_overlay;
     const char *screenshot, *dump;
+    bool hide_walls, hide_bodies, hide_diffuse;
     int frames;
     double bench;
 } opts;
@@ -956,6 +959,17 @@ static int parse_opts(int argc, char **argv, opts *o)
             o->bench = v ? strtod(v, &end) : -1;
             if (!v || *end || !(o->bench > 0 && o->bench <= 3600)) return usage("--bench: '%s' is not 0..3600 seconds", v ? v : "");
             i++;
+        } else if (!strcmp(a, "--hide")) {
+            if (!v) return usage("%s needs a list: walls,bodies,diffuse", a);
+            char buf[256];
+            snprintf(buf, sizeof buf, "%s", v);
+            for (char *t = strtok(buf, ","); t; t = strtok(NULL, ",")) {
+                if (!strcmp(t, "walls")) o->hide_walls = true;
+                else if (!strcmp(t, "bodies")) o->hide_bodies = true;
+                else if (!strcmp(t, "diffuse")) o->hide_diffuse = true;
+                else return usage("--hide: '%s' is not walls, bodies or diffuse", t);
+            }
+            i++;
         } else if (!strcmp(a, "--paused")) o->paused = true;
         else if (!strcmp(a, "--no-overlay")) o->no_overlay = true;
         else if (a[0] == '-') return usage("unknown option '%s'", a);
@@ -1163,7 +1177,7 @@ int pfsph_view_main(int argc, char **argv)
     }
     if (A->is_live) {
         rc = o->input ? pfsph_scene_load(A->scene, o->input, &err)
-                      : pfsph_scene_parse(A->scene, pfsph_scene_default_json(), "<embedded>", &err);
+                      : pfsph_scene_parse(A->scene, pfsph_scene_default_json(), "<default scene>", &err);
     } else {
         char p[PFSPH_PATH_LEN + 32];
         if (strlen(o->input) >= PFSPH_PATH_LEN) {
@@ -1173,6 +1187,8 @@ int pfsph_view_main(int argc, char **argv)
             rc = pfsph_scene_load(A->scene, p, &err);
         }
     }
+    /* a scene or run directory that cannot be read is bad input, as for `pfsph run` */
+    if (rc == PFSPH_EIO) rc = PFSPH_EINPUT;
     if (rc) goto fail;
     A->by = color_code(o->color_by ? o->color_by : A->scene->camera.color_by);
     if (A->by < 0) {
@@ -1182,7 +1198,9 @@ int pfsph_view_main(int argc, char **argv)
     }
     A->fb_w = o->w > 0 ? o->w : (A->scene->camera.width > 0 ? A->scene->camera.width : 960);
     A->fb_h = o->h > 0 ? o->h : (A->scene->camera.height > 0 ? A->scene->camera.height : 540);
-    A->show_walls = A->show_bodies = A->show_diffuse = true;
+    A->show_walls = !o->hide_walls;
+    A->show_bodies = !o->hide_bodies;
+    A->show_diffuse = !o->hide_diffuse;
 
     if (A->is_live) {
         live *L = &A->L;
