@@ -54,7 +54,8 @@ const char *const pfsph_view_help =
     "Mouse: left drag orbits (2D: pans), right or middle drag (or shift + left) pans, wheel\n"
     "zooms; replay: click or drag the slider. Keys: space pause/play, N single step (live) or\n"
     "next frame, P previous frame, Home/End first/last frame, R reset, C colour field,\n"
-    "W walls, B bodies, D diffuse, F reset the camera, H help, Esc or Q quit. Live only:\n"
+    "W walls, B bodies, D diffuse, F reset the camera, S save pfsph_view_NNN.png, H help,\n"
+    "Esc or Q quit. Live only:\n"
     "G gravity on/off, [ and ] turn gravity by 15 degrees, Tab next phase pair, + and - raise\n"
     "or lower its coefficient / surface tension (x1.25) or contact angle (10 degrees).\n";
 
@@ -422,6 +423,8 @@ typedef struct app {
     pfsph_vsprite *spr;
     size_t spr_cap;
     bool dirty;         /* redraw needed */
+    bool save_next;     /* S pressed: write the next frame drawn */
+    int saved;          /* screenshots written with S */
     double mx, my;      /* cursor, framebuffer pixels */
     bool drag_l, drag_r, slider_drag;
     double fps;         /* frames drawn per second, over the last half second */
@@ -768,6 +771,7 @@ static void on_key(GLFWwindow *w, int key, int sc, int action, int mods)
     case GLFW_KEY_D: A->show_diffuse = !A->show_diffuse; return;
     case GLFW_KEY_H: A->show_help = !A->show_help; return;
     case GLFW_KEY_F: A->cam = A->cam0; return;
+    case GLFW_KEY_S: A->save_next = true; return;
     default: break;
     }
     if (!A->is_live) {
@@ -989,6 +993,19 @@ static int color_code(const char *s)
     return -1;
 }
 
+/* The frame just drawn as a PNG (the S key); prints where. */
+static void save_png(app *A, const char *path)
+{
+    pfsph_error err = {0};
+    uint8_t *rgb = malloc((size_t)A->fb_w * A->fb_h * 3);
+    if (!rgb) return;
+    pfsph_vdraw_read(A->draw, rgb);
+    if (pfsph_write_png_rgb(path, rgb, A->fb_w, A->fb_h, &err)) fprintf(stderr, "pfsph: view: %s\n", err.msg);
+    else printf("wrote %s\n", path);
+    fflush(stdout);
+    free(rgb);
+}
+
 static int write_outputs(app *A)
 {
     pfsph_error err = {0};
@@ -1124,6 +1141,12 @@ static int run_window(app *A)
                 A->fps = fps_frames / (now - fps_t0);
                 fps_frames = 0;
                 fps_t0 = now;
+            }
+            if (A->save_next) {
+                A->save_next = false;
+                char name[64];
+                snprintf(name, sizeof name, "pfsph_view_%03d.png", A->saved++);
+                save_png(A, name);
             }
             if (headless && drawn >= o->frames) {
                 status = write_outputs(A);
