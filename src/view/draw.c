@@ -18,6 +18,7 @@ struct pfsph_vdraw {
     GLuint final_fbo, final_col;
     int w, h; /* size of the frame */
     int ss;   /* supersampling: the layers are ss w x ss h */
+    int want_ss;
     float view[16], proj[16];
     int ortho, walls3d;
     double f;
@@ -251,8 +252,8 @@ static GLuint texture(GLint ifmt, GLenum fmt, GLenum type, int w, int h)
 static void make_targets(pfsph_vdraw *d, int w, int h)
 {
     free_targets(d);
-    /* 2 x 2 samples per pixel as the renderer takes (up to 4K frames) */
-    d->ss = (double)w * h <= 4096.0 * 2160.0 ? 2 : 1;
+    /* 2 x 2 samples per pixel as the renderer takes (up to 4K frames), unless asked for 1 */
+    d->ss = d->want_ss == 1 || (double)w * h > 4096.0 * 2160.0 ? 1 : 2;
     for (int l = 0; l < 2; l++) {
         d->L[l].col = texture(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, d->ss * w, d->ss * h);
         d->L[l].depth = texture(GL_DEPTH_COMPONENT24, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, d->ss * w, d->ss * h);
@@ -267,6 +268,18 @@ static void make_targets(pfsph_vdraw *d, int w, int h)
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, d->final_col, 0);
     d->w = w;
     d->h = h;
+}
+
+void pfsph_vdraw_set_samples(pfsph_vdraw *d, int ss)
+{
+    d->want_ss = ss == 1 ? 1 : 2;
+    d->w = d->h = 0; /* targets are made again at the next begin */
+}
+
+int pfsph_vdraw_software(void)
+{
+    const char *r = (const char *)glGetString(GL_RENDERER);
+    return r && (strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "swrast") || strstr(r, "Software"));
 }
 
 void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const float proj[16],

@@ -20,6 +20,11 @@ typedef struct pfsph_vdraw pfsph_vdraw;
 pfsph_vdraw *pfsph_vdraw_create(char *msg, size_t cap);
 void pfsph_vdraw_destroy(pfsph_vdraw *d);
 
+/* Samples per pixel along each axis: 2 (default, as the PNG renderer) or 1. */
+void pfsph_vdraw_set_samples(pfsph_vdraw *d, int ss);
+/* Whether the current context renders in software (Mesa llvmpipe, softpipe). */
+int pfsph_vdraw_software(void);
+
 /* Start a frame of w x h pixels with these column-major matrices; f: pixels per metre at unit
  * distance (perspective) or everywhere (ortho), for the shading level of small discs; walls3d:
  * translucent, flat-shaded walls (3D) rather than walls behind the fluid (2D). */

@@ -32,7 +32,7 @@ const char *const pfsph_view_help =
     "usage: pfsph view [SCENE | RUN_DIR] [--size WxH] [--color-by FIELD] [--frame N]\n"
     "                  [--threads N] [--paused] [--screenshot FILE.png --frames N]\n"
     "                  [--dump DIR] [--hide walls,bodies,diffuse] [--no-overlay]\n"
-    "                  [--bench SECONDS]\n"
+    "                  [--samples 1|2] [--bench SECONDS]\n"
     "\n"
     "Live mode (SCENE, a JSON file; none: the embedded default scene): the scene is simulated\n"
     "in the window, step by step, as `pfsph run` does. Replay mode (RUN_DIR, a run directory):\n"
@@ -49,6 +49,8 @@ const char *const pfsph_view_help =
     "  --dump DIR         with --screenshot: write the particles drawn (fluid.vtp, walls.vtp)\n"
     "  --hide LIST        start with these hidden: walls, bodies, diffuse (comma separated)\n"
     "  --no-overlay       no text, legend or slider\n"
+    "  --samples 1|2      samples per pixel along each axis (default 2, as `pfsph render`;\n"
+    "                     1 in a window on a software renderer, for speed)\n"
     "  --bench SECONDS    draw continuously for SECONDS, print frames/s and steps/s, exit\n"
     "\n"
     "Mouse: left drag orbits (2D: pans), right or middle drag (or shift + left) pans, wheel\n"
@@ -399,6 +401,7 @@ typedef struct opts {
     const char *screenshot, *dump;
     bool hide_walls, hide_bodies, hide_diffuse;
     int frames;
+    int samples; /* 0: automatic */
     double bench;
 } opts;
 
@@ -578,8 +581,10 @@ static void overlay(app *A, double lo, double hi)
                      strcmp(v, "C") ? v : "COEFFICIENT", cv);
         }
         pthread_mutex_unlock(&A->L.mu);
-        snprintf(line, sizeof line, "LIVE  T=%.4f S  STEP %llu  %.1f STEPS/S  %.0f FPS%s", f->time,
-                 (unsigned long long)f->steps, sps, A->fps, failed ? "  STOPPED" : paused ? "  PAUSED" : "");
+        char fps[32] = "";
+        if (A->fps > 0) snprintf(fps, sizeof fps, "  %.0f FPS", A->fps); /* none yet in the first half second */
+        snprintf(line, sizeof line, "LIVE  T=%.4f S  STEP %llu  %.1f STEPS/S%s%s", f->time, (unsigned long long)f->steps,
+                 sps, fps, failed ? "  STOPPED" : paused ? "  PAUSED" : "");
         panel_text(A, 6 * s, y, s, line, INK);
         y += lh;
         snprintf(line, sizeof line, "G %.3g %.3g %.3g M/S2", g[0], g[1], g[2]);
@@ -601,8 +606,10 @@ static void overlay(app *A, double lo, double hi)
             }
         }
     } else {
-        snprintf(line, sizeof line, "REPLAY  FRAME %d  (%d/%d)  T=%.4f S  %.0f FPS%s", f->number, A->R.cur + 1,
-                 A->R.fluid.n, f->time, A->fps, A->R.playing ? "" : "  PAUSED");
+        char fps[32] = "";
+        if (A->fps > 0) snprintf(fps, sizeof fps, "  %.0f FPS", A->fps);
+        snprintf(line, sizeof line, "REPLAY  FRAME %d  (%d/%d)  T=%.4f S%s%s", f->number, A->R.cur + 1, A->R.fluid.n,
+                 f->time, fps, A->R.playing ? "" : "  PAUSED");
         panel_text(A, 6 * s, y, s, line, INK);
         y += lh;
     }
@@ -974,6 +981,10 @@ static int parse_opts(int argc, char **argv, opts *o)
                 else return usage("--hide: '%s' is not walls, bodies or diffuse", t);
             }
             i++;
+        } else if (!strcmp(a, "--samples")) {
+            if (!v || (strcmp(v, "1") && strcmp(v, "2"))) return usage("--samples: '%s' is not 1 or 2", v ? v : "");
+            o->samples = atoi(v);
+            i++;
         } else if (!strcmp(a, "--paused")) o->paused = true;
         else if (!strcmp(a, "--no-overlay")) o->no_overlay = true;
         else if (a[0] == '-') return usage("unknown option '%s'", a);
@@ -1087,6 +1098,10 @@ static int run_window(app *A)
         glfwTerminate();
         return 1;
     }
+    /* Screenshots take the renderer's 2 x 2 samples; a window on a software renderer 1, which
+     * draws about 3x faster (docs/benchmarks.md) */
+    int ss = o->samples ? o->samples : (!headless && pfsph_vdraw_software() ? 1 : 2);
+    pfsph_vdraw_set_samples(A->draw, ss);
     glfwSetWindowUserPointer(A->win, A);
     glfwSetKeyCallback(A->win, on_key);
     glfwSetMouseButtonCallback(A->win, on_button);
@@ -1154,9 +1169,10 @@ static int run_window(app *A)
             }
             if (o->bench > 0 && now - bench_t0 >= o->bench) {
                 uint64_t st = A->shown->steps;
-                printf("bench: %zu fluid particles, %.1f frames/s drawn, %.2f simulation steps/s, %dx%d\n",
-                       A->shown->fluid.n, drawn / (now - bench_t0), (double)(st - bench_steps0) / (now - bench_t0),
-                       A->fb_w, A->fb_h);
+                printf("bench: %zu fluid + %zu wall particles, %.1f frames/s drawn, %.2f simulation steps/s, "
+                       "%dx%d, %d sample(s) per pixel, %s\n", A->shown->fluid.n, A->shown->walls.n,
+                       drawn / (now - bench_t0), (double)(st - bench_steps0) / (now - bench_t0), A->fb_w, A->fb_h,
+                       ss * ss, (const char *)glGetString(GL_RENDERER));
                 break;
             }
             glfwPollEvents();
