@@ -946,3 +946,20 @@ int pfsph_sim_set_pair_contact_angle(pfsph_sim *sim, int a, int b, double deg, p
                           s->phases[a].name, s->phases[b].name, deg);
     return set_pair(sim, a, b, 2, deg, err);
 }
+
+int pfsph_sim_drag_body(pfsph_sim *sim, int body, const double target[3], pfsph_error *err)
+{
+    int nb = pfsph_bodies_count(sim->bodies);
+    if (body < 0 || body >= nb)
+        return pfsph_fail(err, PFSPH_EINPUT, "drag: no body %d (the scene has %d)", body, nb);
+    if (!pfsph_bodies_draggable(sim->bodies, body))
+        return pfsph_fail(err, PFSPH_EINPUT, "drag: body \"%s\" is %s; only kinematic bodies without keyframes can be "
+                          "dragged", pfsph_bodies_name(sim->bodies, body),
+                          sim->scene.bodies[body].kinematic ? "moved by keyframes" : "dynamic");
+    /* no faster than the flows the scene is set up for (a tenth of its sound speed, Mach 0.1),
+     * and well inside the blow-up bound */
+    double vmax = fmin(0.1 * sim->sound_speed, 0.2 * sim->solver->speed_bound(sim->solver_state, &sim->ctx));
+    if (pfsph_bodies_drag(sim->bodies, body, target, vmax))
+        return pfsph_fail(err, PFSPH_EINPUT, "drag: target %g %g %g is not finite", target[0], target[1], target[2]);
+    return PFSPH_OK;
+}

@@ -108,5 +108,10 @@ int pfsph_sim_set_pair_coefficient(pfsph_sim *sim, int a, int b, double c, pfsph
 int pfsph_sim_set_pair_sigma(pfsph_sim *sim, int a, int b, double sigma, pfsph_error *err);
 /* Static contact-angle target [degrees, 0..180] of a fluid phase on a solid phase. */
 int pfsph_sim_set_pair_contact_angle(pfsph_sim *sim, int a, int b, double deg, pfsph_error *err);
+/* Drag rigid body `body` (kinematic, without keyframes) towards target [m]: it moves there in a
+ * straight line from the next step on, at most a tenth of the sound speed (the flow speed the
+ * scene is set up for) and a fifth of the blow-up speed bound, and stays where it is left;
+ * target NULL lets go. */
+int pfsph_sim_drag_body(pfsph_sim *sim, int body, const double target[3], pfsph_error *err);
 
 #endif

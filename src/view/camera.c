@@ -144,3 +144,34 @@ void pfsph_vcam_matrices(const pfsph_vcam *c, int w, int h, double depth, float 
     proj[11] = -1;
     proj[14] = (float)(-2 * fa * n / (fa - n));
 }
+
+int pfsph_vcam_project(const pfsph_vcam *c, int w, int h, const double p[3], double *sx, double *sy, double *depth)
+{
+    double f = c->f_per_h * h;
+    if (c->ortho) {
+        *sx = 0.5 * w + (p[0] - c->cx) * f;
+        *sy = 0.5 * h - (p[1] - c->cy) * f;
+        *depth = 0;
+        return 1;
+    }
+    double q[3] = {p[0] - c->eye[0], p[1] - c->eye[1], p[2] - c->eye[2]};
+    double zc = dot3(q, c->fwd);
+    if (!(zc > 0)) return 0;
+    *sx = 0.5 * w + dot3(q, c->right) * f / zc;
+    *sy = 0.5 * h - dot3(q, c->up) * f / zc;
+    *depth = zc;
+    return 1;
+}
+
+void pfsph_vcam_unproject(const pfsph_vcam *c, int w, int h, double sx, double sy, double depth, double p[3])
+{
+    double f = c->f_per_h * h;
+    if (c->ortho) {
+        p[0] = c->cx + (sx - 0.5 * w) / f;
+        p[1] = c->cy - (sy - 0.5 * h) / f;
+        p[2] = 0;
+        return;
+    }
+    double a = (sx - 0.5 * w) / f, b = -(sy - 0.5 * h) / f;
+    for (int k = 0; k < 3; k++) p[k] = c->eye[k] + depth * (c->fwd[k] + a * c->right[k] + b * c->up[k]);
+}

@@ -29,4 +29,10 @@ void pfsph_vcam_matrices(const pfsph_vcam *c, int w, int h, double depth, float 
 /* Pixels per metre at unit distance (perspective) or everywhere (ortho), for an image h high. */
 double pfsph_vcam_focal(const pfsph_vcam *c, int h);
 
+/* Pixel position (from the top left) and depth along the view axis of world point p; 0 when it
+ * is behind the eye. Ortho: depth 0. */
+int pfsph_vcam_project(const pfsph_vcam *c, int w, int h, const double p[3], double *sx, double *sy, double *depth);
+/* The world point at pixel (sx, sy) and that depth (ortho: in the plane z = 0). */
+void pfsph_vcam_unproject(const pfsph_vcam *c, int w, int h, double sx, double sy, double depth, double p[3]);
+
 #endif

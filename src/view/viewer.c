@@ -54,7 +54,8 @@ const char *const pfsph_view_help =
     "  --bench SECONDS    draw continuously for SECONDS, print frames/s and steps/s, exit\n"
     "\n"
     "Mouse: left drag orbits (2D: pans), right or middle drag (or shift + left) pans, wheel\n"
-    "zooms; replay: click or drag the slider. Keys: space pause/play, N single step (live) or\n"
+    "zooms, ctrl + left drag moves a kinematic body (live, bodies without keyframes); replay:\n"
+    "click or drag the slider. Keys: space pause/play, N single step (live) or\n"
     "next frame, P previous frame, Home/End first/last frame, R reset, C colour field,\n"
     "W walls, B bodies, D diffuse, F reset the camera, S save pfsph_view_NNN.png, H help,\n"
     "Esc or Q quit. Live only:\n"
@@ -67,8 +68,12 @@ static const char *const BY_UNIT[BY_COUNT] = {"", "M/S", "KG/M3", "PA"};
 
 /* ---- particle sets of one drawn frame ------------------------------------------------- */
 
+#define VIEW_MAX_BODIES 64
 typedef struct vframe {
     pfsph_particles fluid, walls, bodies, diffuse;
+    int nb;                                   /* rigid bodies (live), at most VIEW_MAX_BODIES */
+    double bx[VIEW_MAX_BODIES][3];            /* their centres */
+    bool draggable[VIEW_MAX_BODIES];
     double time;
     uint64_t steps;
     int number; /* replay: the frame number */
@@ -113,7 +118,7 @@ static int set_copy(pfsph_particles *d, const pfsph_particles *s, uint32_t lo, u
 
 /* ---- live mode: the simulation thread --------------------------------------------------- */
 
-enum { CMD_GRAVITY, CMD_COEF, CMD_SIGMA, CMD_ANGLE };
+enum { CMD_GRAVITY, CMD_COEF, CMD_SIGMA, CMD_ANGLE, CMD_DRAG, CMD_RELEASE };
 typedef struct vcmd {
     int kind, a, b;
     double v[3];
@@ -151,6 +156,14 @@ static int publish_into(live *L, vframe *f)
     if (!rc) rc = set_copy(&f->diffuse, pfsph_sim_diffuse(L->sim), 0, UINT32_MAX);
     f->time = pfsph_sim_time(L->sim);
     f->steps = pfsph_sim_steps(L->sim);
+    f->nb = pfsph_bodies_count(B);
+    if (f->nb > VIEW_MAX_BODIES) f->nb = VIEW_MAX_BODIES;
+    for (int i = 0; i < f->nb; i++) {
+        pfsph_body_state bs;
+        pfsph_bodies_get_state(B, i, &bs);
+        memcpy(f->bx[i], bs.x, sizeof bs.x);
+        f->draggable[i] = pfsph_bodies_draggable(B, i);
+    }
     return rc;
 }
 
@@ -183,6 +196,8 @@ static void apply_cmds(live *L)
         case CMD_GRAVITY: rc = pfsph_sim_set_gravity(L->sim, q->v, &err); break;
         case CMD_COEF: rc = pfsph_sim_set_pair_coefficient(L->sim, q->a, q->b, q->v[0], &err); break;
         case CMD_SIGMA: rc = pfsph_sim_set_pair_sigma(L->sim, q->a, q->b, q->v[0], &err); break;
+        case CMD_DRAG: rc = pfsph_sim_drag_body(L->sim, q->a, q->v, &err); break;
+        case CMD_RELEASE: rc = pfsph_sim_drag_body(L->sim, q->a, NULL, &err); break;
         default: rc = pfsph_sim_set_pair_contact_angle(L->sim, q->a, q->b, q->v[0], &err); break;
         }
         if (rc) snprintf(L->msg, sizeof L->msg, "refused: %s", err.msg);
@@ -273,6 +288,9 @@ static void *live_main(void *arg)
 static void live_post(live *L, const vcmd *q)
 {
     pthread_mutex_lock(&L->mu);
+    /* a new drag target replaces one not yet applied */
+    if (q->kind == CMD_DRAG && L->ncmd > 0 && L->cmd[L->ncmd - 1].kind == CMD_DRAG && L->cmd[L->ncmd - 1].a == q->a)
+        L->ncmd--;
     if (L->ncmd < MAX_CMDS) L->cmd[L->ncmd++] = *q;
     pthread_cond_broadcast(&L->cv);
     pthread_mutex_unlock(&L->mu);
@@ -430,6 +448,8 @@ typedef struct app {
     int saved;          /* screenshots written with S */
     double mx, my;      /* cursor, framebuffer pixels */
     bool drag_l, drag_r, slider_drag;
+    int grab;           /* body dragged with ctrl + left button, -1 none */
+    double grab_depth;
     double fps;         /* frames drawn per second, over the last half second */
     int fb_w, fb_h;
 } app;
@@ -875,6 +895,34 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
     A->mx = x;
     A->my = y;
     bool down = action == GLFW_PRESS;
+    if (button == GLFW_MOUSE_BUTTON_LEFT && A->grab >= 0 && !down) {
+        vcmd q = {CMD_RELEASE, A->grab, 0, {0, 0, 0}};
+        live_post(&A->L, &q);
+        A->grab = -1;
+        return;
+    }
+    if (button == GLFW_MOUSE_BUTTON_LEFT && down && (mods & GLFW_MOD_CONTROL) && A->is_live) {
+        /* the draggable body whose centre is nearest the cursor, within 80 pixels */
+        const vframe *f = A->shown;
+        double best = 80, bd = 0;
+        int pick = -1;
+        for (int i = 0; i < f->nb; i++) {
+            double sx, sy, d;
+            if (!f->draggable[i] || !pfsph_vcam_project(&A->cam, A->fb_w, A->fb_h, f->bx[i], &sx, &sy, &d)) continue;
+            double r = hypot(sx - x, sy - y);
+            if (r < best) best = r, pick = i, bd = d;
+        }
+        if (pick >= 0) {
+            A->grab = pick;
+            A->grab_depth = bd;
+        } else {
+            pthread_mutex_lock(&A->L.mu);
+            snprintf(A->L.msg, sizeof A->L.msg, "ctrl + drag: no kinematic body without keyframes near the cursor");
+            pthread_mutex_unlock(&A->L.mu);
+            A->dirty = true;
+        }
+        return;
+    }
     if (button == GLFW_MOUSE_BUTTON_LEFT) {
         if (down && on_slider(A, x, y)) {
             A->slider_drag = true;
@@ -896,7 +944,11 @@ static void on_cursor(GLFWwindow *w, double x, double y)
     double dx = x - A->mx, dy = y - A->my;
     A->mx = x;
     A->my = y;
-    if (A->slider_drag) {
+    if (A->grab >= 0) {
+        vcmd q = {CMD_DRAG, A->grab, 0, {0, 0, 0}};
+        pfsph_vcam_unproject(&A->cam, A->fb_w, A->fb_h, x, y, A->grab_depth, q.v);
+        live_post(&A->L, &q);
+    } else if (A->slider_drag) {
         slider_set(A, x);
     } else if (A->drag_l && !A->cam.ortho) {
         pfsph_vcam_orbit(&A->cam, dx * 0.008, dy * 0.008);
@@ -1237,6 +1289,7 @@ int pfsph_view_main(int argc, char **argv)
     }
     A->fb_w = o->w > 0 ? o->w : (A->scene->camera.width > 0 ? A->scene->camera.width : 960);
     A->fb_h = o->h > 0 ? o->h : (A->scene->camera.height > 0 ? A->scene->camera.height : 540);
+    A->grab = -1;
     A->show_walls = !o->hide_walls;
     A->show_bodies = !o->hide_bodies;
     A->show_diffuse = !o->hide_diffuse;

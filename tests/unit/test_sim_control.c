@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pfsph/bodies.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 #include "testutil.h"
@@ -170,12 +171,83 @@ static void test_next_step(void **state)
     free(sb);
 }
 
+/* A kinematic paddle without keyframes and a floating dynamic block over a little water: the
+ * paddle follows the drag target in a straight line at the capped speed, stops there, stays
+ * after release; the dynamic block cannot be dragged. */
+static const char *BODIES =
+    "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
+    " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.5, 0.5]},"
+    " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 1, \"dt_max\": 0.001},"
+    " \"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": 1e-3},"
+    "  {\"name\": \"wall\", \"kind\": \"solid\"}, {\"name\": \"wood\", \"kind\": \"solid\", \"rest_density\": 500}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.4, 0.06], \"phase\": \"water\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.4, 0.3], \"open_top\": true, \"layers\": 2,"
+    "   \"phase\": \"wall\"}],"
+    " \"bodies\": [{\"name\": \"paddle\", \"shape\": \"box\", \"half_extents\": [0.02, 0.04], \"position\": [0.1, 0.2],"
+    "   \"kinematic\": true, \"phase\": \"wood\"},"
+    "  {\"name\": \"block\", \"shape\": \"box\", \"half_extents\": [0.03, 0.02], \"position\": [0.3, 0.2], \"phase\": \"wood\"}]}";
+
+static void test_drag(void **state)
+{
+    (void)state;
+    pfsph_scene *sc = malloc(sizeof *sc);
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(sc, BODIES, "<drag>", &err), PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    if (pfsph_sim_create(&sim, sc, &err)) fail_msg("%s", err.msg);
+    const struct pfsph_bodies *B = pfsph_sim_bodies(sim);
+    assert_int_equal(pfsph_sim_drag_body(sim, 1, (double[3]){0.2, 0.2, 0}, &err), PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "dynamic"));
+    assert_int_equal(pfsph_sim_drag_body(sim, 2, (double[3]){0.2, 0.2, 0}, &err), PFSPH_EINPUT);
+    assert_int_equal(pfsph_sim_drag_body(sim, 0, (double[3]){NAN, 0.2, 0}, &err), PFSPH_EINPUT);
+    pfsph_body_state bs;
+    step(sim);
+    pfsph_bodies_get_state(B, 0, &bs);
+    assert_true(bs.x[0] == 0.1 && bs.x[1] == 0.2); /* kinematic, no keyframes: it stays */
+    /* drag 5 cm to the right and 3 cm down */
+    const double target[3] = {0.15, 0.17, 0.4}; /* z is dropped in 2D */
+    assert_int_equal(pfsph_sim_drag_body(sim, 0, target, &err), PFSPH_OK);
+    double path = 0, prev[2] = {0.1, 0.2}, tmax = 0;
+    int steps = 0;
+    for (; steps < 20000; steps++) {
+        double t0 = pfsph_sim_time(sim);
+        step(sim);
+        double dt = pfsph_sim_time(sim) - t0;
+        pfsph_bodies_get_state(B, 0, &bs);
+        double d = hypot(bs.x[0] - prev[0], bs.x[1] - prev[1]);
+        path += d;
+        tmax = fmax(tmax, d / dt);
+        /* on the straight line from the start to the target */
+        double cross = (bs.x[0] - 0.1) * (0.17 - 0.2) - (bs.x[1] - 0.2) * (0.15 - 0.1);
+        assert_true(fabs(cross) < 1e-9);
+        assert_true(bs.x[2] == 0);
+        prev[0] = bs.x[0], prev[1] = bs.x[1];
+        if (hypot(bs.x[0] - 0.15, bs.x[1] - 0.17) < 1e-9) break;
+    }
+    const double dist = hypot(0.05, 0.03);
+    print_message("paddle dragged %.4f m in %d steps (%.4g s), top speed %.3g m/s\n", path, steps + 1,
+                  pfsph_sim_time(sim), tmax);
+    assert_true(steps < 20000);
+    assert_true(fabs(path - dist) < 1e-9);
+    /* capped at a tenth of the sound speed */
+    assert_true(tmax <= 0.1 * pfsph_sim_sound_speed(sim) * (1 + 1e-9));
+    assert_true(tmax > 0.05 * pfsph_sim_sound_speed(sim));
+    assert_int_equal(pfsph_sim_drag_body(sim, 0, NULL, &err), PFSPH_OK);
+    for (int k = 0; k < 5; k++) step(sim);
+    pfsph_bodies_get_state(B, 0, &bs);
+    assert_true(fabs(bs.x[0] - 0.15) < 1e-12 && fabs(bs.x[1] - 0.17) < 1e-12);
+    assert_true(bs.v[0] == 0 && bs.v[1] == 0);
+    pfsph_sim_destroy(sim);
+    free(sc);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_matrix),
         cmocka_unit_test(test_next_step),
+        cmocka_unit_test(test_drag),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
