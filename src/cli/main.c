@@ -15,6 +15,9 @@
 #include "pfsph/run.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
+#ifdef PFSPH_HAVE_VIEWER
+#include "view/view.h"
+#endif
 
 static const char *USAGE =
     "usage: pfsph run [SCENE] [-o DIR] [--force] [--threads N] [--end T] [--render] [--quiet]\n"
@@ -22,6 +25,7 @@ static const char *USAGE =
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH]\n"
+    "       pfsph view [SCENE | RUN_DIR] [--screenshot FILE --frames N] [...]\n"
     "       pfsph --version\n"
     "       pfsph help [COMMAND]    (or pfsph COMMAND --help)\n";
 
@@ -32,6 +36,7 @@ static const char *HELP =
     "  run      simulate a scene into a run directory (frames, stats.csv, summary.json)\n"
     "  check    validate a scene: particle counts, memory estimate, coefficients\n"
     "  render   PNG previews (and an mp4) of a run directory's frames\n"
+    "  view     a window: a scene simulated live, or a run directory replayed\n"
     "  help     this text, or a command's: pfsph help run\n"
     "  --version  the version, precision and OpenMP thread count\n"
     "\n"
@@ -502,6 +507,20 @@ static int cmd_render(int argc, char **argv)
     return 0;
 }
 
+/* `pfsph view` (src/view/) exists only in builds that found GLFW and libepoxy. */
+static int cmd_view(int argc, char **argv)
+{
+#ifdef PFSPH_HAVE_VIEWER
+    return pfsph_view_main(argc, argv);
+#else
+    (void)argc;
+    (void)argv;
+    fprintf(stderr, "pfsph: view: this build has no viewer (it needs GLFW 3 and libepoxy at build time: Debian "
+                    "libglfw3-dev libepoxy-dev, then cmake -DPFSPH_VIEWER=ON); `pfsph render` makes PNG previews\n");
+    return 2;
+#endif
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -519,11 +538,17 @@ int main(int argc, char **argv)
         else if (!strcmp(topic, "run")) fputs(HELP_RUN, stdout);
         else if (!strcmp(topic, "check")) fputs(HELP_CHECK, stdout);
         else if (!strcmp(topic, "render")) fputs(HELP_RENDER, stdout);
+        else if (!strcmp(topic, "view")) {
+            char h[] = "--help";
+            char *v[] = {h, NULL};
+            return cmd_view(1, v);
+        }
         else return usage_error("help: unknown command '%s'", topic);
         return 0;
     }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "check")) return cmd_check(argc - 2, argv + 2);
     if (!strcmp(cmd, "render")) return cmd_render(argc - 2, argv + 2);
+    if (!strcmp(cmd, "view")) return cmd_view(argc - 2, argv + 2);
     return usage_error("unknown command '%s'", cmd);
 }
