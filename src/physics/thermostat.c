@@ -24,6 +24,7 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
     const uint64_t key = pfsph_thermo_step_key(ctx->seed, ctx->step, 0);
     const uint64_t wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
     const size_t n = f->n;
+    const int mixed = ctx->nwalls > 1;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
@@ -58,7 +59,7 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
                 fy += s * (double)dy;
                 fz += s * (double)dz;
             }
-        if (b->n && nui > 0) {
+        if (b->n && (nui > 0 || (mixed && ctx->wall_nu_max > 0))) {
             pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
             for (int q = 0; q < r.n; q++)
                 for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
@@ -66,8 +67,11 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
                     pfsph_real r2 = dx * dx + dy * dy + dz * dz;
                     if (r2 >= h2 || r2 <= 0) continue;
                     double rr = sqrt((double)r2);
-                    /* Akinci friction: m_i visc_c nu_i V_b r^2 |W'/r| / (r^2 + eps) */
-                    double g = nui * mi * (double)b->aux[j] * (double)r2 *
+                    /* Akinci friction: m_i visc_c nu_w V_b r^2 |W'/r| / (r^2 + eps), nu_w the
+                     * wall's friction viscosity (viscosity.c: free slip 0, no slip nu_i or the
+                     * solid's own) */
+                    const double nuw = mixed ? (double)ctx->wall_scale[b->wall[j]] * nui + (double)ctx->wall_nu[b->wall[j]] : nui;
+                    double g = nuw * mi * (double)b->aux[j] * (double)r2 *
                                -(double)pfsph_kernel_dw_r(k, (pfsph_real)rr) / (double)(r2 + eps);
                     if (!(g > 0)) continue;
                     double s = sqrt(amp * ts[pa][pa] * g) * pfsph_thermo_theta(wkey, idi, b->id[j]) / rr;
