@@ -19,7 +19,7 @@ static void usage(void)
 {
     fprintf(stderr,
             "usage: bench [--particles N] [--steps N] [--warmup N] [--solver wcsph|pcisph]\n"
-            "             [--pairwise] [--threads N] [--diffuse N] [--diffuse-emit-all]\n"
+            "             [--pairwise [--no-thermostat]] [--threads N] [--diffuse N] [--diffuse-emit-all]\n"
             "Runs a 3D dam break of about N fluid particles (default 50000) for --steps steps\n"
             "(default 20) after --warmup steps (default 3) and prints throughput figures.\n"
             "--diffuse N turns diffuse material on (the limits of scenes/diffuse_dam_*.json)\n"
@@ -121,7 +121,7 @@ static int seed_diffuse(pfsph_sim *sim, long n, double top, pfsph_error *err)
 int main(int argc, char **argv)
 {
     long target = 50000, steps = 20, warmup = 3;
-    int pcisph = 0, pairwise = 0, threads = 0, emit_all = 0;
+    int pcisph = 0, pairwise = 0, threads = 0, emit_all = 0, no_thermo = 0;
     long ndiffuse = -1;
     double wall_nu = -1;
     for (int i = 1; i < argc; i++) {
@@ -137,6 +137,7 @@ int main(int argc, char **argv)
             else { usage(); return 2; }
             i++;
         } else if (!strcmp(a, "--pairwise")) pairwise = 1;
+        else if (!strcmp(a, "--no-thermostat")) no_thermo = 1;
         else if (!strcmp(a, "--diffuse") && v) { ndiffuse = atol(v); i++; }
         else if (!strcmp(a, "--diffuse-emit-all")) emit_all = 1;
         else if (!strcmp(a, "--wall-viscosity") && v) { wall_nu = atof(v); i++; }
@@ -165,8 +166,8 @@ int main(int argc, char **argv)
     char pair[256] = "";
     if (pairwise)
         snprintf(pair, sizeof pair,
-                 ",\n\"pairwise\": {\"coefficients\": [{\"phases\": [\"water\", \"water\"], "
-                 "\"c\": 1000}]}");
+                 ",\n\"pairwise\": {%s\"coefficients\": [{\"phases\": [\"water\", \"water\"], "
+                 "\"c\": 1000}]}", no_thermo ? "\"thermostat\": false, " : "");
     /* Diffuse block: the limits of scenes/diffuse_dam_*.json; the cap leaves room above the
      * seeded count so that generation runs (it is skipped at the cap). */
     char dif[1024] = "";
