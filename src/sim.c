@@ -622,7 +622,12 @@ static int st_forces(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     (void)bad;
     (void)err;
-    pfsph__nonpressure(&sim->ctx);
+    if (sim->scr_noise >= 0) { /* with the thermostat's random forces, fused (viscosity.c) */
+        pfsph_real *nz[3] = {sim->scr[sim->scr_noise], sim->scr[sim->scr_noise + 1], sim->scr[sim->scr_noise + 2]};
+        pfsph__nonpressure_thermo(&sim->ctx, nz);
+    } else {
+        pfsph__nonpressure(&sim->ctx);
+    }
     return PFSPH_OK;
 }
 
@@ -631,16 +636,6 @@ static int st_pairwise(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)bad;
     (void)err;
     pfsph_pairwise_apply(sim->pw, &sim->ctx);
-    return PFSPH_OK;
-}
-
-/* thermal noise after every deterministic force, before the pressure solve sees them */
-static int st_thermostat(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
-{
-    (void)bad;
-    (void)err;
-    pfsph_real *nz[3] = {sim->scr[sim->scr_noise], sim->scr[sim->scr_noise + 1], sim->scr[sim->scr_noise + 2]};
-    pfsph_thermostat_apply(&sim->ctx, nz);
     return PFSPH_OK;
 }
 
@@ -771,7 +766,6 @@ static void build_stages(pfsph_sim *sim)
     if (sim->solver->pre_forces) ADD("divergence", PFSPH_STAGE_PRESSURE, st_divergence);
     ADD("forces", PFSPH_STAGE_FORCES, st_forces);
     if (sim->pw) ADD("pairwise", PFSPH_STAGE_PAIRWISE, st_pairwise);
-    if (sim->scr_noise >= 0 && pfsph_thermostat_kT(&sim->ctx) > 0) ADD("thermostat", PFSPH_STAGE_PAIRWISE, st_thermostat);
     ADD("pressure", PFSPH_STAGE_PRESSURE, st_pressure);
     if (sim->bodies) ADD("bodies", PFSPH_STAGE_BODIES, st_body_forces);
     ADD("integrate", PFSPH_STAGE_INTEGRATE, st_integrate);

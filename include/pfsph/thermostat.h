@@ -4,6 +4,7 @@
 #ifndef PFSPH_THERMOSTAT_H
 #define PFSPH_THERMOSTAT_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "pfsph/ctx.h"
@@ -49,6 +50,30 @@ static inline double pfsph_thermostat_scale(const pfsph_ctx *ctx, int a)
 {
     const double rr = ctx->pairwise->thermo.rho_ref, ra = (double)ctx->rest_density[a];
     return rr > 0 && ra > 0 && ctx->phases[a].kind != PFSPH_PHASE_SOLID ? ra / rr : 1.0;
+}
+
+/* The noise force of one fluid pair divided by r (multiply by x_ij): amp_ts = 2 kT_ij visc_c /
+ * dt, nu the pair's viscosity, dwr = W'(r)/r (negative), theta the pair's draw. The
+ * viscosity's friction is m_i / n_j on i and m_j / n_i on j; one force on both takes their
+ * harmonic mean 2 m_i m_j / (m_i n_i + m_j n_j): the same from either side, the arithmetic
+ * mean to second order within a phase, and no more than twice the lighter particle's friction
+ * across a density ratio (the arithmetic mean shook a gas particle next to water with the
+ * water's friction, 500x its own at a ratio of 1000). */
+static inline double pfsph__thermo_fluid(double amp_ts, double nu, double mi, double mj, double ndi,
+                                         double ndj, double r2, double dwr, double eps, double rr,
+                                         double theta)
+{
+    double g = nu * 2.0 * mi * mj / (mi * ndi + mj * ndj) * r2 * -dwr / (r2 + eps);
+    return g > 0 ? sqrt(amp_ts * g) * theta / rr : 0.0;
+}
+
+/* The same for a fluid particle of mass m_i and a solid particle of volume V_b whose wall
+ * friction viscosity is nu_w (Akinci: m_i visc_c nu_w V_b r^2 |W'/r| / (r^2 + eps)). */
+static inline double pfsph__thermo_wall(double amp_ts, double nuw, double mi, double vb, double r2,
+                                        double dwr, double eps, double rr, double theta)
+{
+    double g = nuw * mi * vb * r2 * -dwr / (r2 + eps);
+    return g > 0 ? sqrt(amp_ts * g) * theta / rr : 0.0;
 }
 
 /* ADD the random pair forces of this step (dt = ctx->dt) to ctx->ax, ay, az, as accelerations,

@@ -793,17 +793,14 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
                         /* the thermostat's random force on the fluid, reversed (thermostat.c:
                          * the same expression, same draw) */
                         double rr = sqrt((double)r2);
-                        double g = (double)nui * (double)ctx->mass[f->phase[i]] * (double)vol *
-                                   (double)r2 * -(double)pfsph_kernel_dw_r(k, (pfsph_real)rr) /
-                                   (double)(r2 + eps);
-                        if (g > 0) {
-                            /* x_ib points from the body particle to the fluid: -e_ib on the body */
-                            double sr = -sqrt(amp * pfsph_thermostat_scale(ctx, f->phase[i]) * g) *
-                                        pfsph_thermo_theta(wkey, f->id[i], b->id[j]) / rr;
-                            tx += sr * (double)dx;
-                            ty += sr * (double)dy;
-                            tz += sr * (double)dz;
-                        }
+                        /* x_ib points from the body particle to the fluid: -e_ib on the body */
+                        double sr = -pfsph__thermo_wall(amp * pfsph_thermostat_scale(ctx, f->phase[i]), (double)nui,
+                                                        (double)ctx->mass[f->phase[i]], (double)vol, (double)r2,
+                                                        (double)pfsph_kernel_dw_r(k, (pfsph_real)rr), (double)eps, rr,
+                                                        pfsph_thermo_theta(wkey, f->id[i], b->id[j]));
+                        tx += sr * (double)dx;
+                        ty += sr * (double)dy;
+                        tz += sr * (double)dz;
                     }
                 }
                 fx += (double)(s * dx);

@@ -43,18 +43,10 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
                 double nu = 0.5 * (nui + (double)ctx->nu[pb]);
                 if (!(nu > 0)) continue;
                 double rr = sqrt((double)r2);
-                /* The viscosity's friction is m_i / n_j on i and m_j / n_i on j; the noise
-                 * must be one force on both, so it takes their harmonic mean 2 m_i m_j /
-                 * (m_i n_i + m_j n_j): the same from either side, the arithmetic mean to second
-                 * order within a phase, and no more than twice the lighter particle's friction
-                 * across a density ratio (the arithmetic mean would shake a gas particle next to
-                 * water with the water's friction, 500x its own at a ratio of 1000). */
-                const double mj = (double)ctx->mass[pb];
-                double g = nu * 2.0 * mi * mj / (mi * ndi + mj * (double)ctx->nd[j]) *
-                           (double)r2 * -(double)pfsph_kernel_dw_r(k, (pfsph_real)rr) /
-                           (double)(r2 + eps);
-                if (!(g > 0)) continue;
-                double s = sqrt(amp * ts[pa][pb] * g) * pfsph_thermo_theta(key, idi, f->id[j]) / rr;
+                double s = pfsph__thermo_fluid(amp * ts[pa][pb], nu, mi, (double)ctx->mass[pb], ndi,
+                                               (double)ctx->nd[j], (double)r2,
+                                               (double)pfsph_kernel_dw_r(k, (pfsph_real)rr), (double)eps, rr,
+                                               pfsph_thermo_theta(key, idi, f->id[j]));
                 fx += s * (double)dx;
                 fy += s * (double)dy;
                 fz += s * (double)dz;
@@ -67,14 +59,12 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
                     pfsph_real r2 = dx * dx + dy * dy + dz * dz;
                     if (r2 >= h2 || r2 <= 0) continue;
                     double rr = sqrt((double)r2);
-                    /* Akinci friction: m_i visc_c nu_w V_b r^2 |W'/r| / (r^2 + eps), nu_w the
-                     * wall's friction viscosity (viscosity.c: free slip 0, no slip nu_i or the
-                     * solid's own) */
+                    /* nu_w: the wall's friction viscosity (viscosity.c: free slip 0, no slip nu_i
+                     * or the solid's own) */
                     const double nuw = mixed ? (double)ctx->wall_scale[b->wall[j]] * nui + (double)ctx->wall_nu[b->wall[j]] : nui;
-                    double g = nuw * mi * (double)b->aux[j] * (double)r2 *
-                               -(double)pfsph_kernel_dw_r(k, (pfsph_real)rr) / (double)(r2 + eps);
-                    if (!(g > 0)) continue;
-                    double s = sqrt(amp * ts[pa][pa] * g) * pfsph_thermo_theta(wkey, idi, b->id[j]) / rr;
+                    double s = pfsph__thermo_wall(amp * ts[pa][pa], nuw, mi, (double)b->aux[j], (double)r2,
+                                                  (double)pfsph_kernel_dw_r(k, (pfsph_real)rr), (double)eps, rr,
+                                                  pfsph_thermo_theta(wkey, idi, b->id[j]));
                     fx += s * (double)dx;
                     fy += s * (double)dy;
                     fz += s * (double)dz;

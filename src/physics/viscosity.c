@@ -2,7 +2,12 @@
  * the fluid's or the solid's own viscosity, or free slip). */
 #include "physics/viscosity.h"
 
-void pfsph__nonpressure(const pfsph_ctx *ctx)
+#include "pfsph/thermostat.h"
+
+/* thermo: also the thermostat's random forces (thermostat.h), fused into this pass so that the
+ * neighbours within h are walked once; the same expressions as pfsph_thermostat_apply, so the
+ * same bits. Specialised at compile time (two call sites with a constant). */
+static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3], const int thermo)
 {
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
@@ -17,11 +22,25 @@ void pfsph__nonpressure(const pfsph_ctx *ctx)
     const int mixed = ctx->nwalls > 1;
     const uint8_t *wall = b->wall;
     const pfsph_real *wall_scale = ctx->wall_scale, *wall_nu = ctx->wall_nu, wall_nu_max = ctx->wall_nu_max;
+    double amp = 0, ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    uint64_t key = 0, wkey = 0;
+    if (thermo) {
+        amp = 2.0 * pfsph_thermostat_kT(ctx) / ctx->dt * (double)(2 * (ctx->dim + 2));
+        for (int a = 0; a < ctx->nphases; a++)
+            for (int c = 0; c < ctx->nphases; c++)
+                ts[a][c] = fmin(pfsph_thermostat_scale(ctx, a), pfsph_thermostat_scale(ctx, c));
+        key = pfsph_thermo_step_key(ctx->seed, ctx->step, 0);
+        wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
+    }
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
         const pfsph_real vxi = f->vx[i], vyi = f->vy[i], vzi = f->vz[i];
-        const pfsph_real nui = ctx->nu[f->phase[i]];
+        const int pa = f->phase[i];
+        const pfsph_real nui = ctx->nu[pa];
+        const double mi = (double)ctx->mass[pa], ndi = thermo ? (double)ctx->nd[i] : 0;
+        const uint32_t idi = f->id[i];
+        double fx = 0, fy = 0, fz = 0; /* thermostat */
         pfsph_real ax = 0, ay = 0, az = 0;
         pfsph_ranges r;
         pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
@@ -32,10 +51,25 @@ void pfsph__nonpressure(const pfsph_ctx *ctx)
                 if (r2 >= h2 || j == i) continue;
                 pfsph_real nu = (pfsph_real)0.5 * (nui + ctx->nu[f->phase[j]]);
                 pfsph_real vdx = (vxi - f->vx[j]) * dx + (vyi - f->vy[j]) * dy + (vzi - f->vz[j]) * dz;
-                pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                const pfsph_real rr = pfsph_sqrt(r2), dwr = pfsph_kernel_dw_r(k, rr);
+                pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
                 ax += s * dx;
                 ay += s * dy;
                 az += s * dz;
+                if (thermo) {
+                    const int pb = f->phase[j];
+                    const double nud = 0.5 * ((double)nui + (double)ctx->nu[pb]);
+                    if (nud > 0 && r2 > 0) {
+                        const double rd = sqrt((double)r2);
+                        const double t = pfsph__thermo_fluid(
+                            amp * ts[pa][pb], nud, mi, (double)ctx->mass[pb], ndi, (double)ctx->nd[j], (double)r2,
+                            (double)pfsph_kernel_dw_r(k, (pfsph_real)rd), (double)eps, rd,
+                            pfsph_thermo_theta(key, idi, f->id[j]));
+                        fx += t * (double)dx;
+                        fy += t * (double)dy;
+                        fz += t * (double)dz;
+                    }
+                }
             }
         /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
          * says otherwise (ctx wall tables: free slip, its own viscosity); static walls rest,
@@ -56,6 +90,17 @@ void pfsph__nonpressure(const pfsph_ctx *ctx)
                     bx += s * dx;
                     by += s * dy;
                     bz += s * dz;
+                    if (thermo && r2 > 0) {
+                        const double rd = sqrt((double)r2);
+                        const double nuw = mixed ? (double)wall_scale[wall[j]] * (double)nui + (double)wall_nu[wall[j]]
+                                                 : (double)nui;
+                        const double t = pfsph__thermo_wall(amp * ts[pa][pa], nuw, mi, (double)b->aux[j], (double)r2,
+                                                            (double)pfsph_kernel_dw_r(k, (pfsph_real)rd), (double)eps, rd,
+                                                            pfsph_thermo_theta(wkey, idi, b->id[j]));
+                        fx += t * (double)dx;
+                        fy += t * (double)dy;
+                        fz += t * (double)dz;
+                    }
                 }
             const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
             ax += nub * bx;
@@ -65,5 +110,22 @@ void pfsph__nonpressure(const pfsph_ctx *ctx)
         ctx->ax[i] = gx + visc_c * ax;
         ctx->ay[i] = gy + visc_c * ay;
         ctx->az[i] = gz + visc_c * az;
+        if (thermo) {
+            const pfsph_real nx = (pfsph_real)(fx / mi), ny = (pfsph_real)(fy / mi), nz = (pfsph_real)(fz / mi);
+            noise[0][i] = nx;
+            noise[1][i] = ny;
+            noise[2][i] = nz;
+            ctx->ax[i] += nx;
+            ctx->ay[i] += ny;
+            ctx->az[i] += nz;
+        }
     }
+}
+
+void pfsph__nonpressure(const pfsph_ctx *ctx) { nonpressure(ctx, NULL, 0); }
+
+void pfsph__nonpressure_thermo(const pfsph_ctx *ctx, pfsph_real *const noise[3])
+{
+    if (pfsph_thermostat_kT(ctx) > 0 && ctx->dt > 0) nonpressure(ctx, noise, 1);
+    else nonpressure(ctx, NULL, 0);
 }

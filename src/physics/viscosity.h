@@ -6,5 +6,8 @@
 
 /* ctx->ax.. = gravity + viscosity (fluid-fluid and fluid-boundary). */
 void pfsph__nonpressure(const pfsph_ctx *ctx);
+/* The same plus the thermostat's random forces (pfsph_thermostat_apply, same bits), stored
+ * alone in noise[0..2] as accelerations; without a temperature the plain pass. */
+void pfsph__nonpressure_thermo(const pfsph_ctx *ctx, pfsph_real *const noise[3]);
 
 #endif

@@ -1,7 +1,8 @@
 /* The thermostat of the pair-force liquid (issue 11, docs/thermostat.md).
  * - noise: theta_ij = theta_ji, zero mean and unit variance over 1e5 draws (3 sigma of the mean
  *   is 0.01); the thermostat forces on a random 2D cloud (no walls) sum to zero to float
- *   round-off (|sum F| <= 1e-6 sum |F|: each force is rounded to float once, 6e-8 relative).
+ *   round-off (|sum F| <= 1e-6 sum |F|: each force is rounded to float once, 6e-8 relative);
+ *   the step's fused viscosity + noise pass gives the reference function's forces bit for bit.
  * - temperature: a 2D drop at rest (disc of radius 8 d, no gravity), WCSPH: the kinetic
  *   temperature sum m |v - v_cm|^2 / (dim (N - 1)), averaged over 0.5-2 s every 0.01 s, is
  *   within 10 % of the set kT. PCISPH's pressure projection removes part of the longitudinal
@@ -23,6 +24,7 @@
 #include "pfsph/run.h"
 #include "pfsph/sim.h"
 #include "pfsph/thermostat.h"
+#include "physics/viscosity.h"
 #include "testutil.h"
 
 static pfsph_sim *make(const char *json)
@@ -108,7 +110,15 @@ static void test_noise(void **st)
     print_message("%zu particles: |sum m a| / sum |m a| = %.3g\n", n, hypot(P[0], P[1]) / A);
     assert_true(A > 0);
     assert_true(hypot(P[0], P[1]) <= 1e-6 * A);
-    for (int a = 0; a < 3; a++) free(nz[a]);
+    /* the step's fused pass (viscosity.c) draws the same forces, bit for bit */
+    pfsph_real *fz[3];
+    for (int a = 0; a < 3; a++) fz[a] = calloc(n, sizeof(pfsph_real));
+    pfsph__nonpressure_thermo(c, fz);
+    for (int a = 0; a < 3; a++) {
+        assert_memory_equal(nz[a], fz[a], n * sizeof(pfsph_real));
+        free(nz[a]);
+        free(fz[a]);
+    }
     pfsph_sim_destroy(sim);
 }
 
