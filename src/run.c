@@ -22,6 +22,7 @@
 #include "pfsph/checkpoint.h"
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
+#include "pfsph/thermostat.h"
 
 /* ---- the run directory: lock, what is pfsph's, temporaries, the run's own end ---- */
 
@@ -362,6 +363,8 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
         pfsph_sim_diffuse_counts(sim, cnt);
         fprintf(f, ",%zu,%zu,%zu", cnt[0], cnt[1], cnt[2]);
     }
+    if (pfsph_thermostat_kT(c) > 0) /* kinetic temperature of the fluid and the one set */
+        fprintf(f, ",%.6g,%.6g", pfsph_thermostat_measure(c->fluid, c->mass, c->dim), pfsph_thermostat_kT(c));
     fputc('\n', f);
     fflush(f);
 }
@@ -581,8 +584,9 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
 
     char header[256];
     snprintf(header, sizeof header,
-             "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s\n",
-             s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "");
+             "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s%s\n",
+             s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "",
+             pfsph_thermostat_kT(pfsph_sim_ctx(sim)) > 0 ? ",kT,kT_set" : "");
     snprintf(path, sizeof path, "%s/stats.csv", dir);
     long kept = -1;
     if (resume && (rc = truncate_csv(path, header, frame0, &kept, err))) {
