@@ -36,8 +36,47 @@ static const cli_case cases[] = {
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"time\":{\"end\":1e6,\"fps\":1e4}}",
      "$.time.end: end 1e+06 s at 10000 fps makes 1e+10 frames, more than the 100000000 one run holds"},
+    {"thermo_both.json", /* issue 11: the thermostat takes kT or a reduced temperature */
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"pairwise\":{\"thermostat\":{\"kT\":1e-6,"
+     "\"reduced_temperature\":0.01}}}",
+     "$.pairwise.thermostat.kT: give kT or reduced_temperature, not both"},
+    {"thermo_kind.json",
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"pairwise\":{\"thermostat\":\"hot\"}}",
+     "$.pairwise.thermostat: expected true, false or an object"},
+    {"thermo_neg.json",
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"pairwise\":{\"thermostat\":{\"kT\":-1}}}",
+     "$.pairwise.thermostat.kT: value -1 is out of range"},
 };
 #define NCASES (sizeof cases / sizeof cases[0])
+
+/* `pfsph check` states the thermostat's temperature and thermal speeds (issue 11): kT = 0.01
+ * sigma d^2 = 0.01 * 0.0728 * 0.02^2 = 2.912e-07 J for water of 1000 kg/m^3 at d = 2 cm, thermal
+ * speed sqrt(kT / (1000 d^3)) = 0.00603 m/s; switched off it says so. */
+static void test_check_thermostat(void **state)
+{
+    (void)state;
+    const char *fmt =
+        "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_radius\":0.01,"
+        "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],"
+        "\"pairwise\":{%s\"coefficients\":[{\"phases\":[\"water\",\"water\"],\"sigma\":0.0728}]}}";
+    char json[1024], path[512], cmd[2048], out[8192];
+    snprintf(json, sizeof json, fmt, "");
+    snprintf(path, sizeof path, "%s/thermo_on.json", tu_tmpdir());
+    assert_int_equal(tu_write_file(path, json), 0);
+    snprintf(cmd, sizeof cmd, "'%s' check '%s'", tu_pfsph_bin(), path);
+    int st = tu_run(cmd, out, sizeof out);
+    if (st != 0) fail_msg("exit %d: %s", st, out);
+    if (!strstr(out, "thermostat on: kT = 2.912e-07 J = 0.01 sigma d^2") ||
+        !strstr(out, "thermal speed sqrt(kT/m) = 0.00603 m/s"))
+        fail_msg("check output lacks the thermostat lines:\n%s", out);
+    snprintf(json, sizeof json, fmt, "\"thermostat\": false,");
+    assert_int_equal(tu_write_file(path, json), 0);
+    st = tu_run(cmd, out, sizeof out);
+    if (st != 0 || !strstr(out, "thermostat off")) fail_msg("exit %d: %s", st, out);
+}
 
 static void write_case(const cli_case *c, char *path, size_t cap)
 {
@@ -326,6 +365,7 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_check_bad),
+        cmocka_unit_test(test_check_thermostat),
         cmocka_unit_test(test_check_missing_file),
         cmocka_unit_test(test_run_bad_writes_nothing),
         cmocka_unit_test(test_run_end_overflow),
