@@ -630,6 +630,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     int frame = frame0, written = 0;
     if (!resume) {
         fputs(header, csv);
+        pfsph_sim_prime_output(sim);
         rc = write_frame(s, dir, 0, sim, err);
         if (!rc) written++;
         csv_row(csv, 0, sim);
