@@ -234,7 +234,8 @@ static int write_set(const pfsph_scene *s, const char *dir, const char *name, in
                        .write_id = (s->output.fields & PFSPH_OUT_ID) != 0,
                        .write_speed = (s->output.fields & PFSPH_OUT_SPEED) != 0,
                        .aux_name = aux,
-                       .time = time};
+                       .time = time,
+                       .diffuse = !strcmp(name, "diffuse")};
     int rc;
     if (s->output.vtp) {
         snprintf(path, sizeof path, "%s/frames/%s_%05d.vtp", dir, name, frame);

@@ -176,6 +176,9 @@ int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frame
     char path[PFSPH_PATH_LEN + 64], frames_dir[PFSPH_PATH_LEN + 16];
     *frames = 0;
     snprintf(path, sizeof path, "%s/scene.json", dir);
+    FILE *probe = fopen(path, "rb");
+    if (!probe) return pfsph_fail(err, PFSPH_EINPUT, "%s: not a run directory (no readable scene.json)", dir);
+    fclose(probe);
     pfsph_scene *s = malloc(sizeof *s);
     if (!s) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
     int rc = pfsph_scene_load(s, path, err);
