@@ -80,7 +80,8 @@ static int frame_file(const char *name, long *num)
         int digits = 0;
         while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
         if (!digits) return 0;
-        if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj")) {
+        if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj") ||
+            !strcmp(p, ".geo")) {
             *num = v;
             return 1;
         }

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "pfsph/bodies.h"
+#include "pfsph/houdini.h"
 #include "pfsph/meshing.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/render.h"
@@ -24,6 +25,7 @@ static const char *USAGE =
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH]\n"
     "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
+    "       pfsph export RUN_DIR --houdini\n"
     "       pfsph --version\n"
     "       pfsph help [COMMAND]    (or pfsph COMMAND --help)\n";
 
@@ -34,6 +36,7 @@ static const char *HELP =
     "  run      simulate a scene into a run directory (frames, stats.csv, summary.json)\n"
     "  check    validate a scene: particle counts, memory estimate, coefficients\n"
     "  render   PNG previews (and an mp4) of a run directory's frames\n"
+    "  export   Houdini geometry (.geo) of a run directory's fluid frames\n"
     "  mesh     liquid surface meshes (PLY, OBJ, VTP) of a 3D run directory's fluid frames\n"
     "  help     this text, or a command's: pfsph help run\n"
     "  --version  the version, precision and OpenMP thread count\n"
@@ -102,6 +105,16 @@ static const char *HELP_MESH =
     "  -h, --help      this text\n"
     "\n"
     "A 2D run is refused (exit status 2): meshes are 3D only.\n";
+
+static const char *HELP_EXPORT =
+    "usage: pfsph export RUN_DIR --houdini\n"
+    "\n"
+    "Write every fluid frame of RUN_DIR as Houdini ASCII geometry, RUN_DIR/frames/fluid_NNNNN.geo:\n"
+    "points with the attributes v, density, pressure, phase and id (id is 0 unless the run wrote\n"
+    "ids: output.fields [\"id\"]). docs/surfaces.md#houdini.\n"
+    "\n"
+    "  --houdini   the format (the only one so far)\n"
+    "  -h, --help  this text\n";
 
 static int is_help(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h"); }
 
@@ -521,6 +534,33 @@ static int cmd_render(int argc, char **argv)
     return 0;
 }
 
+static int cmd_export(int argc, char **argv)
+{
+    const char *dir = NULL;
+    bool houdini = false;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (is_help(a)) {
+            fputs(HELP_EXPORT, stdout);
+            return 0;
+        } else if (!strcmp(a, "--houdini")) houdini = true;
+        else if (a[0] == '-') return usage_error("unknown option '%s'", a);
+        else if (!dir) dir = a;
+        else return usage_error("unexpected argument '%s'", a);
+    }
+    if (!dir) return usage_error("%s", "export needs a run directory");
+    if (!houdini) return usage_error("%s", "export needs a format: --houdini");
+    pfsph_error err = {0};
+    int count = 0;
+    int rc = pfsph_export_houdini(dir, &count, &err);
+    if (rc) {
+        print_error(NULL, err.msg);
+        return exit_code(rc);
+    }
+    printf("exported %d frames into %s/frames/fluid_NNNNN.geo\n", count, dir);
+    return 0;
+}
+
 static int cmd_mesh(int argc, char **argv)
 {
     const char *dir = NULL;
@@ -592,6 +632,7 @@ int main(int argc, char **argv)
         else if (!strcmp(topic, "check")) fputs(HELP_CHECK, stdout);
         else if (!strcmp(topic, "render")) fputs(HELP_RENDER, stdout);
         else if (!strcmp(topic, "mesh")) fputs(HELP_MESH, stdout);
+        else if (!strcmp(topic, "export")) fputs(HELP_EXPORT, stdout);
         else return usage_error("help: unknown command '%s'", topic);
         return 0;
     }
@@ -599,5 +640,6 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "check")) return cmd_check(argc - 2, argv + 2);
     if (!strcmp(cmd, "render")) return cmd_render(argc - 2, argv + 2);
     if (!strcmp(cmd, "mesh")) return cmd_mesh(argc - 2, argv + 2);
+    if (!strcmp(cmd, "export")) return cmd_export(argc - 2, argv + 2);
     return usage_error("unknown command '%s'", cmd);
 }
