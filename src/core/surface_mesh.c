@@ -10,7 +10,7 @@
 #include "pfsph/eigen.h"
 
 #define BS 8             /* cells per block edge */
-#define BN (BS + 3)      /* nodes per block edge: -1 .. BS + 1 (ghosts for central differences) */
+#define BN (BS + 1)      /* nodes per block edge: 0 .. BS (the last layer is the next block's first) */
 #define BNODES (BN * BN * BN)
 #define COORD_BITS 20
 #define COORD_BIAS (1 << (COORD_BITS - 1))
@@ -387,7 +387,7 @@ static void unpack3(int64_t key, int b[3])
     b[2] = (int)(key & mask) - COORD_BIAS;
 }
 
-#define NIDX(a, b, c) ((((c) + 1) * BN + ((b) + 1)) * BN + ((a) + 1))
+#define NIDX(a, b, c) (((c) * BN + (b)) * BN + (a))
 
 /* node values of a block: block-local splat of candidate kernels in ascending index, so a node
  * shared with another block gets the same sum in the same order (the same bits) */
@@ -395,8 +395,8 @@ static void block_field(block *bl, const kern *K, const cells *cg, double rmax, 
 {
     double lo[3], hi[3];
     for (int u = 0; u < 3; u++) {
-        lo[u] = ((double)bl->b[u] * BS - 1) * cellw;
-        hi[u] = ((double)bl->b[u] * BS + BS + 1) * cellw;
+        lo[u] = ((double)bl->b[u] * BS) * cellw;
+        hi[u] = ((double)bl->b[u] * BS + BS) * cellw;
     }
     for (int i = 0; i < BNODES; i++) bl->f[i] = 0;
     long c0[3], c1[3];
@@ -439,17 +439,37 @@ static void block_field(block *bl, const kern *K, const cells *cg, double rmax, 
         for (int u = 0; u < 3; u++) {
             long g0 = (long)ceil((k->c[u] - k->rad) * inv), g1 = (long)floor((k->c[u] + k->rad) * inv);
             long base = (long)bl->b[u] * BS;
-            n0[u] = (int)(g0 - base < -1 ? -1 : g0 - base);
-            n1[u] = (int)(g1 - base > BS + 1 ? BS + 1 : g1 - base);
+            n0[u] = (int)(g0 - base < 0 ? 0 : g0 - base);
+            n1[u] = (int)(g1 - base > BS ? BS : g1 - base);
         }
+        /* along a row of nodes G r = t0 + A gx with A the global node index: each node's value is
+         * a function of its global index alone (the same bits in every block that holds it), and
+         * the row's range inside the ellipsoid comes from the quadratic |t0 + A gx|^2 < 1 */
+        const double gx[3] = {k->G[0] * cellw, k->G[3] * cellw, k->G[6] * cellw};
+        const double gxx = gx[0] * gx[0] + gx[1] * gx[1] + gx[2] * gx[2];
+        const long base0 = (long)bl->b[0] * BS;
         for (int c = n0[2]; c <= n1[2]; c++)
-            for (int b = n0[1]; b <= n1[1]; b++)
-                for (int a = n0[0]; a <= n1[0]; a++) {
-                    double p[3] = {((double)bl->b[0] * BS + a) * cellw, ((double)bl->b[1] * BS + b) * cellw,
-                                   ((double)bl->b[2] * BS + c) * cellw};
-                    double w = kern_eval(k, p);
-                    if (w != 0) bl->f[NIDX(a, b, c)] += vol * w;
+            for (int b = n0[1]; b <= n1[1]; b++) {
+                double ry = ((double)bl->b[1] * BS + b) * cellw - k->c[1];
+                double rz = ((double)bl->b[2] * BS + c) * cellw - k->c[2];
+                double t0[3];
+                for (int u = 0; u < 3; u++) t0[u] = k->G[3 * u] * -k->c[0] + k->G[3 * u + 1] * ry + k->G[3 * u + 2] * rz;
+                double tg = t0[0] * gx[0] + t0[1] * gx[1] + t0[2] * gx[2];
+                double tt = t0[0] * t0[0] + t0[1] * t0[1] + t0[2] * t0[2];
+                double disc = tg * tg - gxx * (tt - 1);
+                if (disc < 0) continue;
+                double sq = sqrt(disc);
+                long A0 = (long)floor((-tg - sq) / gxx) - 1, A1 = (long)ceil((-tg + sq) / gxx) + 1;
+                int a0 = A0 - base0 > n0[0] ? (int)(A0 - base0) : n0[0];
+                int a1 = A1 - base0 < n1[0] ? (int)(A1 - base0) : n1[0];
+                double *row = bl->f + NIDX(0, b, c);
+                for (int a = a0; a <= a1; a++) {
+                    double A = (double)(base0 + a);
+                    double x0 = t0[0] + A * gx[0], x1 = t0[1] + A * gx[1], x2 = t0[2] + A * gx[2];
+                    double q2 = x0 * x0 + x1 * x1 + x2 * x2;
+                    if (q2 < 1) row[a] += vol * k->det * cubic_unit(sqrt(q2));
                 }
+            }
     }
     free(cand);
 }
@@ -466,6 +486,7 @@ typedef struct vrec {
     int64_t key; /* edge: lower node packed << 3 | direction bits */
     double p[3];
     float n[3];
+    float pad; /* zero: records are compared bytewise */
 } vrec;
 
 typedef struct tribuf {
@@ -480,9 +501,14 @@ static const int KUHN[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0
 
 static void grad_at(const double *f, int a, int b, int c, double cellw, double g[3])
 {
-    g[0] = (f[NIDX(a + 1, b, c)] - f[NIDX(a - 1, b, c)]) / (2 * cellw);
-    g[1] = (f[NIDX(a, b + 1, c)] - f[NIDX(a, b - 1, c)]) / (2 * cellw);
-    g[2] = (f[NIDX(a, b, c + 1)] - f[NIDX(a, b, c - 1)]) / (2 * cellw);
+    /* central differences, one-sided on the block's faces */
+    int i[3] = {a, b, c};
+    for (int u = 0; u < 3; u++) {
+        int lo[3] = {a, b, c}, hi[3] = {a, b, c};
+        lo[u] = i[u] > 0 ? i[u] - 1 : 0;
+        hi[u] = i[u] < BS ? i[u] + 1 : BS;
+        g[u] = (f[NIDX(hi[0], hi[1], hi[2])] - f[NIDX(lo[0], lo[1], lo[2])]) / ((hi[u] - lo[u]) * cellw);
+    }
 }
 
 /* vertex on the edge between local nodes p and q (integer coordinates, p <= q componentwise) */
@@ -508,6 +534,7 @@ static int64_t edge_vertex(tribuf *tb, const block *bl, const int p[3], const in
     if (t > 1 - 1e-3) t = 1 - 1e-3;
     vrec *v = tb->v + tb->nv++;
     v->key = key;
+    v->pad = 0;
     v->p[0] = ((double)gx + t * (q[0] - p[0])) * cellw;
     v->p[1] = ((double)gy + t * (q[1] - p[1])) * cellw;
     v->p[2] = ((double)gz + t * (q[2] - p[2])) * cellw;
@@ -619,6 +646,14 @@ static int vrec_cmp(const void *a, const void *b)
     return x < y ? -1 : (x > y);
 }
 
+/* the order of the merge: by edge, then by the record's bytes (a vertex on a block face has a
+ * one-sided normal in each block; which one is kept must not depend on the sort) */
+static int vrec_cmp_full(const void *a, const void *b)
+{
+    int c = vrec_cmp(a, b);
+    return c ? c : memcmp(a, b, sizeof(vrec));
+}
+
 static int block_cmp(const void *a, const void *b)
 {
     int64_t x = ((const block *)a)->key, y = ((const block *)b)->key;
@@ -726,9 +761,8 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
     for (size_t i = 0; i < n; i++) {
         if (!surf[i]) continue;
         m->surface_particles++;
-        for (int s = 0; s < 27; s++) {
-            double p[3] = {K[i].c[0] + (s % 3 - 1) * 1.5 * d, K[i].c[1] + ((s / 3) % 3 - 1) * 1.5 * d,
-                           K[i].c[2] + (s / 9 - 1) * 1.5 * d};
+        {
+            const double *p = K[i].c; /* its block: growth finds the rest */
             long b[3];
             for (int u = 0; u < 3; u++) {
                 b[u] = cell_of(p[u], inv_bw);
@@ -840,7 +874,7 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
         memcpy(all + nvr, tbs[i].v, tbs[i].nv * sizeof *all);
         nvr += tbs[i].nv;
     }
-    qsort(all, nvr, sizeof *all, vrec_cmp);
+    qsort(all, nvr, sizeof *all, vrec_cmp_full);
     size_t uv = 0;
     for (size_t i = 0; i < nvr; i++)
         if (!uv || all[i].key != all[uv - 1].key) all[uv++] = all[i];
