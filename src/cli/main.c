@@ -23,7 +23,7 @@ static const char *USAGE =
     "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
-    "                            [--size WxH]\n"
+    "                            [--size WxH] [--particles]\n"
     "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
     "       pfsph export RUN_DIR --houdini\n"
     "       pfsph --version\n"
@@ -86,6 +86,8 @@ static const char *HELP_RENDER =
     "camera (RUN_DIR/scene.json).\n"
     "\n"
     "  --video                 also RUN_DIR/frames.mp4 (needs ffmpeg on the PATH)\n"
+    "  --particles             fluid particles even where liquid meshes exist (frames/liquid_*.ply,\n"
+    "                          `pfsph mesh`), which are otherwise drawn as a water surface\n"
     "  --color-by FIELD        phase, speed, density or pressure (default: the scene camera's)\n"
     "  --size WxH              image size in pixels, 16..16384 each (default: the camera's)\n"
     "  -h, --help              this text\n";
@@ -511,6 +513,7 @@ static int cmd_render(int argc, char **argv)
             fputs(HELP_RENDER, stdout);
             return 0;
         } else if (!strcmp(a, "--video")) o.video = true;
+        else if (!strcmp(a, "--particles")) o.particles = true;
         else if (!strcmp(a, "--color-by")) {
             if (++i >= argc) return usage_error("%s needs a field", a);
             o.color_by = argv[i];
