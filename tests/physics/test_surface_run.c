@@ -2,6 +2,7 @@
  * the same bytes afterwards with another thread count, the meshes are closed, the .pvd
  * collections list every frame, frame 0 carries densities, 2D and bad keys are refused with the
  * JSON path, diffuse frames name their class "type" and carry no density or pressure. */
+#include <png.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -205,6 +206,46 @@ static void test_houdini_roundtrip(void **state)
     pfsph_particles_free(&ps);
 }
 
+/* pixels of the water shading (blue, dark red channel): none in the viridis or grey palettes */
+static long water_pixels(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png_create_info_struct(png);
+    if (setjmp(png_jmpbuf(png))) fail_msg("libpng failed on %s", path);
+    png_init_io(png, f);
+    png_read_info(png, info);
+    assert_int_equal(png_get_color_type(png, info), PNG_COLOR_TYPE_RGB);
+    int w = (int)png_get_image_width(png, info), h = (int)png_get_image_height(png, info);
+    unsigned char *row = malloc((size_t)w * 3);
+    long n = 0;
+    for (int y = 0; y < h; y++) {
+        png_read_row(png, row, NULL);
+        for (int x = 0; x < w; x++) n += row[3 * x] < 80 && row[3 * x + 2] > 150;
+    }
+    free(row);
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    return n;
+}
+
+/* pfsph render draws the liquid meshes as a water surface, and the particles with --particles */
+static void test_render_meshes(void **state)
+{
+    (void)state;
+    char out[8192], path[1400], run[1200];
+    snprintf(run, sizeof run, "%s/run3", tu_tmpdir());
+    snprintf(path, sizeof path, "%s/png/frame_00002.png", run);
+    assert_int_equal(pf(out, sizeof out, "render '%s' --size 240x135 --color-by speed", run), 0);
+    long mesh = water_pixels(path);
+    assert_int_equal(pf(out, sizeof out, "render '%s' --size 240x135 --color-by speed --particles", run), 0);
+    long parts = water_pixels(path);
+    printf("water-coloured pixels: %ld with meshes, %ld with particles\n", mesh, parts);
+    assert_true(mesh > 200);
+    assert_int_equal(parts, 0);
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
@@ -264,6 +305,7 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_run_and_mesh),
+        cmocka_unit_test(test_render_meshes),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_diffuse_type),
         cmocka_unit_test(test_houdini_roundtrip),
