@@ -2,6 +2,7 @@
  * run's .pvd collections as time series with the point arrays; Blender (background mode) runs the
  * loader on a small run (object count, frame range, the mesh face counts of the PLY files) and the
  * render script writes a PNG. Each test is skipped when its program is not installed. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,7 +19,21 @@ static const char *SCENE =
     "             \"phase\": \"wall\"}],\n"
     " \"output\": {\"formats\": [\"vtp\", \"ply\"], \"surface\": %s}}\n";
 
-static char g_run[1200], g_points[1200];
+static char g_run[1200], g_points[1200], g_bodies[1200];
+
+/* a ball (r 5 cm, 600 kg/m^3) dropped beside the water column, meshes on */
+static const char *SCENE_BODIES =
+    "{\"dimension\": 3, \"particle_radius\": 0.01, \"gravity\": [0, -9.81, 0],\n"
+    " \"domain\": {\"min\": [-0.1, -0.1, -0.1], \"max\": [0.7, 0.6, 0.3]},\n"
+    " \"solver\": {\"type\": \"dfsph\"}, \"time\": {\"end\": 0.1, \"fps\": 20},\n"
+    " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"},\n"
+    "            {\"name\": \"wood\", \"kind\": \"solid\", \"rest_density\": 600}],\n"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [0.2, 0.3, 0.2], \"phase\": \"water\"}],\n"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0, 0], \"max\": [0.6, 0.5, 0.2], \"open_top\": true,\n"
+    "             \"phase\": \"wall\"}],\n"
+    " \"bodies\": [{\"name\": \"ball\", \"shape\": \"sphere\", \"radius\": 0.05, \"position\": [0.4, 0.1, 0.1],\n"
+    "             \"density\": 600, \"phase\": \"wood\"}],\n"
+    " \"output\": {\"formats\": [\"vtp\", \"ply\"], \"surface\": true}}\n";
 
 static int have(const char *prog)
 {
@@ -32,7 +47,8 @@ static int make_run(char *dir, size_t cap, const char *name, const char *surface
     char scene[1400], text[2048], cmd[4096], out[4096];
     snprintf(scene, sizeof scene, "%s/%s.json", tu_tmpdir(), name);
     snprintf(dir, cap, "%s/%s", tu_tmpdir(), name);
-    snprintf(text, sizeof text, SCENE, surface);
+    if (surface) snprintf(text, sizeof text, SCENE, surface);
+    else snprintf(text, sizeof text, "%s", SCENE_BODIES);
     if (tu_write_file(scene, text)) return -1;
     snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet", tu_pfsph_bin(), scene, dir);
     return tu_run(cmd, out, sizeof out);
@@ -42,6 +58,7 @@ static int setup(void **state)
 {
     (void)state;
     if (make_run(g_run, sizeof g_run, "meshed", "true")) return -1;
+    if (make_run(g_bodies, sizeof g_bodies, "bodies", NULL)) return -1;
     return make_run(g_points, sizeof g_points, "points", "false");
 }
 
@@ -119,6 +136,24 @@ static void test_blender_load(void **state)
     printf("points: %.400s\n", j);
     assert_non_null(strstr(j, "\"fluid points\": 6"));
     assert_non_null(strstr(j, "\"objects\": 7"));
+    /* a rigid body: its own object, keyed every frame, falling (Blender's z is pfsph's y) */
+    snprintf(cmd, sizeof cmd, "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_load.py' -- '%s'",
+             tu_source_dir(), g_bodies);
+    assert_int_equal(tu_run(cmd, out, sizeof out), 0);
+    j = json_after(out, "pfsph_load: ");
+    assert_non_null(j);
+    printf("bodies: %.600s\n", j);
+    assert_non_null(strstr(j, "\"objects\": 4"));
+    const char *b = strstr(j, "\"body ball\": {");
+    assert_non_null(b);
+    double zf = 0, zl = 0;
+    int faces = 0, keys = 0;
+    assert_int_equal(sscanf(b, "\"body ball\": {\"faces\": %d, \"keys\": %d, \"z_first\": %lf, \"z_last\": %lf",
+                            &faces, &keys, &zf, &zl), 4);
+    assert_int_equal(keys, 3);
+    assert_true(faces > 100);
+    assert_true(fabs(zf - 0.1) < 1e-6);
+    assert_true(zl < zf - 0.005);
 }
 
 static void test_blender_render(void **state)

@@ -247,6 +247,13 @@ def load_run(run_dir, max_frames=None):
                 ob.keyframe_insert("location", frame=fr // interval)
                 ob.keyframe_insert("rotation_quaternion", frame=fr // interval)
         report["sets"]["bodies"] = len(objs)
+        report["bodies"] = {}
+        for i, ob in objs.items():
+            fc = [f for f in ob.animation_data.action.fcurves if f.data_path == "location" and f.array_index == 2]
+            keys = [(k.co[0], k.co[1]) for k in fc[0].keyframe_points] if fc else []
+            report["bodies"][ob.name] = {"keys": len(keys), "faces": len(ob.data.polygons),
+                                         "z_first": round(keys[0][1], 6) if keys else None,
+                                         "z_last": round(keys[-1][1], 6) if keys else None}
 
     report["objects"] = len(root.all_objects)
     report["frame_start"], report["frame_end"] = first, last
