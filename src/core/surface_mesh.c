@@ -934,8 +934,13 @@ int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n, c
         return pfsph_fail(err, PFSPH_EINPUT, "surface: options out of range (lambda %g, kr %g, cell %g d, "
                           "support %g d, neighbourhood %g d, %d smoothing passes)", o.lambda, o.kr, o.cell,
                           o.support, o.pca_radius, o.smooth_iters);
-    for (size_t i = 0; i < 3 * n; i++)
+    const double reach = (double)(1 << 18) * o.cell * o.spacing; /* the grid's integer coordinates */
+    for (size_t i = 0; i < 3 * n; i++) {
         if (!isfinite(x[i])) return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu has a non-finite position", i / 3);
+        if (fabs(x[i]) > reach)
+            return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu is %g m from the origin, beyond the meshing "
+                              "grid's %g m (2^18 cells)", i / 3, fabs(x[i]), reach);
+    }
     double iso = o.iso > 0 ? o.iso : pfsph_surface_calibrate_iso(&o);
     int present[256] = {0};
     for (size_t i = 0; i < n; i++) present[phase ? phase[i] : 0]++;

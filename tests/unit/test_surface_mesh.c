@@ -225,8 +225,13 @@ static void test_threads(void **state)
     assert_int_equal(check_manifold(&a), 4);
     /* bad input: a non-positive spacing is refused with a message */
     o.spacing = 0;
+    pfsph_surface_mesh_free(&b);
     assert_int_equal(pfsph_surface_reconstruct(x, ph, n, &o, &b, &err), PFSPH_EINPUT);
     assert_non_null(strstr(err.msg, "spacing"));
+    o.spacing = D;
+    x[3 * 5 + 1] = 1e30;
+    assert_int_equal(pfsph_surface_reconstruct(x, ph, n, &o, &b, &err), PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "particle 5"));
     pfsph_surface_mesh_free(&a);
     pfsph_surface_mesh_free(&b);
     free(ph);
