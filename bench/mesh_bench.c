@@ -74,6 +74,8 @@ int main(int argc, char **argv)
     printf("  mesh %zu vertices, %zu faces; %zu surface particles; grid %zu blocks kept, %zu at peak, %.1f MB "
            "(%.0f B per surface particle)\n", m.nverts, m.ntris, m.surface_particles, m.blocks, m.blocks_peak,
            m.grid_bytes / 1e6, (double)m.grid_bytes / (double)(m.surface_particles ? m.surface_particles : 1));
+    printf("  last run: kernels (PCA, smoothing) %.3f s, field and grid growth %.3f s, marching %.3f s, "
+           "merge %.3f s\n", m.seconds[0], m.seconds[1], m.seconds[2], m.seconds[3]);
     pfsph_surface_mesh_free(&m);
     free(t);
     free(x);

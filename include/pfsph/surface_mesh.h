@@ -38,6 +38,7 @@ typedef struct pfsph_surface_mesh {
     size_t blocks_peak;  /* blocks allocated at most at once */
     size_t grid_bytes;   /* peak bytes of the sparse grid's node values */
     size_t surface_particles; /* particles classified as near the surface */
+    double seconds[4];        /* wall time: kernels (PCA), field (grid growth), marching, merge */
 } pfsph_surface_mesh;
 
 void pfsph_surface_opts_default(pfsph_surface_opts *o, double spacing);

@@ -4,6 +4,7 @@
  * six tetrahedra (Kuhn), vertices welded by edge id. docs/surfaces.md gives the choices. */
 #include "pfsph/surface_mesh.h"
 
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -199,36 +200,34 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
         long ci = cell_of(xi[0], g.inv), cj = cell_of(xi[1], g.inv), ck = cell_of(xi[2], g.inv);
         double sw = 0, m[3] = {0, 0, 0};
         int cnt = 0;
-        for (int pass = 0; pass < 2; pass++) {
-            double C[3][3] = {{0}};
-            for (long a = ci - 1; a <= ci + 1; a++)
-                for (long b = cj - 1; b <= cj + 1; b++)
-                    for (long c = ck - 1; c <= ck + 1; c++) {
-                        uint32_t lo, hi;
-                        cells_range(&g, a, b, c, &lo, &hi);
-                        for (uint32_t q = lo; q < hi; q++) {
-                            const double *xj = x + 3 * g.idx[q];
-                            double dx = xj[0] - xi[0], dy = xj[1] - xi[1], dz = xj[2] - xi[2];
-                            double s2 = dx * dx + dy * dy + dz * dz;
-                            if (s2 >= r * r) continue;
-                            double s = sqrt(s2) / r, w = 1 - s * s * s;
-                            if (pass == 0) {
-                                sw += w;
-                                m[0] += w * xj[0];
-                                m[1] += w * xj[1];
-                                m[2] += w * xj[2];
-                                cnt++;
-                            } else {
-                                double e[3] = {xj[0] - m[0], xj[1] - m[1], xj[2] - m[2]};
-                                for (int u = 0; u < 3; u++)
-                                    for (int v = u; v < 3; v++) C[u][v] += w * e[u] * e[v];
-                            }
+        /* one pass: weighted sums of offsets e = x_j - x_i and of e e^T; the covariance about
+         * the weighted mean is S2 / sw - mu mu^T (offsets keep it well conditioned) */
+        double C[3][3] = {{0}}, mu[3] = {0, 0, 0};
+        for (long a = ci - 1; a <= ci + 1; a++)
+            for (long b = cj - 1; b <= cj + 1; b++)
+                for (long c = ck - 1; c <= ck + 1; c++) {
+                    uint32_t lo, hi;
+                    cells_range(&g, a, b, c, &lo, &hi);
+                    for (uint32_t q = lo; q < hi; q++) {
+                        const double *xj = x + 3 * g.idx[q];
+                        double e[3] = {xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]};
+                        double s2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+                        if (s2 >= r * r) continue;
+                        double sr = sqrt(s2) / r, w = 1 - sr * sr * sr;
+                        sw += w;
+                        for (int u = 0; u < 3; u++) {
+                            mu[u] += w * e[u];
+                            for (int v = u; v < 3; v++) C[u][v] += w * e[u] * e[v];
                         }
+                        cnt++;
                     }
-            if (pass == 0) {
-                for (int u = 0; u < 3; u++) m[u] /= sw;
-                continue;
-            }
+                }
+        for (int u = 0; u < 3; u++) mu[u] /= sw;
+        for (int u = 0; u < 3; u++) {
+            m[u] = xi[u] + mu[u];
+            for (int v = u; v < 3; v++) C[u][v] = C[u][v] / sw - mu[u] * mu[v];
+        }
+        {
             kern *k = K + i;
             for (int u = 0; u < 3; u++) k->c[u] = (1 - o->lambda) * xi[u] + o->lambda * m[u];
             double off = sqrt((m[0] - xi[0]) * (m[0] - xi[0]) + (m[1] - xi[1]) * (m[1] - xi[1]) +
@@ -237,8 +236,6 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
             int flat = 0;
             if (o->isotropic) scale[0] = scale[1] = scale[2] = 1;
             else if (cnt >= n_eps) {
-                for (int u = 0; u < 3; u++)
-                    for (int v = u; v < 3; v++) C[u][v] /= sw;
                 double w[3];
                 pfsph_eigen_sym3((const double(*)[3])C, w, V);
                 for (int u = 0; u < 3; u++) {
@@ -595,6 +592,8 @@ static void emit(tribuf *tb, const block *bl, int e[3][2][3], const int in[3], i
     }
 }
 
+static int vrec_cmp_full(const void *a, const void *b);
+
 static void march_block(tribuf *tb, const block *bl, double iso, double cellw)
 {
     for (int c = 0; c < BS; c++)
@@ -638,6 +637,13 @@ static void march_block(tribuf *tb, const block *bl, double iso, double cellw)
                     }
                 }
             }
+    /* a vertex appears once per tetrahedron edge use: keep one per edge (within a block every
+     * copy is the same record), so that the serial merge sorts few */
+    qsort(tb->v, tb->nv, sizeof *tb->v, vrec_cmp_full);
+    size_t u = 0;
+    for (size_t i = 0; i < tb->nv; i++)
+        if (!u || tb->v[i].key != tb->v[u - 1].key) tb->v[u++] = tb->v[i];
+    tb->nv = u;
 }
 
 static int vrec_cmp(const void *a, const void *b)
@@ -744,8 +750,10 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
     vrec *all = NULL;
     int rc = PFSPH_ENOMEM;
     if (!K || !surf) goto out;
-    double rmax;
+    double rmax, w0 = omp_get_wtime();
     if ((rc = kernels_build(x, n, o, K, surf, &rmax))) goto out;
+    double w1 = omp_get_wtime();
+    m->seconds[0] += w1 - w0;
     rc = PFSPH_ENOMEM;
     double *cen = malloc(3 * (n ? n : 1) * sizeof *cen);
     if (!cen) goto out;
@@ -857,10 +865,14 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
     m->blocks += kept;
     if (peak > m->blocks_peak) m->blocks_peak = peak;
     if (peak * BNODES * sizeof(double) > m->grid_bytes) m->grid_bytes = peak * BNODES * sizeof(double);
+    double w2 = omp_get_wtime();
+    m->seconds[1] += w2 - w1;
     tbs = calloc(kept ? kept : 1, sizeof *tbs);
     if (!tbs) goto out;
 #pragma omp parallel for schedule(dynamic, 1)
     for (size_t i = 0; i < kept; i++) march_block(tbs + i, bl + i, iso, cellw);
+    double w3 = omp_get_wtime();
+    m->seconds[2] += w3 - w2;
     size_t nvr = 0, ntr = 0;
     for (size_t i = 0; i < kept; i++) {
         if (tbs[i].fail) goto out;
@@ -888,9 +900,14 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
         memcpy(m->v + 3 * (v0 + i), all[i].p, sizeof all[i].p);
         memcpy(m->n + 3 * (v0 + i), all[i].n, sizeof all[i].n);
     }
-    size_t t = t0;
+    size_t *tstart = malloc((kept + 1) * sizeof *tstart);
+    if (!tstart) goto out;
+    tstart[0] = t0;
+    for (size_t i = 0; i < kept; i++) tstart[i + 1] = tstart[i] + tbs[i].nt;
+#pragma omp parallel for schedule(dynamic, 4)
     for (size_t i = 0; i < kept; i++)
-        for (size_t k = 0; k < tbs[i].nt; k++, t++) {
+        for (size_t k = 0; k < tbs[i].nt; k++) {
+            size_t t = tstart[i] + k;
             for (int c = 0; c < 3; c++) {
                 vrec key = {.key = tbs[i].t[3 * k + c]};
                 const vrec *f = bsearch(&key, all, uv, sizeof *all, vrec_cmp);
@@ -898,9 +915,12 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
             }
             m->phase[t] = phase;
         }
+    size_t t = tstart[kept];
+    free(tstart);
     m->nverts = v0 + uv;
     m->ntris = t;
     rc = taubin(m, v0, t0, o->smooth_iters);
+    m->seconds[3] += omp_get_wtime() - w3;
 out:
     if (rc == PFSPH_ENOMEM && !err->msg[0]) pfsph_fail(err, PFSPH_ENOMEM, "surface: out of memory");
     if (tbs)
