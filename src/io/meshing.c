@@ -225,33 +225,74 @@ int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frame
     return rc;
 }
 
+static int long_cmp(const void *a, const void *b)
+{
+    long x = *(const long *)a, y = *(const long *)b;
+    return x < y ? -1 : (x > y);
+}
+
 int pfsph_write_pvd_collections(const char *dir, double frame_dt, pfsph_error *err)
 {
-    static const char *const sets[] = {"fluid", "boundary", "diffuse", "bodies", "surfaces", "liquid", NULL};
+    enum { NSETS = 6 };
+    static const char *const sets[NSETS] = {"fluid", "boundary", "diffuse", "bodies", "surfaces", "liquid"};
     char frames_dir[PFSPH_PATH_LEN + 16], path[PFSPH_PATH_LEN + 64];
     snprintf(frames_dir, sizeof frames_dir, "%s/frames", dir);
-    for (int s = 0; sets[s]; s++) {
-        long last = last_frame(frames_dir, sets[s], "vtp");
-        if (last < 0) continue;
-        size_t cap = 256 + (size_t)(last + 1) * 96, len = 0;
-        char *buf = malloc(cap);
-        if (!buf) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-        len += (size_t)snprintf(buf + len, cap - len, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
-                                "version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
-        for (long k = 0; k <= last; k++) {
-            snprintf(path, sizeof path, "%s/%s_%05ld.vtp", frames_dir, sets[s], k);
-            FILE *f = fopen(path, "rb");
-            if (!f) continue;
-            fclose(f);
-            len += (size_t)snprintf(buf + len, cap - len,
-                                    "<DataSet timestep=\"%.9g\" group=\"\" part=\"0\" file=\"frames/%s_%05ld.vtp\"/>\n",
-                                    k * frame_dt, sets[s], k);
+    long *num[NSETS] = {NULL};
+    size_t n[NSETS] = {0}, cap[NSETS] = {0};
+    int rc = PFSPH_OK;
+    /* one pass over the directory: the frame numbers of "<set>_NNNNN.vtp" */
+    DIR *d = opendir(frames_dir);
+    if (!d) return PFSPH_OK;
+    for (struct dirent *de; (de = readdir(d)) && !rc;) {
+        const char *nm = de->d_name;
+        size_t len = strlen(nm);
+        if (len < 11 || strcmp(nm + len - 4, ".vtp")) continue;
+        for (int k = 0; k < NSETS; k++) {
+            size_t ls = strlen(sets[k]);
+            if (len != ls + 10 || strncmp(nm, sets[k], ls) || nm[ls] != '_') continue;
+            long v = 0;
+            int ok = 1;
+            for (int i = 0; i < 5; i++) {
+                char c = nm[ls + 1 + i];
+                if (c < '0' || c > '9') ok = 0;
+                v = 10 * v + (c - '0');
+            }
+            if (!ok) continue;
+            if (n[k] == cap[k]) {
+                size_t nc = cap[k] ? 2 * cap[k] : 64;
+                long *t = realloc(num[k], nc * sizeof *t);
+                if (!t) {
+                    rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+                    break;
+                }
+                num[k] = t;
+                cap[k] = nc;
+            }
+            num[k][n[k]++] = v;
         }
-        len += (size_t)snprintf(buf + len, cap - len, "</Collection>\n</VTKFile>\n");
-        snprintf(path, sizeof path, "%s/%s.pvd", dir, sets[s]);
-        int rc = pfsph_write_file_atomic(path, buf, len, err);
-        free(buf);
-        if (rc) return rc;
     }
-    return PFSPH_OK;
+    closedir(d);
+    for (int k = 0; k < NSETS && !rc; k++) {
+        if (!n[k]) continue;
+        qsort(num[k], n[k], sizeof *num[k], long_cmp);
+        const size_t line = 160; /* one DataSet line is at most about 100 characters */
+        size_t bcap = 256 + n[k] * line, len = 0;
+        char *buf = malloc(bcap);
+        if (!buf) {
+            rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+            break;
+        }
+        len += (size_t)snprintf(buf + len, bcap - len, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
+                                "version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
+        for (size_t i = 0; i < n[k]; i++)
+            len += (size_t)snprintf(buf + len, line,
+                                    "<DataSet timestep=\"%.9g\" group=\"\" part=\"0\" file=\"frames/%s_%05ld.vtp\"/>\n",
+                                    (double)num[k][i] * frame_dt, sets[k], num[k][i]);
+        len += (size_t)snprintf(buf + len, bcap - len, "</Collection>\n</VTKFile>\n");
+        snprintf(path, sizeof path, "%s/%s.pvd", dir, sets[k]);
+        rc = pfsph_write_file_atomic(path, buf, len, err);
+        free(buf);
+    }
+    for (int k = 0; k < NSETS; k++) free(num[k]);
+    return rc;
 }
