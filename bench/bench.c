@@ -19,13 +19,15 @@ static void usage(void)
 {
     fprintf(stderr,
             "usage: bench [--particles N] [--steps N] [--warmup N] [--solver wcsph|pcisph]\n"
-            "             [--pairwise] [--threads N] [--diffuse N] [--diffuse-emit-all]\n"
+            "             [--pairwise [--no-thermostat]] [--threads N] [--diffuse N] [--diffuse-emit-all]\n"
             "Runs a 3D dam break of about N fluid particles (default 50000) for --steps steps\n"
             "(default 20) after --warmup steps (default 3) and prints throughput figures.\n"
             "--diffuse N turns diffuse material on (the limits of scenes/diffuse_dam_*.json)\n"
             "and seeds N diffuse particles in and around the water block before the warm-up;\n"
             "--diffuse-emit-all sets phi_e_min = 0 so every moving fluid particle evaluates the\n"
-            "velocity difference of Eqs. 10-13 (worst case of the generation stage).\n");
+            "velocity difference of Eqs. 10-13 (worst case of the generation stage).\n"
+            "--wall-viscosity NU gives the container its own wall viscosity [m^2/s] (the\n"
+            "friction loop then reads the per-solid wall table; 1e-3 is the fluid's own).\n");
 }
 
 /* Mean number of neighbours j != i within h of each fluid particle: fluid ones through the
@@ -119,8 +121,9 @@ static int seed_diffuse(pfsph_sim *sim, long n, double top, pfsph_error *err)
 int main(int argc, char **argv)
 {
     long target = 50000, steps = 20, warmup = 3;
-    int pcisph = 0, pairwise = 0, threads = 0, emit_all = 0;
+    int pcisph = 0, pairwise = 0, threads = 0, emit_all = 0, no_thermo = 0;
     long ndiffuse = -1;
+    double wall_nu = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -134,8 +137,10 @@ int main(int argc, char **argv)
             else { usage(); return 2; }
             i++;
         } else if (!strcmp(a, "--pairwise")) pairwise = 1;
+        else if (!strcmp(a, "--no-thermostat")) no_thermo = 1;
         else if (!strcmp(a, "--diffuse") && v) { ndiffuse = atol(v); i++; }
         else if (!strcmp(a, "--diffuse-emit-all")) emit_all = 1;
+        else if (!strcmp(a, "--wall-viscosity") && v) { wall_nu = atof(v); i++; }
         else { usage(); return !strcmp(a, "--help") || !strcmp(a, "-h") ? 0 : 2; }
     }
     if (target < 100 || steps < 1 || warmup < 0 || threads < 0 || (emit_all && ndiffuse < 0) ||
@@ -161,8 +166,8 @@ int main(int argc, char **argv)
     char pair[256] = "";
     if (pairwise)
         snprintf(pair, sizeof pair,
-                 ",\n\"pairwise\": {\"coefficients\": [{\"phases\": [\"water\", \"water\"], "
-                 "\"c\": 1000}]}");
+                 ",\n\"pairwise\": {%s\"coefficients\": [{\"phases\": [\"water\", \"water\"], "
+                 "\"c\": 1000}]}", no_thermo ? "\"thermostat\": false, " : "");
     /* Diffuse block: the limits of scenes/diffuse_dam_*.json; the cap leaves room above the
      * seeded count so that generation runs (it is skipped at the cap). */
     char dif[1024] = "";
@@ -173,6 +178,8 @@ int main(int argc, char **argv)
                  "\"energy_mass\": 1, \"emit_radius_scale\": 2, \"lifetime_min\": 0.5, "
                  "\"lifetime_max\": 2.5}",
                  2 * ndiffuse + 100000, emit_all ? 0.0 : 0.5);
+    char wallkey[64] = "";
+    if (wall_nu >= 0) snprintf(wallkey, sizeof wallkey, ", \"viscosity\": %.9g", wall_nu);
     char json[8192];
     snprintf(json, sizeof json,
              "{\"name\": \"bench\", \"dimension\": 3, \"particle_radius\": %.9g,\n"
@@ -187,11 +194,11 @@ int main(int argc, char **argv)
              "\"phase\": \"water\"}],\n"
              "\"solids\": [{\"shape\": \"container\", \"min\": [0, 0, 0], "
              "\"max\": [%.9g, %.9g, %.9g], \"open_top\": true, \"layers\": 2, "
-             "\"phase\": \"wall\"}],\n"
+             "\"phase\": \"wall\"%s}],\n"
              "\"output\": {\"directory\": \"bench_run\", \"formats\": [], \"boundary\": false}"
              "%s%s}\n",
              r, threads, -m, -m, -m, tx + m, ty + m, tz + m, pcisph ? "pcisph" : "wcsph", bx,
-             by, bz, tx, ty, tz, pair, dif);
+             by, bz, tx, ty, tz, wallkey, pair, dif);
 
     static pfsph_scene scene;
     pfsph_error err = {0};

@@ -338,7 +338,21 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
 {
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     double t = pfsph_sim_time(sim);
-    int rc = write_set(s, dir, "fluid", frame, c->fluid, NULL, t, err);
+    int rc;
+    if (s->pairwise.enabled) {
+        /* the pair-force liquid's pressure is the solver's plus the virial (Laplace's law holds
+         * for that one): written as the fluid's extra field */
+        pfsph_particles fl = *c->fluid;
+        fl.aux = malloc((fl.n ? fl.n : 1) * sizeof(pfsph_real));
+        if (!fl.aux || pfsph_sim_mechanical_pressure(sim, fl.aux)) {
+            free(fl.aux);
+            return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the mechanical pressure of frame %d", frame);
+        }
+        rc = write_set(s, dir, "fluid", frame, &fl, "mechanical_pressure", t, err);
+        free(fl.aux);
+    } else {
+        rc = write_set(s, dir, "fluid", frame, c->fluid, NULL, t, err);
+    }
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     if (!rc && frame == 0 && c->boundary->n && s->output.write_boundary) {
         if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);

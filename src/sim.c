@@ -15,6 +15,7 @@
 #include "pfsph/bodies.h"
 #include "pfsph/diffuse.h"
 #include "pfsph/pairwise.h"
+#include "pfsph/thermostat.h"
 #include "physics/boundary.h"
 #include "physics/density.h"
 #include "physics/eos.h"
@@ -27,7 +28,7 @@ const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
 
 /* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
-#define SCR_MAX (SCR_COMMON + 10)
+#define SCR_MAX (SCR_COMMON + 13) /* + the solver's (at most 10) + the thermostat's 3 */
 
 /* What a stage that found a blow-up reports; the step turns it into the one message format. */
 typedef struct blowup_info {
@@ -50,6 +51,7 @@ struct pfsph_sim {
     pfsph_grid grid, bgrid;
     pfsph_real *scr[SCR_MAX]; /* per-step scratch: SCR_COMMON of ours, then the solver's */
     int nscr;
+    int scr_noise;            /* first of the thermostat's 3 arrays (its accelerations), or -1 */
     size_t scr_cap;           /* entries in each scratch array */
     const pfsph_solver_ops *solver;
     void *solver_state;
@@ -99,7 +101,34 @@ static pfsph_real grid_cell(const pfsph_scene *s, pfsph_real h, int *reach, int 
     return cell;
 }
 
-static int build_particles(const pfsph_scene *s, double d, pfsph_particles *fluid,
+/* The wall models of the solids (ctx.h): model 0 is the default (no slip, the fluid's
+ * viscosity; bodies too), a solid that says otherwise gets the model of its setting, shared
+ * with the solids that say the same. */
+static void wall_models(pfsph_ctx *c, const pfsph_scene *s, uint8_t *of_solid)
+{
+    _Static_assert(PFSPH_MAX_SOLIDS + 1 <= PFSPH_MAX_WALLS, "a wall model per solid");
+    c->nwalls = 1;
+    c->wall_scale[0] = 1;
+    c->wall_nu[0] = 0;
+    c->wall_nu_max = 0;
+    for (int i = 0; i < s->nsolids; i++) {
+        const pfsph_solid *o = &s->solids[i];
+        pfsph_real a = 1, b = 0;
+        if (o->slip == PFSPH_FREE_SLIP) a = 0;
+        else if (o->own_viscosity) a = 0, b = (pfsph_real)o->viscosity;
+        int w = 0;
+        while (w < c->nwalls && !(c->wall_scale[w] == a && c->wall_nu[w] == b)) w++;
+        if (w == c->nwalls) {
+            c->wall_scale[w] = a;
+            c->wall_nu[w] = b;
+            c->nwalls++;
+            if (b > c->wall_nu_max) c->wall_nu_max = b;
+        }
+        of_solid[i] = (uint8_t)w;
+    }
+}
+
+static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_wall, pfsph_particles *fluid,
                            pfsph_particles *boundary, pfsph_bodies **bodies, pfsph_error *err)
 {
     /* Boundary volumes. A wall of two or more layers at the fluid's spacing continues the
@@ -113,7 +142,10 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
         size_t first = boundary->n;
         if (pfsph__sample_solid(s, &s->solids[i], d, boundary) < 0)
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling solids");
-        for (size_t j = first; j < boundary->n; j++) boundary->aux[j] = s->solids[i].layers > 1 ? v0 : -1;
+        for (size_t j = first; j < boundary->n; j++) {
+            boundary->aux[j] = s->solids[i].layers > 1 ? v0 : -1;
+            boundary->wall[j] = solid_wall[i];
+        }
     }
     /* bodies after the static solids: their boundary ids follow (pfsph_bodies_first_id) */
     if (s->nbodies) {
@@ -122,7 +154,7 @@ static int build_particles(const pfsph_scene *s, double d, pfsph_particles *flui
     }
     for (int i = 0; i < s->nblocks; i++) {
         size_t first = fluid->n;
-        if (pfsph__sample_block(s, &s->blocks[i], d, fluid) < 0)
+        if (pfsph__sample_scene_block(s, i, d, fluid) < 0)
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
         /* drop fluid particles inside or too close to a solid or a body (their boundary
          * particles sit d/2 inside the surface; one nearer than 0.4 d would start compressed) */
@@ -154,7 +186,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     double d = 2 * s->particle_radius;
     long nf = 0, nb = 0;
     for (int i = 0; i < s->nblocks; i++) {
-        long c = pfsph__sample_block(s, &s->blocks[i], d, NULL);
+        long c = pfsph__sample_scene_block(s, i, d, NULL);
         if (c < 0) return pfsph_fail(err, PFSPH_EINPUT, "cannot sample block %d", i);
         nf += c;
     }
@@ -188,7 +220,8 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const double P = (double)pfsph_particles_bytes_per_particle();
     const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
-    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0)) * sizeof(pfsph_real) + sort + 2 * P;
+    const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
+    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort + 2 * P;
     const double per_boundary = 2 * P + sort;
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
     const double part_bytes = (double)nf * per_fluid + (double)nb * per_boundary;
@@ -247,6 +280,16 @@ static void auto_sound_speed(pfsph_sim *sim)
     sim->sound_speed = s->sound_speed > 0 ? s->sound_speed : 10 * vref;
 }
 
+int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out)
+{
+    if (!sim->pw) return PFSPH_EINPUT;
+    double *vir = malloc((sim->fluid.n ? sim->fluid.n : 1) * sizeof(double));
+    if (!vir) return PFSPH_ENOMEM;
+    pfsph_pairwise_mechanical_pressure(sim->pw, &sim->ctx, vir, out);
+    free(vir);
+    return PFSPH_OK;
+}
+
 void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s)
 {
     for (int a = 0; a < 3; a++) {
@@ -285,6 +328,11 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         goto fail;
     }
     sim->nscr = SCR_COMMON + sim->solver->nscratch;
+    sim->scr_noise = -1;
+    if (s->pairwise.enabled && s->pairwise.thermo.enabled) {
+        sim->scr_noise = sim->nscr;
+        sim->nscr += 3;
+    }
     if (sim->nscr > SCR_MAX) {
         rc = pfsph_fail(err, PFSPH_ENOMEM, "solver %s needs %d scratch arrays, at most %d", sim->solver->name,
                         sim->solver->nscratch, SCR_MAX - SCR_COMMON);
@@ -302,7 +350,9 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         pfsph_fail(err, rc, "out of memory");
         goto fail;
     }
-    if ((rc = build_particles(s, d, &sim->fluid, &sim->boundary, &sim->bodies, err))) goto fail;
+    uint8_t solid_wall[PFSPH_MAX_SOLIDS];
+    wall_models(c, s, solid_wall);
+    if ((rc = build_particles(s, d, solid_wall, &sim->fluid, &sim->boundary, &sim->bodies, err))) goto fail;
     c->fluid = &sim->fluid;
     c->boundary = &sim->boundary;
 
@@ -374,6 +424,18 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
 
     if (s->pairwise.enabled && (rc = pfsph_pairwise_create(&sim->pw, c, err))) goto fail;
     if (s->diffuse.enabled && (rc = pfsph_diffuse_create(&sim->df, c, err))) goto fail;
+    /* The first step's force criterion needs the accelerations the pair forces give: from |g|
+     * alone (0 without gravity) PCISPH took dt_max and blew up at step 0 (issue 11). */
+    if (sim->pw && sim->fluid.n) {
+        if (pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed)) goto nomem;
+        pfsph__number_density(c, sim->fluid.x, sim->fluid.y, sim->fluid.z, c->nd);
+        pfsph__nonpressure(c);
+        pfsph_pairwise_apply(sim->pw, c);
+        double a2 = 0;
+        for (size_t i = 0; i < sim->fluid.n; i++)
+            a2 = fmax(a2, (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i]);
+        sim->amax = sim->amax_np = fmax(g, sqrt(a2));
+    }
     build_stages(sim);
     *out = sim;
     return PFSPH_OK;
@@ -573,6 +635,16 @@ static int st_pairwise(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* thermal noise after every deterministic force, before the pressure solve sees them */
+static int st_thermostat(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_real *nz[3] = {sim->scr[sim->scr_noise], sim->scr[sim->scr_noise + 1], sim->scr[sim->scr_noise + 2]};
+    pfsph_thermostat_apply(&sim->ctx, nz);
+    return PFSPH_OK;
+}
+
 static int st_pressure(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     (void)bad;
@@ -611,13 +683,25 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
     int bad_ = 0;
+    /* The thermostat's random accelerations scale as dt^(-1/2) (their velocity kick as
+     * dt^(1/2)): left in the force criteria they would shrink the next step without end. */
+    const bool noise = sim->scr_noise >= 0 && pfsph_thermostat_kT(c) > 0;
+    const pfsph_real *nx = noise ? sim->scr[sim->scr_noise] : NULL, *ny = noise ? sim->scr[sim->scr_noise + 1] : NULL,
+                     *nz = noise ? sim->scr[sim->scr_noise + 2] : NULL;
 #pragma omp parallel for schedule(static) reduction(max : amax2, anp2, emax, v2max) reduction(| : bad_)
     for (size_t i = 0; i < n; i++) {
-        double b2 = (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i];
+        pfsph_real bx = c->ax[i], by = c->ay[i], bz = c->az[i];
+        if (noise) {
+            bx -= nx[i];
+            by -= ny[i];
+            bz -= nz[i];
+        }
+        double b2 = (double)bx * bx + (double)by * by + (double)bz * bz;
         if (b2 > anp2) anp2 = b2;
-        pfsph_real axi = c->ax[i] + apx[i], ayi = c->ay[i] + apy[i], azi = c->az[i] + apz[i];
-        double a2 = (double)axi * axi + (double)ayi * ayi + (double)azi * azi;
+        pfsph_real cx = bx + apx[i], cy = by + apy[i], cz = bz + apz[i];
+        double a2 = (double)cx * cx + (double)cy * cy + (double)cz * cz;
         if (a2 > amax2) amax2 = a2;
+        pfsph_real axi = c->ax[i] + apx[i], ayi = c->ay[i] + apy[i], azi = c->az[i] + apz[i];
         f->vx[i] += fdt * axi;
         f->vy[i] += fdt * ayi;
         f->vz[i] += fdt * azi;
@@ -688,6 +772,7 @@ static void build_stages(pfsph_sim *sim)
     if (sim->solver->pre_forces) ADD("divergence", PFSPH_STAGE_PRESSURE, st_divergence);
     ADD("forces", PFSPH_STAGE_FORCES, st_forces);
     if (sim->pw) ADD("pairwise", PFSPH_STAGE_PAIRWISE, st_pairwise);
+    if (sim->scr_noise >= 0 && pfsph_thermostat_kT(&sim->ctx) > 0) ADD("thermostat", PFSPH_STAGE_PAIRWISE, st_thermostat);
     ADD("pressure", PFSPH_STAGE_PRESSURE, st_pressure);
     if (sim->bodies) ADD("bodies", PFSPH_STAGE_BODIES, st_body_forces);
     ADD("integrate", PFSPH_STAGE_INTEGRATE, st_integrate);
@@ -882,4 +967,102 @@ void pfsph_sim_prime_output(pfsph_sim *sim)
         rho_common = rhi;
     pfsph__tait(&sim->ctx, sim->ctx.nd, sim->sound_speed * sim->sound_speed / s->gamma, s->gamma, rho_common,
                 sim->fluid.p);
+}
+
+/* ---- changing the model while it runs (sim.h; docs/viewer.md) ---- */
+
+int pfsph_sim_set_gravity(pfsph_sim *sim, const double g[3], pfsph_error *err)
+{
+    for (int a = 0; a < 3; a++)
+        if (!isfinite(g[a]) || fabs(g[a]) > 1e6)
+            return pfsph_fail(err, PFSPH_EINPUT, "gravity %g %g %g: expected finite components of at most 1e6 m/s^2",
+                              g[0], g[1], g[2]);
+    for (int a = 0; a < 3; a++) sim->scene.gravity[a] = a < sim->scene.dim ? g[a] : 0;
+    memcpy(sim->ctx.gravity, sim->scene.gravity, sizeof sim->ctx.gravity);
+    pfsph_bodies_set_gravity(sim->bodies, sim->scene.dim, sim->scene.gravity);
+    return PFSPH_OK;
+}
+
+/* Check a phase pair; `what` names the change in messages. */
+static int pair_ok(const pfsph_sim *sim, int a, int b, const char *what, pfsph_error *err)
+{
+    const pfsph_scene *s = &sim->scene;
+    if (!s->pairwise.enabled || !sim->pw)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: the scene has pair forces off (no \"pairwise\" block)", what);
+    if (a < 0 || b < 0 || a >= s->nphases || b >= s->nphases)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: phase index %d or %d out of range (the scene has %d phases)", what,
+                          a, b, s->nphases);
+    return PFSPH_OK;
+}
+
+/* Install one pair's new statement (kind 0 c, 1 sigma, 2 angle) and resolve every target again;
+ * on failure the old parameters come back. */
+static int set_pair(pfsph_sim *sim, int a, int b, int kind, double v, pfsph_error *err)
+{
+    pfsph_pairwise_params *pp = &sim->scene.pairwise;
+    pfsph_pairwise_params old = *pp;
+    pp->c_set[a][b] = pp->c_set[b][a] = kind == 0;
+    pp->sigma_set[a][b] = pp->sigma_set[b][a] = kind == 1;
+    pp->angle_set[a][b] = pp->angle_set[b][a] = kind == 2;
+    if (kind == 0) pp->c[a][b] = pp->c[b][a] = v;
+    if (kind == 1) pp->sigma[a][b] = pp->sigma[b][a] = v;
+    if (kind == 2) pp->angle_deg[a][b] = pp->angle_deg[b][a] = v;
+    int rc = pfsph_pairwise_resolve(&sim->scene, sim->ctx.spacing, sim->ctx.h, err);
+    if (rc) *pp = old;
+    return rc;
+}
+
+int pfsph_sim_set_pair_coefficient(pfsph_sim *sim, int a, int b, double c, pfsph_error *err)
+{
+    int rc = pair_ok(sim, a, b, "pair coefficient", err);
+    if (rc) return rc;
+    if (!isfinite(c) || c < 0 || c > 1e30)
+        return pfsph_fail(err, PFSPH_EINPUT, "pair coefficient of \"%s\" and \"%s\": %g is not in 0..1e30",
+                          sim->scene.phases[a].name, sim->scene.phases[b].name, c);
+    return set_pair(sim, a, b, 0, c, err);
+}
+
+int pfsph_sim_set_pair_sigma(pfsph_sim *sim, int a, int b, double sigma, pfsph_error *err)
+{
+    int rc = pair_ok(sim, a, b, "surface tension", err);
+    if (rc) return rc;
+    const pfsph_scene *s = &sim->scene;
+    if (s->phases[a].kind == PFSPH_PHASE_SOLID || s->phases[b].kind == PFSPH_PHASE_SOLID)
+        return pfsph_fail(err, PFSPH_EINPUT, "surface tension of \"%s\" and \"%s\": needs two fluid phases",
+                          s->phases[a].name, s->phases[b].name);
+    if (!isfinite(sigma) || sigma < 0 || sigma > 1e6)
+        return pfsph_fail(err, PFSPH_EINPUT, "surface tension of \"%s\" and \"%s\": %g N/m is not in 0..1e6",
+                          s->phases[a].name, s->phases[b].name, sigma);
+    return set_pair(sim, a, b, 1, sigma, err);
+}
+
+int pfsph_sim_set_pair_contact_angle(pfsph_sim *sim, int a, int b, double deg, pfsph_error *err)
+{
+    int rc = pair_ok(sim, a, b, "contact angle", err);
+    if (rc) return rc;
+    const pfsph_scene *s = &sim->scene;
+    if ((s->phases[a].kind == PFSPH_PHASE_SOLID) == (s->phases[b].kind == PFSPH_PHASE_SOLID))
+        return pfsph_fail(err, PFSPH_EINPUT, "contact angle of \"%s\" and \"%s\": needs one fluid and one solid phase",
+                          s->phases[a].name, s->phases[b].name);
+    if (!isfinite(deg) || deg < 0 || deg > 180)
+        return pfsph_fail(err, PFSPH_EINPUT, "contact angle of \"%s\" and \"%s\": %g degrees is not in 0..180",
+                          s->phases[a].name, s->phases[b].name, deg);
+    return set_pair(sim, a, b, 2, deg, err);
+}
+
+int pfsph_sim_drag_body(pfsph_sim *sim, int body, const double target[3], pfsph_error *err)
+{
+    int nb = pfsph_bodies_count(sim->bodies);
+    if (body < 0 || body >= nb)
+        return pfsph_fail(err, PFSPH_EINPUT, "drag: no body %d (the scene has %d)", body, nb);
+    if (!pfsph_bodies_draggable(sim->bodies, body))
+        return pfsph_fail(err, PFSPH_EINPUT, "drag: body \"%s\" is %s; only kinematic bodies without keyframes can be "
+                          "dragged", pfsph_bodies_name(sim->bodies, body),
+                          sim->scene.bodies[body].kinematic ? "moved by keyframes" : "dynamic");
+    /* no faster than the flows the scene is set up for (a tenth of its sound speed, Mach 0.1),
+     * and well inside the blow-up bound */
+    double vmax = fmin(0.1 * sim->sound_speed, 0.2 * sim->solver->speed_bound(sim->solver_state, &sim->ctx));
+    if (pfsph_bodies_drag(sim->bodies, body, target, vmax))
+        return pfsph_fail(err, PFSPH_EINPUT, "drag: target %g %g %g is not finite", target[0], target[1], target[2]);
+    return PFSPH_OK;
 }

@@ -114,6 +114,15 @@ void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, doubl
         }
     }
     b->components = 0;
+    b->largest = 0;
+    int *size = calloc(f->n ? f->n : 1, sizeof *size);
+    if (!size) abort();
+    for (size_t i = 0; i < f->n; i++)
+        if (f->phase[i] == gas) {
+            int r = uf_find(par, (int)i);
+            if (++size[r] > b->largest) b->largest = size[r];
+        }
+    free(size);
     b->rmax = 0;
     b->liquid_in = 0;
     for (size_t i = 0; i < f->n; i++) {

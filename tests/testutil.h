@@ -26,6 +26,7 @@ struct pfsph_ctx;
 typedef struct tu_bubble {
     double cx, cy;   /* gas centroid */
     int components;  /* connected components of gas particles, links shorter than h */
+    int largest;     /* gas particles in the largest component */
     double rmax;     /* farthest gas particle from the centroid */
     int liquid_in;   /* other particles within 3 R with more than 3/4 of their neighbours gas */
     double gas_comp; /* largest gas compression rho / rho_gas - 1 */

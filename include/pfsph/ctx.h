@@ -9,6 +9,8 @@
 #include "pfsph/params.h"
 #include "pfsph/particles.h"
 
+#define PFSPH_MAX_WALLS 80 /* wall models: the default and one per solid at most */
+
 /* What every stage may read. Fluid arrays are in grid order (grid sorted this step). */
 typedef struct pfsph_ctx {
     int dim;
@@ -24,6 +26,13 @@ typedef struct pfsph_ctx {
     pfsph_real mass[PFSPH_MAX_PHASES];         /* particle mass per phase: rho0 * V0 */
     pfsph_real rest_density[PFSPH_MAX_PHASES];
     pfsph_real nu[PFSPH_MAX_PHASES];           /* kinematic viscosity per phase */
+    /* Wall friction per wall model w (the boundary set's `wall`): a fluid particle of viscosity
+     * nu feels the Akinci friction of viscosity wall_scale[w] nu + wall_nu[w] from a wall
+     * particle of model w (no slip: 1, 0; free slip: 0, 0; a solid's own viscosity: 0, nu_w).
+     * nwalls <= 1: every wall is the default, and the friction loop skips the table. */
+    int nwalls;
+    pfsph_real wall_scale[PFSPH_MAX_WALLS], wall_nu[PFSPH_MAX_WALLS];
+    pfsph_real wall_nu_max;                    /* largest wall_nu */
     pfsph_real *ax, *ay, *az; /* per-step non-pressure acceleration of fluid particles */
     pfsph_real *nd;           /* per-step number density of fluid particles (Eq. 23) */
     /* the model (copied from the scene by the simulation; physics never sees the scene) */

@@ -48,6 +48,25 @@ enum pfsph_pw_center {
                                      a stronger, resolution-independent signal at surfaces */
 };
 
+/* ---- thermostat of the pair-force liquid (physics/thermostat.c, docs/thermostat.md) ---- */
+
+/* A pairwise random force whose fluctuation-dissipation partner is the SPH viscosity already in
+ * the step (smoothed DPD, Espanol & Revenga 2003): it gives the liquid a temperature kT, so
+ * that the pair-force fluid flows instead of freezing into a cohesive particle solid. */
+/* Default reduced temperature kT / (sigma d^(dim-1)): about twice the measured melting point
+ * (docs/thermostat.md). */
+#define PFSPH_THERMO_REDUCED_DEFAULT 0.01
+
+typedef struct pfsph_thermostat_params {
+    bool enabled;     /* default: on wherever pair forces act */
+    double kT;        /* k_B T [J] (2D: J per metre of depth); < 0: from `reduced` */
+    double reduced;   /* kT = reduced * sigma_ref * d^(dim-1) when kT is not given */
+    /* Filled by pfsph_pairwise_resolve. */
+    double kT_resolved;  /* the temperature the step uses; 0: thermostat off */
+    double sigma_ref;    /* largest liquid-air surface tension of the coefficient table */
+    double rho_ref;      /* rest density of that liquid: kT is its temperature */
+} pfsph_thermostat_params;
+
 typedef struct pfsph_pairwise_params {
     bool enabled;
     double k;         /* radius enlargement, default (80/30)^(1/3) (Eq. 5) */
@@ -56,6 +75,7 @@ typedef struct pfsph_pairwise_params {
     double eps_min;   /* Eq. 8 clamp on eigenvalues normalised by the largest one, default 0.5 */
     int center;       /* enum pfsph_pw_center */
     pfsph_shift_params shift; /* particle shifting stage (off unless the scene asks) */
+    pfsph_thermostat_params thermo; /* thermal noise (on unless the scene says otherwise) */
     /* Coefficient matrix c[a][b] over scene phases (solids included), symmetric, >= 0.
      * Pair force c m_i m_j f(r): c in N/kg^2 in 3D; in 2D masses are per metre of depth. */
     double c[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];

@@ -29,6 +29,8 @@ typedef struct pfsph_particles {
         };
     };
     uint8_t *phase; /* index into the phase table (fluid/boundary) or diffuse type */
+    uint8_t *wall;  /* boundary: its solid's wall model (pfsph_ctx wall tables; 0 = the
+                     * default, no slip with the fluid's viscosity); 0 in other sets */
     uint32_t *id;   /* stable id, assigned at creation, never reused within a run */
     uint32_t next_id;
 } pfsph_particles;

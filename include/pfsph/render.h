@@ -26,4 +26,25 @@ typedef struct pfsph_render_opts {
 int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count,
                      pfsph_error *err);
 
+/* The camera pfsph_render_run uses for a w x h image (the live viewer starts from it, so that
+ * both show the same picture): 2D an orthographic view of the x-y plane, 3D the scene's camera
+ * or the automatic front-right-above one framing the first frame's fluid and boundary. */
+typedef struct pfsph_render_camera {
+    bool ortho;
+    double eye[3], right[3], up[3], fwd[3]; /* unit vectors, camera looks along fwd */
+    double f;      /* perspective: focal length in pixels; ortho: pixels per metre */
+    double cx, cy; /* ortho: world x, y at the image centre */
+    int w, h;
+} pfsph_render_camera;
+
+struct pfsph_scene;
+struct pfsph_particles;
+/* boundary may be NULL (no boundary frame). */
+void pfsph_render_camera_for(const struct pfsph_scene *s, const struct pfsph_particles *fluid,
+                             const struct pfsph_particles *boundary, int w, int h,
+                             pfsph_render_camera *out);
+
+/* Encode 8-bit RGB rows (top first) as a PNG and write it atomically. */
+int pfsph_write_png_rgb(const char *path, const uint8_t *rgb, int w, int h, pfsph_error *err);
+
 #endif

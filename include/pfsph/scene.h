@@ -10,7 +10,9 @@
 #include "pfsph/types.h"
 #include "pfsph/params.h"
 
-#define PFSPH_MAX_BLOCKS 64
+/* Fluid blocks: a fixed array, as the scene is a plain value that is copied (pfsph_sim keeps
+ * its own) and never freed; 1024 of them take 150 kB. */
+#define PFSPH_MAX_BLOCKS 1024
 #define PFSPH_MAX_SOLIDS 64
 #define PFSPH_MAX_BODIES 32
 #define PFSPH_MAX_KEYFRAMES 16
@@ -45,6 +47,9 @@ typedef struct pfsph_block {
     double jitter;         /* random lattice displacement, fraction of the spacing (0: none) */
 } pfsph_block;
 
+/* Tangential friction of a solid on the fluid (Akinci 2012 wall viscosity) or none. */
+enum pfsph_slip { PFSPH_NO_SLIP = 0, PFSPH_FREE_SLIP = 1 };
+
 /* A static solid sampled with boundary particles. */
 typedef struct pfsph_solid {
     int shape;
@@ -57,6 +62,9 @@ typedef struct pfsph_solid {
     int axis;              /* CYLINDER */
     int layers;            /* boundary particle layers, >= 1 */
     bool open_top;         /* CONTAINER */
+    int slip;              /* enum pfsph_slip: wall friction or none */
+    bool own_viscosity;    /* NO_SLIP: friction with `viscosity`, not the fluid's own */
+    double viscosity;      /* kinematic [m^2/s], when own_viscosity */
 } pfsph_solid;
 
 /* A rigid body (docs/bodies.md): dynamic (moved by fluid forces, gravity and contacts) or

@@ -49,6 +49,9 @@ const pfsph_scene *pfsph_sim_scene(const pfsph_sim *sim);
  * that builds a context by hand. */
 void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s);
 const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim);
+/* Mechanical pressure of every fluid particle (pfsph_pairwise_mechanical_pressure) into out
+ * (fluid->n entries). PFSPH_EINPUT without pair forces, PFSPH_ENOMEM. */
+int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out);
 /* Seconds spent per stage so far. */
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);
 size_t pfsph_sim_removed(const pfsph_sim *sim);
@@ -95,5 +98,26 @@ int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const struct pfsph_bod
 /* Number of particles and bytes a scene would need, without allocating them. */
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
                          size_t *bytes, pfsph_error *err);
+
+/* ---- changing the model while it runs (the live viewer's interface; docs/viewer.md) ----
+ * Each takes effect at the next pfsph_sim_step, as if the scene had said so from the start;
+ * none may be called while a step runs. On error (PFSPH_EINPUT, message naming the value) the
+ * simulation is unchanged. */
+
+/* Gravity [m/s^2] (2D: g[2] is ignored and kept 0); rigid bodies follow. */
+int pfsph_sim_set_gravity(pfsph_sim *sim, const double g[3], pfsph_error *err);
+/* Pair-force coefficient c of phases a and b (both orders), replacing any sigma or contact-angle
+ * target the scene gave that pair; targets of other pairs are resolved again (a contact angle
+ * follows its fluid's cohesion). Units as in params.h; c finite and >= 0. Pair forces must be on. */
+int pfsph_sim_set_pair_coefficient(pfsph_sim *sim, int a, int b, double c, pfsph_error *err);
+/* Surface tension target [N/m] of a fluid pair (a == b: against the unsimulated air). */
+int pfsph_sim_set_pair_sigma(pfsph_sim *sim, int a, int b, double sigma, pfsph_error *err);
+/* Static contact-angle target [degrees, 0..180] of a fluid phase on a solid phase. */
+int pfsph_sim_set_pair_contact_angle(pfsph_sim *sim, int a, int b, double deg, pfsph_error *err);
+/* Drag rigid body `body` (kinematic, without keyframes) towards target [m]: it moves there in a
+ * straight line from the next step on, at most a tenth of the sound speed (the flow speed the
+ * scene is set up for) and a fifth of the blow-up speed bound, and stays where it is left;
+ * target NULL lets go. */
+int pfsph_sim_drag_body(pfsph_sim *sim, int body, const double target[3], pfsph_error *err);
 
 #endif

@@ -17,6 +17,9 @@
 #include "pfsph/run.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
+#ifdef PFSPH_HAVE_VIEWER
+#include "view/view.h"
+#endif
 
 static const char *USAGE =
     "usage: pfsph run [SCENE] [-o DIR] [--force] [--threads N] [--end T] [--render] [--quiet]\n"
@@ -26,6 +29,7 @@ static const char *USAGE =
     "                            [--size WxH] [--particles]\n"
     "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
     "       pfsph export RUN_DIR --houdini\n"
+    "       pfsph view [SCENE | RUN_DIR] [--screenshot FILE --frames N] [...]\n"
     "       pfsph --version\n"
     "       pfsph help [COMMAND]    (or pfsph COMMAND --help)\n";
 
@@ -38,6 +42,7 @@ static const char *HELP =
     "  render   PNG previews (and an mp4) of a run directory's frames\n"
     "  export   Houdini geometry (.geo) of a run directory's fluid frames\n"
     "  mesh     liquid surface meshes (PLY, OBJ, VTP) of a 3D run directory's fluid frames\n"
+    "  view     a window: a scene simulated live, or a run directory replayed\n"
     "  help     this text, or a command's: pfsph help run\n"
     "  --version  the version, precision and OpenMP thread count\n"
     "\n"
@@ -617,6 +622,20 @@ static int cmd_mesh(int argc, char **argv)
     return 0;
 }
 
+/* `pfsph view` (src/view/) exists only in builds that found GLFW and libepoxy. */
+static int cmd_view(int argc, char **argv)
+{
+#ifdef PFSPH_HAVE_VIEWER
+    return pfsph_view_main(argc, argv);
+#else
+    (void)argc;
+    (void)argv;
+    fprintf(stderr, "pfsph: view: this build has no viewer (it needs GLFW 3 and libepoxy at build time: Debian "
+                    "libglfw3-dev libepoxy-dev, then cmake -DPFSPH_VIEWER=ON); `pfsph render` makes PNG previews\n");
+    return 2;
+#endif
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -636,6 +655,11 @@ int main(int argc, char **argv)
         else if (!strcmp(topic, "render")) fputs(HELP_RENDER, stdout);
         else if (!strcmp(topic, "mesh")) fputs(HELP_MESH, stdout);
         else if (!strcmp(topic, "export")) fputs(HELP_EXPORT, stdout);
+        else if (!strcmp(topic, "view")) {
+            char h[] = "--help";
+            char *v[] = {h, NULL};
+            return cmd_view(1, v);
+        }
         else return usage_error("help: unknown command '%s'", topic);
         return 0;
     }
@@ -644,5 +668,6 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "render")) return cmd_render(argc - 2, argv + 2);
     if (!strcmp(cmd, "mesh")) return cmd_mesh(argc - 2, argv + 2);
     if (!strcmp(cmd, "export")) return cmd_export(argc - 2, argv + 2);
+    if (!strcmp(cmd, "view")) return cmd_view(argc - 2, argv + 2);
     return usage_error("unknown command '%s'", cmd);
 }

@@ -34,6 +34,9 @@ void pfsph_pairwise_defaults(pfsph_pairwise_params *p)
     p->eps_min = 0.5;
     p->center = PFSPH_PW_CENTER_PARTICLE; /* Eq. 7 as written */
     pfsph_shift_defaults(&p->shift);
+    p->thermo.enabled = true;
+    p->thermo.kT = -1;
+    p->thermo.reduced = PFSPH_THERMO_REDUCED_DEFAULT;
 }
 
 void pfsph_shift_defaults(pfsph_shift_params *p)

@@ -22,6 +22,9 @@ int pfsph_particles_reserve(pfsph_particles *ps, size_t cap)
     void *q = grow(ps->phase, ps->cap, cap);
     if (!q) return PFSPH_ENOMEM;
     ps->phase = q;
+    q = grow(ps->wall, ps->cap, cap);
+    if (!q) return PFSPH_ENOMEM;
+    ps->wall = q;
     q = grow(ps->id, ps->cap * sizeof(uint32_t), cap * sizeof(uint32_t));
     if (!q) return PFSPH_ENOMEM;
     ps->id = q;
@@ -40,6 +43,7 @@ void pfsph_particles_free(pfsph_particles *ps)
     if (!ps) return;
     for (int k = 0; k < PFSPH_NFIELDS; k++) free(ps->f[k]);
     free(ps->phase);
+    free(ps->wall);
     free(ps->id);
     memset(ps, 0, sizeof(*ps));
 }
@@ -62,6 +66,7 @@ long pfsph_particles_push(pfsph_particles *ps, const pfsph_real x[3], const pfsp
         ps->vz[i] = v[2];
     }
     ps->phase[i] = phase;
+    ps->wall[i] = 0;
     ps->id[i] = ps->next_id++;
     return (long)i;
 }
@@ -92,6 +97,8 @@ int pfsph_particles_permute(pfsph_particles *ps, const uint32_t *perm, size_t n_
     uint8_t *tb = tmp;
     for (size_t i = 0; i < n_new; i++) tb[i] = ps->phase[perm[i]];
     memcpy(ps->phase, tb, n_new);
+    for (size_t i = 0; i < n_new; i++) tb[i] = ps->wall[perm[i]];
+    memcpy(ps->wall, tb, n_new);
     ps->n = n_new;
     free(own);
     return PFSPH_OK;
@@ -99,5 +106,5 @@ int pfsph_particles_permute(pfsph_particles *ps, const uint32_t *perm, size_t n_
 
 size_t pfsph_particles_bytes_per_particle(void)
 {
-    return PFSPH_NFIELDS * sizeof(pfsph_real) + sizeof(uint8_t) + sizeof(uint32_t);
+    return PFSPH_NFIELDS * sizeof(pfsph_real) + 2 * sizeof(uint8_t) + sizeof(uint32_t);
 }

@@ -122,6 +122,11 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
         h_int(h, b->axis);
         h_int(h, b->layers);
         h_int(h, b->open_top);
+        if (b->slip || b->own_viscosity) { /* only then, so that older checkpoints stay resumable */
+            h_int(h, b->slip);
+            h_int(h, b->own_viscosity);
+            h_f64(h, b->viscosity);
+        }
     }
     /* pairwise: what the scene states (c is filled in by pfsph_pairwise_resolve, c_set is not) */
     const pfsph_pairwise_params *pw = &s->pairwise;
@@ -132,6 +137,11 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
         h_f64(h, pw->eta);
         h_f64(h, pw->eps_min);
         h_int(h, pw->center);
+        /* the thermostat (on by default since issue 11): a checkpoint written before it
+         * existed belongs to a different model and is refused */
+        h_int(h, pw->thermo.enabled);
+        h_f64(h, pw->thermo.kT);
+        h_f64(h, pw->thermo.reduced);
         for (int a = 0; a < s->nphases && a < PFSPH_MAX_PHASES; a++)
             for (int b = 0; b < s->nphases && b < PFSPH_MAX_PHASES; b++) {
                 h_int(h, pw->c_set[a][b]);

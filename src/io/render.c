@@ -1171,3 +1171,45 @@ out:
     free(sc);
     return rc;
 }
+
+/* ---- for other front ends (the live viewer) ------------------------------------------- */
+
+void pfsph_render_camera_for(const pfsph_scene *s, const pfsph_particles *fluid,
+                             const pfsph_particles *boundary, int w, int h,
+                             pfsph_render_camera *out)
+{
+    box3 pb;
+    box_empty(&pb);
+    box_add(&pb, fluid);
+    if (boundary) box_add(&pb, boundary);
+    if (s->dim == 2) pb.lo[2] = pb.hi[2] = 0;
+    box3 fb = frame_box(s, &pb, boundary && boundary->n > 0);
+    cam c;
+    memset(&c, 0, sizeof c);
+    c.w = w;
+    c.h = h;
+    setup_camera(&c, s, &fb);
+    memset(out, 0, sizeof *out);
+    out->ortho = c.ortho;
+    memcpy(out->eye, c.eye, sizeof c.eye);
+    memcpy(out->right, c.right, sizeof c.right);
+    memcpy(out->up, c.up, sizeof c.up);
+    memcpy(out->fwd, c.fwd, sizeof c.fwd);
+    out->f = c.f;
+    out->cx = c.cx;
+    out->cy = c.cy;
+    out->w = w;
+    out->h = h;
+}
+
+int pfsph_write_png_rgb(const char *path, const uint8_t *rgb, int w, int h, pfsph_error *err)
+{
+    membuf m = {0};
+    if (png_encode(rgb, w, h, &m) != 0) {
+        free(m.d);
+        return pfsph_fail(err, PFSPH_EIO, "%s: PNG encoding failed", path);
+    }
+    int rc = pfsph_write_file_atomic(path, m.d, m.n, err);
+    free(m.d);
+    return rc;
+}

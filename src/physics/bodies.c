@@ -3,6 +3,7 @@
  * the Open Dynamics Engine (ODE). Why ODE: a maintained C library in Debian with quaternion
  * integration, joints and box/sphere/cylinder/trimesh contacts; the fluid coupling stays ours. */
 #include "pfsph/bodies.h"
+#include "pfsph/thermostat.h"
 
 #include <math.h>
 #include <ode/ode.h>
@@ -31,6 +32,8 @@ typedef struct body {
     uint32_t n;
     double f[3], tq[3]; /* fluid force and torque of the last step */
     double vmax;       /* largest particle speed */
+    bool dragged;      /* kinematic, no keyframes: follows drag_to (pfsph_bodies_drag) */
+    double drag_to[3], drag_vmax;
 } body;
 
 struct pfsph_bodies {
@@ -759,12 +762,15 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
     /* particles dropped from the boundary set (a body that left the grid) must not keep their
      * last force: only the present ones are written below */
     memset(B->fp, 0, 3 * (size_t)B->np * sizeof(double));
+    const double kT = pfsph_thermostat_kT(ctx);
+    const double amp = kT > 0 && ctx->dt > 0 ? 2.0 * kT / ctx->dt * (double)(2 * (ctx->dim + 2)) : 0;
+    const uint64_t wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
 #pragma omp parallel for schedule(static)
     for (size_t j = 0; j < nb; j++) {
         if (b->id[j] < first) continue;
         const uint32_t l = b->id[j] - first;
         const pfsph_real xj = b->x[j], yj = b->y[j], zj = b->z[j], vol = b->aux[j];
-        double fx = 0, fy = 0, fz = 0;
+        double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
         pfsph_ranges r;
         pfsph_grid_ranges(ctx->grid, xj, yj, zj, &r);
         for (int q = 0; q < r.n; q++)
@@ -783,11 +789,30 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
                                      (f->vz[i] - b->vz[j]) * dz;
                     /* friction: the fluid gains m_i nu visc_c V_b (v_ib . x_ib)/(r^2+eps) grad W */
                     s -= ctx->mass[f->phase[i]] * visc_c * nui * vol * vdx / (r2 + eps) * dw;
+                    if (kT > 0 && r2 > 0) {
+                        /* the thermostat's random force on the fluid, reversed (thermostat.c:
+                         * the same expression, same draw) */
+                        double rr = sqrt((double)r2);
+                        double g = (double)nui * (double)ctx->mass[f->phase[i]] * (double)vol *
+                                   (double)r2 * -(double)pfsph_kernel_dw_r(k, (pfsph_real)rr) /
+                                   (double)(r2 + eps);
+                        if (g > 0) {
+                            /* x_ib points from the body particle to the fluid: -e_ib on the body */
+                            double sr = -sqrt(amp * pfsph_thermostat_scale(ctx, f->phase[i]) * g) *
+                                        pfsph_thermo_theta(wkey, f->id[i], b->id[j]) / rr;
+                            tx += sr * (double)dx;
+                            ty += sr * (double)dy;
+                            tz += sr * (double)dz;
+                        }
+                    }
                 }
                 fx += (double)(s * dx);
                 fy += (double)(s * dy);
                 fz += (double)(s * dz);
             }
+        fx += tx;
+        fy += ty;
+        fz += tz;
         if (pw_on) {
             /* the pair forces' reaction (PF Eq. 3): -c m_i m_b f(r) x_ib / r, over k h. The
              * fluid applies its filter T_i (Eq. 12) to its own sum, so with eta > 0 action and
@@ -909,6 +934,24 @@ static void canonical_quat(dBodyID id)
     }
 }
 
+/* A dragged body moves from where it is straight towards drag_to, at most drag_vmax [m/s],
+ * without turning. */
+static void drag_pose(const body *bd, double dt, double x0[3], double q0[4], double x1[3], double q1[4])
+{
+    memcpy(x0, dBodyGetPosition(bd->id), 3 * sizeof(double));
+    const dReal *q = dBodyGetQuaternion(bd->id);
+    double d[3], len = 0;
+    for (int k = 0; k < 3; k++) {
+        q0[k] = q1[k] = q[k];
+        d[k] = bd->drag_to[k] - x0[k];
+        len += d[k] * d[k];
+    }
+    q0[3] = q1[3] = q[3];
+    len = sqrt(len);
+    double s = len > bd->drag_vmax * dt ? bd->drag_vmax * dt / len : 1;
+    for (int k = 0; k < 3; k++) x1[k] = x0[k] + s * d[k];
+}
+
 void pfsph_bodies_step(pfsph_bodies *B, pfsph_particles *bs, double t, double dt)
 {
     if (!B->nb) return;
@@ -919,6 +962,7 @@ void pfsph_bodies_step(pfsph_bodies *B, pfsph_particles *bs, double t, double dt
             double x0[3], q0[4], x1[3], q1[4];
             key_pose(&bd->def, t, x0, q0);
             key_pose(&bd->def, t + dt, x1, q1);
+            if (bd->dragged) drag_pose(bd, dt, x0, q0, x1, q1);
             dBodySetPosition(bd->id, x0[0], x0[1], x0[2]);
             dBodySetQuaternion(bd->id, q0);
             dBodySetLinearVel(bd->id, (x1[0] - x0[0]) / dt, (x1[1] - x0[1]) / dt, (x1[2] - x0[2]) / dt);
@@ -946,6 +990,11 @@ void pfsph_bodies_step(pfsph_bodies *B, pfsph_particles *bs, double t, double dt
         if (bd->def.kinematic) {
             double x1[3], q1[4];
             key_pose(&bd->def, t + dt, x1, q1);
+            if (bd->dragged) {
+                /* the step ended where the drag put it: from now on its resting pose */
+                memcpy(x1, dBodyGetPosition(bd->id), sizeof x1);
+                memcpy(bd->def.position, x1, sizeof x1);
+            }
             dBodySetPosition(bd->id, x1[0], x1[1], x1[2]);
             dBodySetQuaternion(bd->id, q1);
         } else if (B->dim == 2) {
@@ -1001,4 +1050,33 @@ int pfsph_bodies_world_mesh(const pfsph_bodies *B, int i, pfsph_mesh *m)
         for (int k = 0; k < 3; k++) R[3 * r + k] = Rm[4 * r + k];
     pfsph_mesh_transform(m, 1.0, R, t);
     return PFSPH_OK;
+}
+
+void pfsph_bodies_set_gravity(pfsph_bodies *b, int dim, const double g[3])
+{
+    if (b) dWorldSetGravity(b->world, g[0], g[1], dim == 3 ? g[2] : 0);
+}
+
+int pfsph_bodies_drag(pfsph_bodies *b, int i, const double target[3], double vmax)
+{
+    if (!b || i < 0 || i >= b->nb) return PFSPH_EINPUT;
+    body *bd = &b->b[i];
+    if (!bd->def.kinematic || bd->def.nkeys > 0) return PFSPH_EINPUT;
+    if (!target) {
+        bd->dragged = false;
+        return PFSPH_OK;
+    }
+    for (int k = 0; k < 3; k++)
+        if (!isfinite(target[k])) return PFSPH_EINPUT;
+    if (!(vmax > 0) || !isfinite(vmax)) return PFSPH_EINPUT;
+    memcpy(bd->drag_to, target, sizeof bd->drag_to);
+    if (b->dim == 2) bd->drag_to[2] = 0;
+    bd->drag_vmax = vmax;
+    bd->dragged = true;
+    return PFSPH_OK;
+}
+
+bool pfsph_bodies_draggable(const pfsph_bodies *b, int i)
+{
+    return b && i >= 0 && i < b->nb && b->b[i].def.kinematic && b->b[i].def.nkeys == 0;
 }

@@ -289,3 +289,62 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
     }
 }
 
+
+void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir,
+                                        pfsph_real *out)
+{
+    const pfsph_particles *f = ctx->fluid;
+    const size_t n = f->n;
+    const int dim = ctx->dim;
+    pfsph_pairwise_diagnose(pw, ctx, vir, NULL);
+    const pfsph_kernel *k = &ctx->kern;
+    const pfsph_real h2 = k->h * k->h;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        /* peculiar velocity against the kernel-weighted mean of the neighbours (self excluded);
+         * for uncorrelated thermal velocities E|u|^2 = <v'^2> (1 + sum w^2 / (sum w)^2) */
+        double sw = 0, sw2 = 0, m[3] = {0, 0, 0}, pv = 0;
+        const double pi = (double)f->p[i] / ((double)ctx->nd[i] * (double)ctx->nd[i]);
+        pfsph_ranges r;
+        pfsph_grid_ranges(ctx->grid, f->x[i], f->y[i], f->z[i], &r);
+        for (int q = 0; q < r.n; q++)
+            for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+                if (j == i) continue;
+                pfsph_real dx = f->x[i] - f->x[j], dy = f->y[i] - f->y[j], dz = f->z[i] - f->z[j];
+                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+                if (r2 >= h2) continue;
+                pfsph_real rr = pfsph_sqrt(r2);
+                double w = (double)pfsph_kernel_w(k, rr);
+                /* r_ij . F_ij of the pressure force (pressure.c) */
+                pv -= (pi + (double)f->p[j] / ((double)ctx->nd[j] * (double)ctx->nd[j])) * (double)r2 *
+                      (double)pfsph_kernel_dw_r(k, rr);
+                sw += w;
+                sw2 += w * w;
+                m[0] += w * f->vx[j];
+                m[1] += w * f->vy[j];
+                m[2] += w * f->vz[j];
+            }
+        double kin = 0;
+        if (sw > 0) {
+            double ux = f->vx[i] - m[0] / sw, uy = f->vy[i] - m[1] / sw, uz = f->vz[i] - m[2] / sw;
+            kin = (double)ctx->mass[f->phase[i]] * (ux * ux + uy * uy + (dim == 3 ? uz * uz : 0)) /
+                  (1.0 + sw2 / (sw * sw));
+        }
+        const pfsph_particles *b = ctx->boundary;
+        if (b && b->n && pi > 0) { /* the Akinci wall term of the pressure force */
+            pfsph_grid_ranges(ctx->bgrid, f->x[i], f->y[i], f->z[i], &r);
+            for (int q = 0; q < r.n; q++)
+                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+                    pfsph_real dx = f->x[i] - b->x[j], dy = f->y[i] - b->y[j], dz = f->z[i] - b->z[j];
+                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+                    if (r2 >= h2) continue;
+                    pv -= (double)b->aux[j] / (double)ctx->V0 * pi * (double)r2 *
+                          (double)pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                }
+        }
+        /* virial pressure of particle i's volume 1 / n_i: (m u^2 + 1/2 sum_j r_ij . F_ij) / (dim V_i),
+         * F_ij the pressure and pair forces. The pressure force's virial, not p_i itself: they
+         * agree on a lattice (sum_j V_j x_ij (x) grad W_ij = -I), not in a disordered liquid. */
+        out[i] = (pfsph_real)((double)ctx->nd[i] / dim * (kin + 0.5 * (vir[i] + pv)));
+    }
+}

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "scene/json_util.h"
+#include "scene/shapes.h"
 
 /* ---------------------------------------------------------------------------------------- */
 /* Limits of the accepted ranges (documented in docs/scene-format.md). */
@@ -513,15 +514,15 @@ static int parse_solids(parser *p, const cJSON *root)
         pfsph_solid *so = &s->solids[i];
         memset(so, 0, sizeof *so);
         TRY(json_enum(p, e, P, "shape", solid_shapes, &so->shape));
-        static const char *const k_box[] = {"shape", "phase", "layers", "min", "max", "comment",
+        static const char *const k_box[] = {"shape", "phase", "layers", "slip", "viscosity", "min", "max", "comment",
                                             NULL};
-        static const char *const k_cont[] = {"shape", "phase", "layers", "min", "max",
+        static const char *const k_cont[] = {"shape", "phase", "layers", "slip", "viscosity", "min", "max",
                                              "open_top", "comment", NULL};
-        static const char *const k_sph[] = {"shape", "phase", "layers", "center", "radius",
+        static const char *const k_sph[] = {"shape", "phase", "layers", "slip", "viscosity", "center", "radius",
                                             "comment", NULL};
-        static const char *const k_cyl[] = {"shape", "phase", "layers", "center", "radius",
+        static const char *const k_cyl[] = {"shape", "phase", "layers", "slip", "viscosity", "center", "radius",
                                             "height", "axis", "comment", NULL};
-        static const char *const k_plane[] = {"shape", "phase", "layers", "point", "normal",
+        static const char *const k_plane[] = {"shape", "phase", "layers", "slip", "viscosity", "point", "normal",
                                               "comment", NULL};
         const char *const *keys = so->shape == PFSPH_SHAPE_BOX        ? k_box
                                   : so->shape == PFSPH_SHAPE_CONTAINER ? k_cont
@@ -531,6 +532,18 @@ static int parse_solids(parser *p, const cJSON *root)
         TRY(pfsph__json_check_keys(e, P, keys, &p->ctx));
         so->layers = 2;
         TRY(pfsph__json_int(e, P, "layers", 1, 10, &so->layers, &p->ctx));
+        /* wall friction (docs/scene-format.md, "Wall friction"): free slip has none to scale */
+        static const char *const slips[] = {"no-slip", "free-slip", NULL}; /* enum pfsph_slip order */
+        TRY(json_enum(p, e, P, "slip", slips, &so->slip));
+        TRY(pfsph__json_number(e, P, "viscosity", 0.0, 100.0, &so->viscosity, &p->ctx));
+        so->own_viscosity = get(e, "viscosity") != NULL;
+        if (so->slip == PFSPH_FREE_SLIP && get(e, "viscosity")) {
+            char kp[160];
+            path_key(kp, sizeof kp, P, "viscosity");
+            return pfsph__json_fail(&p->ctx, kp,
+                                    "a free-slip wall has no friction: its viscosity would not be used "
+                                    "(remove it, or make the wall \"no-slip\")");
+        }
         TRY(pfsph__json_bool(e, P, "open_top", &so->open_top, &p->ctx));
         if (so->shape == PFSPH_SHAPE_PLANE) {
             TRY(require(p, e, P, "point"));
@@ -651,12 +664,11 @@ static int check_blocks(parser *p)
     pfsph_scene *s = p->s;
     const double sp = 2.0 * s->particle_radius;
     const double tiny = 1e-9 * sp;
-    geo gs[PFSPH_MAX_BLOCKS];
     for (int i = 0; i < s->nblocks; i++) {
         const pfsph_block *b = &s->blocks[i];
         char P[128], kp[160];
         path_index(P, sizeof P, "$.fluid", i);
-        gs[i] = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
+        const geo gb = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
         /* Empty: fewer than one particle along some axis. */
         if (b->shape == PFSPH_SHAPE_BOX) {
             for (int k = 0; k < s->dim; k++)
@@ -687,29 +699,22 @@ static int check_blocks(parser *p)
         /* Inside the domain. */
         for (int k = 0; k < s->dim; k++) {
             double scale = fmax(1.0, fabs(s->domain_max[k] - s->domain_min[k]));
-            if (gs[i].min[k] < s->domain_min[k] - 1e-9 * scale ||
-                gs[i].max[k] > s->domain_max[k] + 1e-9 * scale) {
+            if (gb.min[k] < s->domain_min[k] - 1e-9 * scale ||
+                gb.max[k] > s->domain_max[k] + 1e-9 * scale) {
                 char a[96], c[96], lo[96], hi[96];
                 fmt_vec(a, sizeof a, s->dim, s->domain_min);
                 fmt_vec(c, sizeof c, s->dim, s->domain_max);
-                fmt_vec(lo, sizeof lo, s->dim, gs[i].min);
-                fmt_vec(hi, sizeof hi, s->dim, gs[i].max);
+                fmt_vec(lo, sizeof lo, s->dim, gb.min);
+                fmt_vec(hi, sizeof hi, s->dim, gb.max);
                 const char *key = b->shape != PFSPH_SHAPE_BOX
                                       ? "center"
-                                      : (gs[i].min[k] < s->domain_min[k] ? "min" : "max");
+                                      : (gb.min[k] < s->domain_min[k] ? "min" : "max");
                 path_key(kp, sizeof kp, P, key);
                 return pfsph__json_fail(
                     &p->ctx, kp, "block %s .. %s extends outside the domain %s .. %s along %s", lo,
                     hi, a, c, axis_names[k]);
             }
         }
-        /* Overlaps with earlier blocks. */
-        for (int j = 0; j < i; j++)
-            if (geo_overlap(&gs[j], &gs[i], sp))
-                return pfsph__json_fail(&p->ctx, P,
-                                        "overlaps $.fluid[%d] by more than half a particle spacing "
-                                        "(%g m); particles there would be created twice",
-                                        j, 0.5 * sp);
         /* Solids: obstacles must not start inside fluid; container walls must not cut blocks. */
         for (int j = 0; j < s->nsolids; j++) {
             const pfsph_solid *so = &s->solids[j];
@@ -718,11 +723,11 @@ static int check_blocks(parser *p)
                 /* Partly inside the container's inner box but not wholly: crosses a wall. */
                 bool touches = true, inside = true;
                 for (int k = 0; k < s->dim; k++) {
-                    double lo = fmax(gs[i].min[k], so->min[k]), hi = fmin(gs[i].max[k], so->max[k]);
+                    double lo = fmax(gb.min[k], so->min[k]), hi = fmin(gb.max[k], so->max[k]);
                     if (hi - lo <= 0.5 * sp) touches = false;
-                    if (gs[i].min[k] < so->min[k] - 0.5 * sp) inside = false;
+                    if (gb.min[k] < so->min[k] - 0.5 * sp) inside = false;
                     bool top = so->open_top && k == 1;
-                    if (!top && gs[i].max[k] > so->max[k] + 0.5 * sp) inside = false;
+                    if (!top && gb.max[k] > so->max[k] + 0.5 * sp) inside = false;
                 }
                 if (touches && !inside)
                     return pfsph__json_fail(&p->ctx, P,
@@ -732,12 +737,20 @@ static int check_blocks(parser *p)
             }
             geo g = geo_of(s->dim, so->shape, so->min, so->max, so->center, so->radius,
                            so->height, so->axis);
-            if (geo_overlap(&g, &gs[i], sp))
+            if (geo_overlap(&g, &gb, sp))
                 return pfsph__json_fail(
                     &p->ctx, P,
                     "overlaps the solid $.solids[%d]; fluid particles would start "
                     "inside it",
                     j);
+        }
+        /* Overlaps with later blocks are what carving is for (shapes.c); a block they cover
+         * wholly adds nothing, which is an ordering mistake (a tank listed after its bubble). */
+        if (pfsph__scene_block_covered(s, i, sp)) {
+            return pfsph__json_fail(&p->ctx, P,
+                                    "every particle of this block lies inside later blocks, which replace "
+                                    "earlier ones where they overlap: it would add nothing (list it after "
+                                    "the blocks it should replace)");
         }
     }
     return PFSPH_OK;

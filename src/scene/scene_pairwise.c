@@ -96,7 +96,7 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
                                 pfsph_jctx *ctx)
 {
     static const char *const keys[] = {"enabled", "k", "filter", "eta", "eps_min", "center",
-                                       "shifting", "coefficients", "comment", NULL};
+                                       "shifting", "thermostat", "coefficients", "comment", NULL};
     pfsph_pairwise_params *pp = &s->pairwise;
     int rc = pfsph__json_check_keys(node, path, keys, ctx);
     if (rc) return rc;
@@ -136,6 +136,30 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
             return rc;
         if ((rc = pfsph__json_number(sh, sp, "max_step", 0.0, 0.25, &pp->shift.max_frac, ctx)))
             return rc;
+    }
+    const cJSON *th = cJSON_GetObjectItemCaseSensitive(node, "thermostat");
+    if (th) {
+        static const char *const tkeys[] = {"enabled", "kT", "reduced_temperature", "comment", NULL};
+        char tp[600];
+        snprintf(tp, sizeof tp, "%s.thermostat", path);
+        if (cJSON_IsBool(th)) {
+            pp->thermo.enabled = cJSON_IsTrue(th);
+        } else {
+            if (!cJSON_IsObject(th))
+                return pfsph__json_fail(ctx, tp, "expected true, false or an object {\"kT\": J, ...}");
+            if ((rc = pfsph__json_check_keys(th, tp, tkeys, ctx))) return rc;
+            if ((rc = pfsph__json_bool(th, tp, "enabled", &pp->thermo.enabled, ctx))) return rc;
+            if ((rc = pfsph__json_number(th, tp, "kT", 0.0, 1e6, &pp->thermo.kT, ctx))) return rc;
+            if ((rc = pfsph__json_number(th, tp, "reduced_temperature", 0.0, 10.0,
+                                         &pp->thermo.reduced, ctx)))
+                return rc;
+            if (cJSON_GetObjectItemCaseSensitive(th, "kT") &&
+                cJSON_GetObjectItemCaseSensitive(th, "reduced_temperature")) {
+                char kp[620];
+                snprintf(kp, sizeof kp, "%s.kT", tp);
+                return pfsph__json_fail(ctx, kp, "give kT or reduced_temperature, not both");
+            }
+        }
     }
     const cJSON *co = cJSON_GetObjectItemCaseSensitive(node, "coefficients");
     if (co) {
@@ -249,8 +273,58 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
         }
     pp->radius = R;
     pp->lambda = lam;
+    /* Thermostat: kT = reduced * sigma_ref * d^(dim-1), sigma_ref the largest liquid-air
+     * tension of the table (docs/thermostat.md). */
+    pfsph_thermostat_params *tp = &pp->thermo;
+    tp->sigma_ref = 0;
+    tp->rho_ref = 0;
+    for (int a = 0; a < np; a++)
+        if (!is_solid(s, a)) {
+            double sg = lam * pp->c[a][a] * rho[a] * rho[a];
+            if (sg > tp->sigma_ref) tp->sigma_ref = sg, tp->rho_ref = rho[a];
+        }
+    tp->kT_resolved = 0;
+    if (tp->enabled)
+        tp->kT_resolved = tp->kT >= 0 ? tp->kT
+                                      : tp->reduced * tp->sigma_ref * pow((double)spacing, s->dim - 1);
     pp->resolved = true;
     return PFSPH_OK;
+}
+
+/* Temperature, thermal speed and how fast the viscosity couples the particles to it. */
+static void thermo_report(const pfsph_scene *s, FILE *out)
+{
+    const pfsph_thermostat_params *tp = &s->pairwise.thermo;
+    if (!tp->enabled) {
+        fprintf(out, "  thermostat off (the pair-force liquid has no temperature: it freezes)\n");
+        return;
+    }
+    if (!s->pairwise.resolved) return;
+    double d = 2.0 * s->particle_radius, V = pow(d, s->dim);
+    const char *unit = s->dim == 2 ? "J/m" : "J";
+    if (!(tp->kT_resolved > 0)) {
+        fprintf(out, "  thermostat on, kT = 0 (no liquid-air tension to scale it by)\n");
+        return;
+    }
+    fprintf(out, "  thermostat on: kT = %.4g %s", tp->kT_resolved, unit);
+    if (tp->sigma_ref > 0)
+        fprintf(out, " = %.4g sigma d^%d (sigma = %.4g N/m)", tp->kT_resolved /
+                (tp->sigma_ref * pow(d, s->dim - 1)), s->dim - 1, tp->sigma_ref);
+    fprintf(out, "\n");
+    for (int a = 0; a < s->nphases; a++) {
+        if (is_solid(s, a)) continue;
+        double m = s->phases[a].rest_density * V, nu = s->phases[a].viscosity;
+        double h = s->support_factor * d;
+        double ts = tp->rho_ref > 0 && s->phases[a].rest_density > 0 ? s->phases[a].rest_density / tp->rho_ref : 1;
+        fprintf(out, "    %s: kT x %.3g, thermal speed sqrt(kT/m) = %.3g m/s per component", s->phases[a].name,
+                ts, sqrt(ts * tp->kT_resolved / m));
+        /* relaxation time of a particle's velocity against its neighbours' friction, about
+         * h^2 / (2 (d + 2) nu) for the cubic spline (docs/thermostat.md) */
+        if (nu > 0)
+            fprintf(out, ", velocity relaxation ~%.3g s\n", h * h / (2.0 * (s->dim + 2) * nu));
+        else
+            fprintf(out, "; viscosity 0: no friction, so no noise either (set a viscosity)\n");
+    }
 }
 
 void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
@@ -273,6 +347,7 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
         fprintf(out, "  particle shifting on: diffusivity %g m^2/s, speed factor %g, surface %g, "
                 "max step %g d\n", pp->shift.D, pp->shift.A, pp->shift.surface,
                 pp->shift.max_frac);
+    thermo_report(s, out);
     fprintf(out, "  coefficients c[a][b] (%s):\n  %-14s", s->dim == 2 ? "N m/kg^2, 2D" : "N/kg^2",
             "");
     for (int b = 0; b < np; b++) fprintf(out, " %12.12s", s->phases[b].name);

@@ -4,6 +4,7 @@
 
 #include <limits.h>
 #include <math.h>
+#include <stdlib.h>
 
 #include "pfsph/rng.h"
 
@@ -44,112 +45,242 @@ static int inside_block(const pfsph_block *b, int dim, const double p[3])
     }
 }
 
-/* Lattice coordinate i of a block (as pfsph__sample_block places it) along axis a. */
-static double site(const double *lo, const double *hi, const long *n, double d, int a, long i)
-{
-    return lo[a] + (hi[a] - lo[a] - (double)(n[a] - 1) * d) * 0.5 + (double)i * d;
-}
+/* The scene lattice. Site k along an axis lies at (k + 1/2) d, for every block alike, so that
+ * blocks meet without gaps or doubled particles and a later block can take over the sites of
+ * an earlier one (docs/scene-format.md, "Particle lattice"). Origin 0 rather than the domain's
+ * corner: container walls are sampled from their own `min` (pfsph__sample_solid), and shipped
+ * scenes put container and block faces on multiples of d, whatever the domain's margin. In 2D
+ * the third axis holds the one site z = 0. A box takes the sites in [min, max) (a face on a
+ * site gives it to the block above), a round shape those it contains (closed). */
+#define LAT_TOL 1e-9 /* of d: rounding of faces that lie on sites */
+
+static double lat_x(double d, long k) { return ((double)k + 0.5) * d; }
+
+static long clamp_site(double k) { return k < -1e15 ? (long)-1e15 : k > 1e15 ? (long)1e15 : (long)k; }
 
 static long clamp_count(double c) { return c > (double)LONG_MAX / 2 ? LONG_MAX / 2 : (long)c; }
 
-/* The count of pfsph__sample_block without walking every site: a box is a product; a sphere
- * or cylinder is convex, so each row along x holds an interval of sites, found in closed
- * form and its ends settled with the exact inside test (the same decisions as the walk).
- * Rows: n[1] n[2], about N^(2/3) for N sites. */
-static long count_block(const pfsph_block *b, int dim, const double *lo, const double *hi, const long *n,
-                        double d)
+/* Sites [k0, k1) per axis that can lie in block b: its box, a round shape's bounding box. */
+static void block_range(const pfsph_block *b, int dim, double d, long k0[3], long k1[3])
 {
+    k0[2] = 0;
+    k1[2] = 1;
+    for (int a = 0; a < dim; a++) {
+        if (b->shape == PFSPH_SHAPE_BOX) {
+            k0[a] = clamp_site(ceil(b->min[a] / d - 0.5 - LAT_TOL));
+            k1[a] = clamp_site(ceil(b->max[a] / d - 0.5 - LAT_TOL));
+        } else {
+            double ext = b->radius;
+            if (b->shape == PFSPH_SHAPE_CYLINDER && dim == 3 && a == b->axis) ext = 0.5 * b->height;
+            k0[a] = clamp_site(ceil((b->center[a] - ext) / d - 0.5 - LAT_TOL));
+            k1[a] = clamp_site(floor((b->center[a] + ext) / d - 0.5 + LAT_TOL) + 1);
+        }
+        if (k1[a] < k0[a]) k1[a] = k0[a];
+    }
+}
+
+/* Site k lies in block b (whose range is k0, k1). */
+static int site_in(const pfsph_block *b, int dim, double d, const long *k0, const long *k1, const long k[3])
+{
+    for (int a = 0; a < 3; a++)
+        if (k[a] < k0[a] || k[a] >= k1[a]) return 0;
+    if (b->shape == PFSPH_SHAPE_BOX) return 1;
+    double p[3] = {lat_x(d, k[0]), lat_x(d, k[1]), dim == 3 ? lat_x(d, k[2]) : 0};
+    return inside_block(b, dim, p);
+}
+
+/* The sites of block b on the row (ky, kz) along x, [*lo, *hi] (empty: *lo > *hi). A box: its
+ * range. A sphere or cylinder is convex, so the row holds an interval of sites, found in
+ * closed form and its ends settled with the exact test (the same decisions as the walk). */
+static void row_interval(const pfsph_block *b, int dim, double d, const long *k0, const long *k1, long ky, long kz,
+                         long *lo, long *hi)
+{
+    *lo = 1;
+    *hi = 0;
+    if (ky < k0[1] || ky >= k1[1] || kz < k0[2] || kz >= k1[2] || k1[0] <= k0[0]) return;
+    if (b->shape == PFSPH_SHAPE_BOX) {
+        *lo = k0[0];
+        *hi = k1[0] - 1;
+        return;
+    }
+    const int cyl3 = b->shape == PFSPH_SHAPE_CYLINDER && dim == 3;
+    long k[3] = {0, ky, kz};
+    /* half-width in x of the shape on this row, about b->center[0] */
+    double w2 = b->radius * b->radius, wx;
+    for (int a = 1; a < dim; a++) {
+        if (cyl3 && a == b->axis) continue;
+        double q = lat_x(d, k[a]) - b->center[a];
+        w2 -= q * q;
+    }
+    if (cyl3 && b->axis == 0) wx = w2 >= 0 ? 0.5 * b->height : 0;
+    else wx = w2 > 0 ? sqrt(w2) : 0;
+    long i0 = clamp_site(ceil((b->center[0] - wx) / d - 0.5));
+    long i1 = clamp_site(floor((b->center[0] + wx) / d - 0.5));
+    if (i0 < k0[0]) i0 = k0[0];
+    if (i1 > k1[0] - 1) i1 = k1[0] - 1;
+    while (i0 <= i1 && (k[0] = i0, !site_in(b, dim, d, k0, k1, k))) i0++;
+    while (i0 <= i1 && (k[0] = i1, !site_in(b, dim, d, k0, k1, k))) i1--;
+    if (i0 > i1) {
+        /* nothing inside by the closed form; the exact test may still take a site or two
+         * next to the centre (contiguous: the shape is convex) */
+        long c = clamp_site(floor(b->center[0] / d - 0.5));
+        for (k[0] = c - 1; k[0] <= c + 2; k[0]++)
+            if (site_in(b, dim, d, k0, k1, k)) {
+                if (*lo > *hi) *lo = k[0];
+                *hi = k[0];
+            }
+        return;
+    }
+    while (i0 > k0[0] && (k[0] = i0 - 1, site_in(b, dim, d, k0, k1, k))) i0--;
+    while (i1 < k1[0] - 1 && (k[0] = i1 + 1, site_in(b, dim, d, k0, k1, k))) i1++;
+    *lo = i0;
+    *hi = i1;
+}
+
+/* The sites of one block, without walking them: a box is a product, a round shape a sum of
+ * row intervals (about N^(2/3) rows for N sites). */
+static long count_block(const pfsph_block *b, int dim, double d, const long *k0, const long *k1)
+{
+    double n[3];
+    for (int a = 0; a < 3; a++) n[a] = (double)(k1[a] - k0[a]);
     if (n[0] <= 0 || n[1] <= 0 || n[2] <= 0) return 0;
-    if (b->shape == PFSPH_SHAPE_BOX) return clamp_count((double)n[0] * (double)n[1] * (double)n[2]);
+    if (b->shape == PFSPH_SHAPE_BOX) return clamp_count(n[0] * n[1] * n[2]);
     double total = 0;
-    for (long k = 0; k < n[2]; k++)
-        for (long j = 0; j < n[1]; j++) {
-            double p[3] = {0, site(lo, hi, n, d, 1, j), dim == 3 ? site(lo, hi, n, d, 2, k) : 0};
-            /* half-width in x of the shape on this row; the centre is b->center[0] */
-            double w2 = b->radius * b->radius, wx;
-            int along_x = b->shape == PFSPH_SHAPE_CYLINDER && dim == 3 && b->axis == 0;
-            if (along_x) {
-                for (int a = 1; a < 3; a++) w2 -= (p[a] - b->center[a]) * (p[a] - b->center[a]);
-                if (w2 < 0) continue;
-                wx = 0.5 * b->height;
-            } else {
-                int top = b->shape == PFSPH_SHAPE_CYLINDER && dim == 3 ? -1 : dim;
-                for (int a = 1; a < 3 && a < (top < 0 ? 3 : top); a++) {
-                    if (top < 0 && a == b->axis) continue;
-                    w2 -= (p[a] - b->center[a]) * (p[a] - b->center[a]);
-                }
-                if (top < 0 && fabs(p[b->axis] - b->center[b->axis]) > 0.5 * b->height + d) continue;
-                if (w2 < 0) continue;
-                wx = sqrt(w2);
-            }
-            double x0 = site(lo, hi, n, d, 0, 0);
-            long i0 = (long)ceil((b->center[0] - wx - x0) / d), i1 = (long)floor((b->center[0] + wx - x0) / d);
-            if (i0 < 0) i0 = 0;
-            if (i1 > n[0] - 1) i1 = n[0] - 1;
-            /* settle the ends with the walk's own test */
-            p[0] = site(lo, hi, n, d, 0, i0);
-            while (i0 <= i1 && !inside_block(b, dim, p)) p[0] = site(lo, hi, n, d, 0, ++i0);
-            if (i0 > i1) {
-                /* nothing inside by the closed form; the exact test may still take a site or two */
-                long c = i1 < 0 ? 0 : i1;
-                for (long i = c - 1; i <= c + 1; i++) {
-                    if (i < 0 || i >= n[0]) continue;
-                    p[0] = site(lo, hi, n, d, 0, i);
-                    total += inside_block(b, dim, p);
-                }
-                continue;
-            }
-            for (p[0] = site(lo, hi, n, d, 0, i0 - 1); i0 > 0 && inside_block(b, dim, p);)
-                p[0] = site(lo, hi, n, d, 0, --i0 - 1);
-            p[0] = site(lo, hi, n, d, 0, i1);
-            while (i1 >= i0 && !inside_block(b, dim, p)) p[0] = site(lo, hi, n, d, 0, --i1);
-            for (p[0] = site(lo, hi, n, d, 0, i1 + 1); i1 < n[0] - 1 && inside_block(b, dim, p);)
-                p[0] = site(lo, hi, n, d, 0, ++i1 + 1);
-            total += (double)(i1 - i0 + 1);
+    for (long kz = k0[2]; kz < k1[2]; kz++)
+        for (long ky = k0[1]; ky < k1[1]; ky++) {
+            long lo, hi;
+            row_interval(b, dim, d, k0, k1, ky, kz, &lo, &hi);
+            if (lo <= hi) total += (double)(hi - lo + 1);
         }
     return clamp_count(total);
 }
 
-long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d,
-                         pfsph_particles *ps)
+static int ranges_meet(const long *a0, const long *a1, const long *b0, const long *b1)
 {
-    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    int dim = s->dim;
-    for (int a = 0; a < dim; a++) {
-        if (b->shape == PFSPH_SHAPE_BOX) {
-            lo[a] = b->min[a];
-            hi[a] = b->max[a];
-        } else {
-            double ext = b->radius;
-            if (b->shape == PFSPH_SHAPE_CYLINDER && dim == 3 && a == b->axis) ext = 0.5 * b->height;
-            lo[a] = b->center[a] - ext;
-            hi[a] = b->center[a] + ext;
-        }
+    for (int a = 0; a < 3; a++)
+        if (a1[a] <= b0[a] || b1[a] <= a0[a]) return 0;
+    return 1;
+}
+
+/* Sample (ps) or count (ps NULL) the sites of b, less those of the `nlater` blocks `later`
+ * (blocks listed after b take the sites they contain). `stream` keys the jitter. */
+static long sample(const pfsph_scene *s, const pfsph_block *b, uint32_t stream, const pfsph_block *const *later,
+                   int nlater, double d, pfsph_particles *ps)
+{
+    const int dim = s->dim;
+    long k0[3], k1[3];
+    block_range(b, dim, d, k0, k1);
+    for (int a = 0; a < 3; a++)
+        if (k1[a] <= k0[a]) return 0;
+    /* the later blocks that can take a site of b, with their ranges */
+    long (*lr)[6] = nlater ? malloc((size_t)nlater * sizeof *lr) : NULL;
+    const pfsph_block **lb = nlater ? malloc((size_t)nlater * sizeof *lb) : NULL;
+    if (nlater && (!lr || !lb)) {
+        free(lr);
+        free(lb);
+        return -1;
     }
-    long n[3] = {1, 1, 1};
-    for (int a = 0; a < dim; a++) {
-        double na = floor((hi[a] - lo[a]) / d + 1e-9);
-        n[a] = na < 0 ? 0 : na > 1e15 ? (long)1e15 : (long)na;
+    int m = 0;
+    for (int q = 0; q < nlater; q++) {
+        block_range(later[q], dim, d, lr[m], lr[m] + 3);
+        if (ranges_meet(k0, k1, lr[m], lr[m] + 3)) lb[m++] = later[q];
     }
-    if (!ps) return count_block(b, dim, lo, hi, n, d);
     long count = 0;
-    for (long k = 0; k < n[2]; k++)
-        for (long j = 0; j < n[1]; j++)
-            for (long i = 0; i < n[0]; i++) {
-                /* lattice centred in the block so that a block of width w*d holds w cells */
-                double p[3] = {lo[0] + (hi[0] - lo[0] - (n[0] - 1) * d) * 0.5 + i * d,
-                               lo[1] + (hi[1] - lo[1] - (n[1] - 1) * d) * 0.5 + j * d,
-                               dim == 3 ? lo[2] + (hi[2] - lo[2] - (n[2] - 1) * d) * 0.5 + k * d : 0};
-                if (b->shape != PFSPH_SHAPE_BOX && !inside_block(b, dim, p)) continue;
+    if (!ps) {
+        /* each site a later block takes is counted once, against the first later block that
+         * contains it: walk the overlap of b with that block only */
+        double removed = 0;
+        for (int q = 0; q < m; q++) {
+            long o0[3], o1[3];
+            for (int a = 0; a < 3; a++) {
+                o0[a] = k0[a] > lr[q][a] ? k0[a] : lr[q][a];
+                o1[a] = k1[a] < lr[q][3 + a] ? k1[a] : lr[q][3 + a];
+            }
+            int between = 0; /* blocks between b and this one that reach into the overlap */
+            for (int r = 0; r < q; r++) between |= ranges_meet(o0, o1, lr[r], lr[r] + 3);
+            if (!between && b->shape == PFSPH_SHAPE_BOX && lb[q]->shape == PFSPH_SHAPE_BOX) {
+                removed += (double)(o1[0] - o0[0]) * (double)(o1[1] - o0[1]) * (double)(o1[2] - o0[2]);
+                continue;
+            }
+            /* row by row: the sites of both shapes are an interval (both convex); only
+             * when blocks in between reach into the overlap are its sites tested one by one */
+            long k[3];
+            for (k[2] = o0[2]; k[2] < o1[2]; k[2]++)
+                for (k[1] = o0[1]; k[1] < o1[1]; k[1]++) {
+                    long a0, a1, b0, b1;
+                    row_interval(b, dim, d, k0, k1, k[1], k[2], &a0, &a1);
+                    row_interval(lb[q], dim, d, lr[q], lr[q] + 3, k[1], k[2], &b0, &b1);
+                    if (b0 > a0) a0 = b0;
+                    if (b1 < a1) a1 = b1;
+                    if (a0 > a1) continue;
+                    if (!between) {
+                        removed += (double)(a1 - a0 + 1);
+                        continue;
+                    }
+                    for (k[0] = a0; k[0] <= a1; k[0]++) {
+                        int first = 1;
+                        for (int r = 0; r < q && first; r++)
+                            if (site_in(lb[r], dim, d, lr[r], lr[r] + 3, k)) first = 0;
+                        removed += first;
+                    }
+                }
+        }
+        free(lr);
+        free(lb);
+        return clamp_count((double)count_block(b, dim, d, k0, k1) - removed);
+    }
+    const long n0 = k1[0] - k0[0], n1 = k1[1] - k0[1];
+    long k[3];
+    for (k[2] = k0[2]; k[2] < k1[2]; k[2]++)
+        for (k[1] = k0[1]; k[1] < k1[1]; k[1]++)
+            for (k[0] = k0[0]; k[0] < k1[0]; k[0]++) {
+                if (!site_in(b, dim, d, k0, k1, k)) continue;
+                int taken = 0;
+                for (int q = 0; q < m && !taken; q++) taken = site_in(lb[q], dim, d, lr[q], lr[q] + 3, k);
+                if (taken) continue;
+                double p[3] = {lat_x(d, k[0]), lat_x(d, k[1]), dim == 3 ? lat_x(d, k[2]) : 0};
                 if (b->jitter > 0) { /* from the scene seed, the block and the lattice site */
                     double u[4];
-                    pfsph_rng_uniform4(s->seed, (uint32_t)(i + n[0] * (j + n[1] * k)), 0,
-                                       0x4a170000u + (uint32_t)(b - s->blocks), u);
+                    long site = (k[0] - k0[0]) + n0 * ((k[1] - k0[1]) + n1 * (k[2] - k0[2]));
+                    pfsph_rng_uniform4(s->seed, (uint32_t)site, 0, 0x4a170000u + stream, u);
                     for (int a = 0; a < dim; a++) p[a] += b->jitter * d * (2 * u[a] - 1);
                 }
-                if (emit(ps, &count, p[0], p[1], p[2], b->velocity, b->phase)) return -1;
+                if (emit(ps, &count, p[0], p[1], p[2], b->velocity, b->phase)) {
+                    count = -1;
+                    goto done;
+                }
             }
+done:
+    free(lr);
+    free(lb);
     return count;
+}
+
+long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d, pfsph_particles *ps)
+{
+    return sample(s, b, (uint32_t)(b - s->blocks), NULL, 0, d, ps);
+}
+
+int pfsph__scene_block_covered(const pfsph_scene *s, int i, double d)
+{
+    long k0[3], k1[3];
+    block_range(&s->blocks[i], s->dim, d, k0, k1);
+    double sites = 1;
+    for (int a = 0; a < 3; a++) sites *= (double)(k1[a] - k0[a]);
+    /* a bound on the work: the count walks at most the overlaps, within this block's range */
+    if (i + 1 >= s->nblocks || sites > 1e7) return 0;
+    return pfsph__sample_scene_block(s, i, d, NULL) == 0;
+}
+
+long pfsph__sample_scene_block(const pfsph_scene *s, int i, double d, pfsph_particles *ps)
+{
+    int nlater = s->nblocks - 1 - i;
+    const pfsph_block **later = nlater > 0 ? malloc((size_t)nlater * sizeof *later) : NULL;
+    if (nlater > 0 && !later) return -1;
+    for (int q = 0; q < nlater; q++) later[q] = &s->blocks[i + 1 + q];
+    long c = sample(s, &s->blocks[i], (uint32_t)i, later, nlater > 0 ? nlater : 0, d, ps);
+    free(later);
+    return c;
 }
 
 /* Orthonormal basis (t1, t2) perpendicular to unit n. */

@@ -218,7 +218,7 @@ static void test_left_domain_feels_nothing(void **state)
     static const char *json =
         "{\"dimension\": 2, \"particle_radius\": 0.01, \"gravity\": [0, 0],"
         " \"domain\": {\"min\": [0, 0], \"max\": [1.0, 1.0]},"
-        " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 0.6, \"fps\": 25, \"dt_max\": 0.004},"
+        " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 0.7, \"fps\": 25, \"dt_max\": 0.004},"
         " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": 0},"
         "              {\"name\": \"body\", \"kind\": \"solid\", \"rest_density\": 1000}],"
         " \"bodies\": [{\"name\": \"crate\", \"shape\": \"box\", \"half_extents\": [0.05, 0.05],"
@@ -231,12 +231,15 @@ static void test_left_domain_feels_nothing(void **state)
     assert_int_equal(pfsph_scene_parse(&s, json, "left", &err), PFSPH_OK);
     pfsph_sim *sim = NULL;
     assert_int_equal(pfsph_sim_create(&sim, &s, &err), PFSPH_OK);
-    advance(sim, 0.52);
+    /* wholly outside from about 0.58 s (0.52 s before issue 11 put the water block, 0.45 m
+     * wide, on the scene lattice: its sites moved by a quarter spacing, and the water that
+     * adheres to the body slows it a little more) */
+    advance(sim, 0.6);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     pfsph_body_state a, b;
     double F[3], T[3];
     pfsph_bodies_get_state(B, 0, &a);
-    advance(sim, 0.6);
+    advance(sim, 0.68);
     pfsph_bodies_get_state(B, 0, &b);
     pfsph_bodies_last_force(B, 0, F, T);
     printf("left the domain: x %.4f -> %.4f m, vx %.9f -> %.9f m/s, force %g %g N\n", a.x[0], b.x[0], a.v[0],

@@ -10,7 +10,9 @@
  * U 2R / nu ~ 14.
  *
  * Checks, sampled every 0.05 s up to 0.8 s (the bubble's top is then ~0.12 m below the surface):
- *  - one bubble: the gas particles form exactly one connected component (links shorter than h);
+ *  - one bubble: the largest connected component of gas particles (links shorter than h) holds
+ *    at least 62 of the 64 (since the thermostat, issue 11, the rim of the cap may shed a
+ *    satellite of one particle: measured 63 with PCISPH), at most 3 components;
  *  - no gas particle strays: every gas particle is within 2 R of the gas centroid (the bubble
  *    measured here reaches 1.5 R at most);
  *  - no mixing: no water particle inside the gas, i.e. with more than 3/4 of its neighbours
@@ -23,7 +25,9 @@
  *    radius R): U_DT = 0.5 sqrt(g (1 - rho_g / rho_w) R) = 0.316 m/s. The 30 % allow for what the
  *    estimate leaves out: the nose radius of the deformed bubble is not R (U goes as its square
  *    root), viscous drag at Re ~ 14 and the walls (bubble width / tank width = 0.3).
- * Measured (1 core, 2026-11-23 with the code of the third session): PCISPH 0.353 m/s (1.12 U_DT;
+ * Measured with the thermostat (2026-12-01): PCISPH 0.356 m/s (1.128 U_DT; halves 0.359 /
+ * 0.353), WCSPH 0.331 (1.050), DFSPH see the output; largest component 63 of 64 (PCISPH).
+ * Before the thermostat (1 core, 2026-11-23 with the code of the third session): PCISPH 0.353 m/s (1.12 U_DT;
  * halves 0.336 / 0.371), WCSPH 0.323 m/s (1.02; halves 0.336 / 0.309); farthest gas 1.46 /
  * 1.51 R. The first measurement (0.321 / 0.342 m/s) predates later core changes of session 2. */
 #include <math.h>
@@ -77,7 +81,7 @@ static void run_bubble(const char *solver)
     const double U_dt = 0.5 * sqrt(9.81 * (1 - 100.0 / 1000.0) * R);
 
     double y_at[3] = {0, 0, 0}; /* centroid height at 0.3, 0.55, 0.8 s */
-    int worst_comp = 1, worst_in = 0;
+    int worst_comp = 1, worst_in = 0, worst_largest = 64;
     double worst_r = 0, worst_gas = 0;
     for (int k = 1; k <= 16; k++) {
         double t = 0.05 * k;
@@ -87,16 +91,17 @@ static void run_bubble(const char *solver)
         assert_int_equal(c->fluid->n, n0);
         tu_bubble b;
         tu_bubble_measure(c, GAS, 100.0, R, &b);
-        if (b.components != 1) worst_comp = b.components;
+        if (b.components > worst_comp) worst_comp = b.components;
+        if (b.largest < worst_largest) worst_largest = b.largest;
         if (b.liquid_in > worst_in) worst_in = b.liquid_in;
         if (b.rmax > worst_r) worst_r = b.rmax;
         if (b.gas_comp > worst_gas) worst_gas = b.gas_comp;
         if (k == 6) y_at[0] = b.cy;
         if (k == 11) y_at[1] = b.cy;
         if (k == 16) y_at[2] = b.cy;
-        printf("%s t=%.2f: centroid (%.4f, %.4f), components %d, rmax %.4f m (%.2f R), water "
+        printf("%s t=%.2f: centroid (%.4f, %.4f), components %d (largest %d), rmax %.4f m (%.2f R), water "
                "inside %d, gas compression %.3f\n",
-               solver, t, b.cx, b.cy, b.components, b.rmax, b.rmax / R, b.liquid_in, b.gas_comp);
+               solver, t, b.cx, b.cy, b.components, b.largest, b.rmax, b.rmax / R, b.liquid_in, b.gas_comp);
     }
     double u1 = (y_at[1] - y_at[0]) / 0.25, u2 = (y_at[2] - y_at[1]) / 0.25;
     double U = (y_at[2] - y_at[0]) / 0.5;
@@ -106,7 +111,10 @@ static void run_bubble(const char *solver)
            solver, U, u1, u2, U_dt, R, U / U_dt, worst_gas, (unsigned long long)pfsph_sim_steps(sim));
     fflush(stdout);
     pfsph_sim_destroy(sim);
-    assert_int_equal(worst_comp, 1);
+    /* at temperature the cap's rim may shed a one-particle satellite (measured: 63 of 64 from
+     * 0.45 s on with PCISPH); the bubble itself must stay whole */
+    assert_true(worst_largest >= 62);
+    assert_true(worst_comp <= 3);
     assert_true(worst_r < 2 * R);
     assert_int_equal(worst_in, 0);
     assert_true(fabs(u1 - u2) < 0.2 * 0.5 * (u1 + u2));

@@ -451,7 +451,7 @@ static const bad_case bad_cases[] = {
             "\"solids\":[{\"shape\":\"container\",\"min\":[0,0,0],\"max\":[1,1,1]}]"),
      "$.phases", "too many phases"},
     {"too_many_blocks", NULL /* built at run time */, "$.fluid",
-     "too many entries (65, at most 64)"},
+     "too many entries (1025, at most 1024)"},
     {"too_many_solids", NULL /* built at run time */, "$.solids",
      "too many entries (65, at most 64)"},
     {"domain_min_ge_max", "{\"domain\":{\"min\":[0,1,0],\"max\":[1,1,1]}," FLUID3 "}", "$.domain",
@@ -470,22 +470,20 @@ static const bad_case bad_cases[] = {
     {"box_min_ge_max",
      "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.5,0.5,0.5],\"max\":[0.4,0.7,0.7]}]}",
      "$.fluid[0].max", "max[0] = 0.4 must be greater than min[0] = 0.5"},
-    {"overlap_box_box",
-     "{" DOM3 ",\"fluid\":[" BOX3 ",{\"shape\":\"box\",\"min\":[0.1,0.1,0.1],"
-     "\"max\":[0.3,0.3,0.3]}]}",
-     "$.fluid[1]", "overlaps $.fluid[0]"},
-    {"overlap_box_sphere",
-     "{" DOM3 ",\"fluid\":[" BOX3 ",{\"shape\":\"sphere\",\"center\":[0.25,0.1,0.1],"
-     "\"radius\":0.1}]}",
-     "$.fluid[1]", "overlaps $.fluid[0]"},
-    {"overlap_sphere_sphere",
+    /* issue 11: overlapping blocks carve (a later one replaces an earlier one); only an
+     * earlier block that later ones cover wholly is refused */
+    {"covered_box_by_box",
+     "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.1,0.1,0.1],\"max\":[0.2,0.2,0.2]},"
+     "{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.3,0.3,0.3]}]}",
+     "$.fluid[0]", "every particle of this block lies inside later blocks"},
+    {"covered_sphere_by_box",
      "{" DOM3 ",\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"radius\":0.1},"
-     "{\"shape\":\"sphere\",\"center\":[0.5,0.68,0.5],\"radius\":0.1}]}",
-     "$.fluid[1]", "overlaps $.fluid[0]"},
-    {"overlap_cylinder_box",
-     "{" DOM3 ",\"fluid\":[" BOX3 ",{\"shape\":\"cylinder\",\"center\":[0.25,0.1,0.1],"
-     "\"radius\":0.1,\"height\":0.2,\"axis\":\"y\"}]}",
-     "$.fluid[1]", "overlaps $.fluid[0]"},
+     "{\"shape\":\"box\",\"min\":[0.2,0.2,0.2],\"max\":[0.8,0.8,0.8]}]}",
+     "$.fluid[0]", "list it after the blocks it should replace"},
+    {"covered_box_by_two",
+     "{" DOM3 ",\"fluid\":[" BOX3 ",{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.1,0.2,0.2]},"
+     "{\"shape\":\"box\",\"min\":[0.1,0,0],\"max\":[0.2,0.2,0.2]}]}",
+     "$.fluid[0]", "lies inside later blocks"},
     {"overlap_solid_obstacle",
      SCENE3(",\"solids\":[{\"shape\":\"sphere\",\"center\":[0.2,0.2,0.2],\"radius\":0.1}]"),
      "$.fluid[0]", "overlaps the solid $.solids[0]"},

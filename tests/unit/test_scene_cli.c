@@ -27,11 +27,11 @@ static const cli_case cases[] = {
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"phase\":\"oil\"}]}",
      "$.fluid[0].phase: unknown phase \"oil\""},
-    {"overlap.json",
+    {"covered.json", /* issue 11: a later block replaces an earlier one where they overlap */
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
-     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]},{\"shape\":\"box\",\"min\":[0.1,0.1,0.1],"
+     "\"min\":[0.1,0.1,0.1],\"max\":[0.2,0.2,0.2]},{\"shape\":\"box\",\"min\":[0,0,0],"
      "\"max\":[0.3,0.3,0.3]}]}",
-     "$.fluid[1]: overlaps $.fluid[0]"},
+     "$.fluid[0]: every particle of this block lies inside later blocks"},
     {"frames.json", /* issue 15 item 4: end x fps overflowed the frame count */
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"time\":{\"end\":1e6,\"fps\":1e4}}",
@@ -245,6 +245,45 @@ static void test_no_boundary(void **state)
     }
 }
 
+/* Issue 11: "output": {"boundary": false} with a rigid body as well. The static walls'
+ * frame is not written (nor on a resume); the body's own frames (its particles and its
+ * surface, which move) are, every frame, as docs/scene-format.md says. */
+static void test_no_boundary_bodies(void **state)
+{
+    (void)state;
+    char path[600], args[2048], out[8192], dir[700], b[800];
+    struct stat sb;
+    const char *json =
+        "{\"dimension\":2,\"particle_radius\":0.02,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
+        "\"time\":{\"end\":0.08},\"phases\":[{\"name\":\"w\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
+        "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}],"
+        "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[0.8,0.8],\"phase\":\"wall\"}],"
+        "\"bodies\":[{\"name\":\"crate\",\"shape\":\"box\",\"half_extents\":[0.05,0.05],"
+        "\"position\":[0.5,0.3],\"phase\":\"wall\"}],"
+        "\"output\":{\"formats\":[\"vtp\",\"ply\"],\"boundary\":%s,\"checkpoint_interval\":1}}";
+    for (int on = 0; on < 2; on++) {
+        char text[2048];
+        snprintf(text, sizeof text, json, on ? "true" : "false");
+        snprintf(path, sizeof path, "%s/boundary_bodies_%d.json", tu_tmpdir(), on);
+        assert_int_equal(tu_write_file(path, text), 0);
+        snprintf(dir, sizeof dir, "%s/boundary_bodies_run_%d", tu_tmpdir(), on);
+        snprintf(args, sizeof args, "run '%s' -o '%s' --quiet", path, dir);
+        assert_int_equal(cli(args, out, sizeof out), 0);
+        snprintf(args, sizeof args, "run --resume '%s' --end 0.16 --quiet", dir);
+        assert_int_equal(cli(args, out, sizeof out), 0);
+        for (int f = 0; f <= 4; f++)
+            for (int ply = 0; ply < 2; ply++) {
+                const char *ext = ply ? "ply" : "vtp";
+                snprintf(b, sizeof b, "%s/frames/boundary_%05d.%s", dir, f, ext);
+                assert_int_equal(stat(b, &sb) == 0, on && f == 0);
+                snprintf(b, sizeof b, "%s/frames/bodies_%05d.%s", dir, f, ext);
+                assert_int_equal(stat(b, &sb), 0);
+                snprintf(b, sizeof b, "%s/frames/surfaces_%05d.%s", dir, f, ext);
+                assert_int_equal(stat(b, &sb), 0);
+            }
+    }
+}
+
 /* Issue 15 item 13: every subcommand explains itself; --threads 0 is the default. */
 static void test_help(void **state)
 {
@@ -292,6 +331,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_run_end_overflow),
         cmocka_unit_test(test_messages),
         cmocka_unit_test(test_no_boundary),
+        cmocka_unit_test(test_no_boundary_bodies),
         cmocka_unit_test(test_help),
         cmocka_unit_test(test_check_good),
     };

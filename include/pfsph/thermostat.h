@@ -1,0 +1,66 @@
+/* Thermostat of the pair-force liquid: pairwise random forces that are the fluctuation partner
+ * of the SPH viscosity (smoothed DPD, Espanol & Revenga 2003), symmetric and deterministic
+ * (a counter-based hash of seed, the two ids and the step). docs/thermostat.md. */
+#ifndef PFSPH_THERMOSTAT_H
+#define PFSPH_THERMOSTAT_H
+
+#include <stdint.h>
+
+#include "pfsph/ctx.h"
+
+/* Salt of fluid-solid pairs, so that fluid id a with boundary id b draws a number unrelated to
+ * the fluid pair (a, b). */
+#define PFSPH_THERMO_SALT_WALL 0x5bd1e9955bd1e995ull
+
+static inline uint64_t pfsph__mix64(uint64_t z)
+{
+    /* splitmix64's finaliser (Steele, Lea, Flood 2014): a bijection with full avalanche */
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* The per-step key: every pair of this step draws from mix(key ^ pair). */
+static inline uint64_t pfsph_thermo_step_key(uint64_t seed, uint64_t step, uint64_t salt)
+{
+    return pfsph__mix64(pfsph__mix64(seed + 0x9E3779B97F4A7C15ull) ^ (step * 0xD1B54A32D192ED03ull + salt));
+}
+
+/* theta_ab = theta_ba, uniform on [-sqrt 3, sqrt 3] (zero mean, unit variance), as Groot &
+ * Warren 1997 draw it. */
+static inline double pfsph_thermo_theta(uint64_t key, uint32_t a, uint32_t b)
+{
+    uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
+    uint64_t z = pfsph__mix64(key ^ pfsph__mix64((lo << 32) | hi));
+    return 1.7320508075688772 * ((double)(z >> 11) * (2.0 / 9007199254740992.0) - 1.0);
+}
+
+/* The resolved temperature in use (0: off). */
+static inline double pfsph_thermostat_kT(const pfsph_ctx *ctx)
+{
+    const pfsph_pairwise_params *pp = ctx->pairwise;
+    return pp && pp->enabled && pp->thermo.enabled ? pp->thermo.kT_resolved : 0.0;
+}
+
+/* Phase a's temperature relative to kT: rho_a / rho_ref (the liquid kT was set for), so that
+ * every phase has the same thermal speed; at equal kT a gas 10-1000x lighter would move
+ * 3-32x faster than its liquid and leave its bubble. Solids and unknown densities: 1. */
+static inline double pfsph_thermostat_scale(const pfsph_ctx *ctx, int a)
+{
+    const double rr = ctx->pairwise->thermo.rho_ref, ra = (double)ctx->rest_density[a];
+    return rr > 0 && ra > 0 && ctx->phases[a].kind != PFSPH_PHASE_SOLID ? ra / rr : 1.0;
+}
+
+/* ADD the random pair forces of this step (dt = ctx->dt) to ctx->ax, ay, az, as accelerations,
+ * and store them alone in noise[0..2] (the time step must not follow them):
+ * F_ij = sqrt(2 kT_ij Gamma_ij / dt) theta_ij e_ij (kT_ij: the colder phase's), where Gamma_ij is the friction coefficient of
+ * the Morris viscosity between i and j (fluid pairs: the harmonic mean of its i -> j and j -> i
+ * values, so that Gamma_ij = Gamma_ji) and of the Akinci wall friction between i and a solid particle. Needs
+ * ctx->nd of this step. Deterministic for any thread count; sum over fluid pairs zero to
+ * round-off. */
+void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3]);
+
+/* Kinetic temperature of the fluid: sum m_i |v_i - v_cm|^2 / (dim (N - 1)) [J]; 0 if N < 2. */
+double pfsph_thermostat_measure(const pfsph_particles *f, const pfsph_real *mass, int dim);
+
+#endif

@@ -1,0 +1,300 @@
+/* `pfsph view` under a display (xvfb-run in CI, CMakeLists.txt): a live 2D scene drawn for 20
+ * frames covers the pixels its particles' positions predict; replaying a run shows the frame
+ * the PNG renderer shows (2D and 3D, same camera); bad input. Skipped in builds without the
+ * viewer or without a display. */
+#include <math.h>
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pfsph/io.h"
+#include "pfsph/render.h"
+#include "pfsph/scene.h"
+#include "pfsph/sim.h"
+#include "testutil.h"
+
+/* A 2D tank, 25 x 25 particles of water released against the right wall; a 320 x 240 camera. */
+static const char *SCENE2D =
+    "{\"name\": \"viewer test 2D\", \"dimension\": 2, \"particle_radius\": 0.006,"
+    " \"gravity\": [0, -9.81], \"domain\": {\"min\": [-0.05, -0.05], \"max\": [0.75, 0.55]},"
+    " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 0.16, \"fps\": 25, \"dt_max\": 0.002},"
+    " \"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": 1e-3,"
+    "   \"color\": [0.2, 0.4, 0.9]}, {\"name\": \"wall\", \"kind\": \"solid\"}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.3, 0.3], \"phase\": \"water\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.7, 0.5], \"open_top\": true,"
+    "   \"layers\": 2, \"phase\": \"wall\"}],"
+    " \"output\": {\"formats\": [\"vtp\"], \"boundary\": true},"
+    " \"camera\": {\"width\": 320, \"height\": 240, \"color_by\": \"speed\"}}";
+
+/* A small 3D tank (perspective camera, translucent walls). */
+static const char *SCENE3D =
+    "{\"name\": \"viewer test 3D\", \"dimension\": 3, \"particle_radius\": 0.02,"
+    " \"gravity\": [0, -9.81, 0], \"domain\": {\"min\": [-0.1, -0.1, -0.1], \"max\": [0.7, 0.6, 0.5]},"
+    " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 0.08, \"fps\": 25, \"dt_max\": 0.004},"
+    " \"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": 1e-3,"
+    "   \"color\": [0.2, 0.4, 0.9]}, {\"name\": \"wall\", \"kind\": \"solid\"}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [0.2, 0.24, 0.2], \"phase\": \"water\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0, 0], \"max\": [0.6, 0.4, 0.4], \"open_top\": true,"
+    "   \"layers\": 2, \"phase\": \"wall\"}],"
+    " \"output\": {\"formats\": [\"vtp\"], \"boundary\": true},"
+    " \"camera\": {\"width\": 320, \"height\": 240}}";
+
+typedef struct img {
+    int w, h;
+    unsigned char *rgb;
+} img;
+
+static img read_png(const char *path)
+{
+    img m = {0, 0, NULL};
+    FILE *f = fopen(path, "rb");
+    if (!f) fail_msg("cannot open %s", path);
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png_create_info_struct(png);
+    if (setjmp(png_jmpbuf(png))) fail_msg("libpng failed on %s", path);
+    png_init_io(png, f);
+    png_read_info(png, info);
+    assert_int_equal(png_get_color_type(png, info), PNG_COLOR_TYPE_RGB);
+    assert_int_equal(png_get_bit_depth(png, info), 8);
+    m.w = (int)png_get_image_width(png, info);
+    m.h = (int)png_get_image_height(png, info);
+    m.rgb = malloc((size_t)m.w * m.h * 3);
+    for (int y = 0; y < m.h; y++) png_read_row(png, m.rgb + (size_t)y * m.w * 3, NULL);
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    return m;
+}
+
+/* Both front ends draw the same background: light grey, darker towards the bottom. A pixel
+ * more than 14/255 away from it in some channel shows a particle. */
+static unsigned char *mask_of(const img *m)
+{
+    unsigned char *k = calloc((size_t)m->w * m->h, 1);
+    const double top[3] = {0.945, 0.950, 0.965}, bot[3] = {0.840, 0.850, 0.875};
+    for (int y = 0; y < m->h; y++) {
+        double t = (y + 0.5) / m->h;
+        for (int x = 0; x < m->w; x++) {
+            const unsigned char *p = m->rgb + 3 * ((size_t)y * m->w + x);
+            int on = 0;
+            for (int c = 0; c < 3; c++) on |= fabs(p[c] - 255.0 * ((1 - t) * top[c] + t * bot[c])) > 14;
+            k[(size_t)y * m->w + x] = (unsigned char)on;
+        }
+    }
+    return k;
+}
+
+static double iou(const unsigned char *a, const unsigned char *b, size_t n, size_t *na, size_t *nb)
+{
+    size_t i_ = 0, u = 0;
+    *na = *nb = 0;
+    for (size_t i = 0; i < n; i++) {
+        i_ += a[i] && b[i];
+        u += a[i] || b[i];
+        *na += a[i] != 0;
+        *nb += b[i] != 0;
+    }
+    return u ? (double)i_ / u : 1.0;
+}
+
+static bool viewer_available(void)
+{
+#ifndef PFSPH_HAVE_VIEWER
+    print_message("this build has no viewer (GLFW or libepoxy missing): skipped\n");
+    return false;
+#else
+    if (!getenv("DISPLAY") || !*getenv("DISPLAY")) {
+        print_message("no display (DISPLAY unset; xvfb-run not found at configure time): skipped\n");
+        return false;
+    }
+    return true;
+#endif
+}
+
+static void write_scene(const char *dir, const char *name, const char *text, char *path, size_t cap)
+{
+    snprintf(path, cap, "%s/%s", dir, name);
+    assert_int_equal(tu_write_file(path, text), 0);
+}
+
+/* Live 2D, 20 frames: the screenshot's particle pixels against discs of the drawn radius
+ * (1.3 r, the renderer's 2D fluid radius) at the positions the viewer dumped for the frame it
+ * drew, projected with the renderer's camera of the initial state. Walls hidden, overlay off,
+ * coloured by phase (blue on grey). Measured IoU 0.97; the tolerance, 0.9, leaves room for
+ * the edges: a pixel half covered counts on one side or the other. */
+static void test_live_2d(void **state)
+{
+    (void)state;
+    if (!viewer_available()) skip();
+    const char *dir = tu_tmpdir();
+    char scene[600], cmd[2400], out[4096], shot[600], dump[600], p[700];
+    write_scene(dir, "live2d.json", SCENE2D, scene, sizeof scene);
+    snprintf(shot, sizeof shot, "%s/live.png", dir);
+    snprintf(dump, sizeof dump, "%s/dump", dir);
+    snprintf(cmd, sizeof cmd, "%s view %s --screenshot %s --frames 20 --dump %s --no-overlay --hide walls "
+             "--color-by phase --threads 2", tu_pfsph_bin(), scene, shot, dump);
+    int st = tu_run(cmd, out, sizeof out);
+    print_message("%s", out);
+    assert_int_equal(st, 0);
+    img m = read_png(shot);
+    assert_int_equal(m.w, 320);
+    assert_int_equal(m.h, 240);
+
+    pfsph_error err = {0};
+    pfsph_particles fl = {0};
+    double t = 0;
+    snprintf(p, sizeof p, "%s/fluid.vtp", dump);
+    assert_int_equal(pfsph_read_vtp(p, &fl, &t, &err), PFSPH_OK);
+    print_message("frame drawn: t = %.4f s, %zu fluid particles\n", t, fl.n);
+    assert_true(t > 0); /* it did step */
+    /* the camera: the renderer's for the initial particles */
+    pfsph_scene *sc = malloc(sizeof *sc);
+    assert_int_equal(pfsph_scene_load(sc, scene, &err), PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    assert_int_equal(pfsph_sim_create(&sim, sc, &err), PFSPH_OK);
+    pfsph_render_camera cam;
+    pfsph_render_camera_for(sc, pfsph_sim_ctx(sim)->fluid, pfsph_sim_ctx(sim)->boundary, m.w, m.h, &cam);
+    assert_true(cam.ortho);
+    unsigned char *pred = calloc((size_t)m.w * m.h, 1);
+    const double rad = 1.3 * sc->particle_radius * cam.f;
+    for (size_t i = 0; i < fl.n; i++) {
+        double sx = 0.5 * m.w + (fl.x[i] - cam.cx) * cam.f, sy = 0.5 * m.h - (fl.y[i] - cam.cy) * cam.f;
+        for (int y = (int)floor(sy - rad); y <= (int)ceil(sy + rad); y++)
+            for (int x = (int)floor(sx - rad); x <= (int)ceil(sx + rad); x++) {
+                if (x < 0 || y < 0 || x >= m.w || y >= m.h) continue;
+                double dx = x + 0.5 - sx, dy = y + 0.5 - sy;
+                if (dx * dx + dy * dy <= rad * rad) pred[(size_t)y * m.w + x] = 1;
+            }
+    }
+    unsigned char *got = mask_of(&m);
+    size_t na, nb;
+    double q = iou(got, pred, (size_t)m.w * m.h, &na, &nb);
+    print_message("live 2D: %zu particle pixels drawn, %zu predicted, IoU %.4f (at least 0.9)\n", na, nb, q);
+    assert_true(nb > 2000);
+    assert_true(q >= 0.9);
+    free(pred);
+    free(got);
+    free(m.rgb);
+    pfsph_particles_free(&fl);
+    pfsph_sim_destroy(sim);
+    free(sc);
+}
+
+/* Replay of frame `frame` of a run against the renderer's PNG of it. Coarse: both masks in
+ * 4 x 4 pixel blocks (a block is on when half its pixels are), the renderer's caption rows
+ * left out; and the mean colour difference over pixels both call particles. Measured: IoU 1.0
+ * and a difference of 0.0006 (2D) and 0.0004 (3D) of full scale; asked: IoU >= 0.98 (a block
+ * or two of 1,000 to 2,300 may tip) and at most 0.02 (5 levels of 255). */
+static void compare_replay(const char *scene_text, const char *name, int frame, double min_iou, double max_diff)
+{
+    const char *dir = tu_tmpdir();
+    char scene[600], run[600], cmd[2400], out[4096], shot[700], ref[700];
+    write_scene(dir, name, scene_text, scene, sizeof scene);
+    snprintf(run, sizeof run, "%s/run_%s", dir, name);
+    snprintf(cmd, sizeof cmd, "%s run %s -o %s --render --quiet --threads 2", tu_pfsph_bin(), scene, run);
+    int st = tu_run(cmd, out, sizeof out);
+    if (st) print_message("%s", out);
+    assert_int_equal(st, 0);
+    snprintf(shot, sizeof shot, "%s/replay.png", run);
+    snprintf(cmd, sizeof cmd, "%s view %s --frame %d --screenshot %s --frames 3 --no-overlay", tu_pfsph_bin(), run,
+             frame, shot);
+    st = tu_run(cmd, out, sizeof out);
+    print_message("%s", out);
+    assert_int_equal(st, 0);
+    snprintf(ref, sizeof ref, "%s/png/frame_%05d.png", run, frame);
+    img a = read_png(ref), b = read_png(shot);
+    assert_int_equal(a.w, b.w);
+    assert_int_equal(a.h, b.h);
+    unsigned char *ma = mask_of(&a), *mb = mask_of(&b);
+    const int B = 4, bw = a.w / B, bh = (a.h - 20) / B; /* the caption sits in the last 13 rows */
+    unsigned char *ca = calloc((size_t)bw * bh, 1), *cb = calloc((size_t)bw * bh, 1);
+    for (int y = 0; y < bh; y++)
+        for (int x = 0; x < bw; x++) {
+            int sa = 0, sb = 0;
+            for (int v = 0; v < B; v++)
+                for (int u = 0; u < B; u++) {
+                    size_t o = (size_t)(y * B + v) * a.w + (size_t)(x * B + u);
+                    sa += ma[o];
+                    sb += mb[o];
+                }
+            ca[(size_t)y * bw + x] = sa * 2 >= B * B;
+            cb[(size_t)y * bw + x] = sb * 2 >= B * B;
+        }
+    size_t na, nb;
+    double q = iou(ca, cb, (size_t)bw * bh, &na, &nb);
+    double diff = 0;
+    size_t both = 0;
+    for (int y = 0; y < a.h - 20; y++)
+        for (int x = 0; x < a.w; x++) {
+            size_t o = (size_t)y * a.w + x;
+            if (!ma[o] || !mb[o]) continue;
+            for (int c = 0; c < 3; c++) diff += fabs((double)a.rgb[3 * o + c] - b.rgb[3 * o + c]) / 255.0 / 3;
+            both++;
+        }
+    diff = both ? diff / both : 1;
+    print_message("%s frame %d: %zu blocks (renderer) / %zu (viewer), IoU %.4f (at least %.2f); mean colour "
+                  "difference %.4f (at most %.2f) over %zu pixels\n", name, frame, na, nb, q, min_iou, diff, max_diff,
+                  both);
+    assert_true(na > 100);
+    assert_true(q >= min_iou);
+    assert_true(diff <= max_diff);
+    free(ca);
+    free(cb);
+    free(ma);
+    free(mb);
+    free(a.rgb);
+    free(b.rgb);
+}
+
+static void test_replay_2d(void **state)
+{
+    (void)state;
+    if (!viewer_available()) skip();
+    compare_replay(SCENE2D, "replay2d.json", 3, 0.98, 0.02);
+}
+
+static void test_replay_3d(void **state)
+{
+    (void)state;
+    if (!viewer_available()) skip();
+    compare_replay(SCENE3D, "replay3d.json", 2, 0.98, 0.02);
+}
+
+/* Bad input: exit status 2 and a message naming the problem, before any window opens. */
+static void test_bad_input(void **state)
+{
+    (void)state;
+    char cmd[1400], out[4096];
+    snprintf(cmd, sizeof cmd, "%s view /nonexistent/scene.json --screenshot /tmp/x.png", tu_pfsph_bin());
+    int st = tu_run(cmd, out, sizeof out);
+#ifndef PFSPH_HAVE_VIEWER
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(out, "this build has no viewer"));
+    return;
+#endif
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(out, "/nonexistent/scene.json"));
+    snprintf(cmd, sizeof cmd, "%s view --color-by vorticity --screenshot /tmp/x.png", tu_pfsph_bin());
+    assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "vorticity"));
+    snprintf(cmd, sizeof cmd, "%s view --frames 0", tu_pfsph_bin());
+    assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    snprintf(cmd, sizeof cmd, "%s view --hide water", tu_pfsph_bin());
+    assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "water"));
+    snprintf(cmd, sizeof cmd, "%s view %s --frame 99999 --screenshot /tmp/x.png", tu_pfsph_bin(), tu_tmpdir());
+    assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "scene.json"));
+}
+
+int main(int argc, char **argv)
+{
+    tu_init(argc, argv);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_live_2d),
+        cmocka_unit_test(test_replay_2d),
+        cmocka_unit_test(test_replay_3d),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
