@@ -26,7 +26,7 @@ static const char *USAGE =
     "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
-    "                            [--size WxH] [--particles]\n"
+    "                            [--size WxH] [--particles] [--all-walls] [--no-legend]\n"
     "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
     "       pfsph export RUN_DIR --houdini\n"
     "       pfsph view [SCENE | RUN_DIR] [--screenshot FILE --frames N] [...]\n"
@@ -93,6 +93,9 @@ static const char *HELP_RENDER =
     "  --video                 also RUN_DIR/frames.mp4 (needs ffmpeg on the PATH)\n"
     "  --particles             fluid particles even where liquid meshes exist (frames/liquid_*.ply,\n"
     "                          `pfsph mesh`), which are otherwise drawn as a water surface\n"
+    "  --all-walls             3D: keep the tank walls facing the camera (cut away by default,\n"
+    "                          so that what stands in the tank shows)\n"
+    "  --no-legend             no colour bar for the field the fluid is coloured by\n"
     "  --color-by FIELD        phase, speed, density or pressure (default: the scene camera's)\n"
     "  --size WxH              image size in pixels, 16..16384 each (default: the camera's)\n"
     "  -h, --help              this text\n";
@@ -519,6 +522,8 @@ static int cmd_render(int argc, char **argv)
             return 0;
         } else if (!strcmp(a, "--video")) o.video = true;
         else if (!strcmp(a, "--particles")) o.particles = true;
+        else if (!strcmp(a, "--all-walls")) o.all_walls = true;
+        else if (!strcmp(a, "--no-legend")) o.no_legend = true;
         else if (!strcmp(a, "--color-by")) {
             if (++i >= argc) return usage_error("%s needs a field", a);
             o.color_by = argv[i];

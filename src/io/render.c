@@ -620,6 +620,7 @@ typedef struct ctx {
     cam c;
     int ss;       /* supersampling factor */
     int out_w, out_h;
+    bool all_walls, no_legend;
     int color_by;
     double vref;  /* speed colour scale: sqrt(2 g H) of the first frame's fluid, 0 if none */
     image im;
@@ -759,7 +760,7 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     /* 2D fluid discs are drawn a little larger than the particle so that a block of fluid
      * reads as a surface rather than a lattice with holes (spacing is 2r). */
     const int ssf = x->ss;
-    cutaway cw = {.on = !d2 && bnd && bnd->n, .m = 5 * r, .up = 1};
+    cutaway cw = {.on = !d2 && bnd && bnd->n && !x->all_walls, .m = 5 * r, .up = 1};
     if (cw.on) {
         box3 bb;
         box_empty(&bb);
@@ -886,7 +887,7 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     snprintf(cap, sizeof cap, "frame %d  t=%.3f s", frame, time);
     int tsc = oh >= 400 ? 2 : 1;
     draw_text(x->rgb, ow, oh, 6 * tsc, oh - 9 * tsc - 4, tsc, cap);
-    if (x->color_by != COLOR_PHASE && !mesh) draw_legend(x->rgb, ow, oh, tsc, range);
+    if (x->color_by != COLOR_PHASE && !mesh && !x->no_legend) draw_legend(x->rgb, ow, oh, tsc, range);
 
     membuf m = {0};
     if (png_encode(x->rgb, ow, oh, &m) != 0) {
@@ -1047,6 +1048,8 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
 
     const char *cby = o->color_by ? o->color_by : sc->camera.color_by;
     x.color_by = color_code(cby);
+    x.all_walls = o->all_walls;
+    x.no_legend = o->no_legend;
     if (x.color_by < 0) {
         rc = pfsph_fail(err, PFSPH_EINPUT,
                         "color_by '%s': expected phase, speed, density or pressure", cby);
