@@ -86,6 +86,7 @@ static const char *HELP_CHECK =
 
 static const char *HELP_RENDER =
     "usage: pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure] [--size WxH]\n"
+    "                            [--particles] [--all-walls] [--no-legend]\n"
     "\n"
     "Render the frames of RUN_DIR/frames into RUN_DIR/png/frame_NNNNN.png with the scene's\n"
     "camera (RUN_DIR/scene.json).\n"
