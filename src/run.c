@@ -2,6 +2,7 @@
 #include "pfsph/run.h"
 
 #include "pfsph/bodies.h"
+#include "pfsph/meshing.h"
 #include "pfsph/surface_io.h"
 
 #include <cjson/cJSON.h>
@@ -71,7 +72,7 @@ static void run_unlock(int fd)
 /* "<prefix><digits>.<ext>" with prefix one of the frame sets; *num receives the digits. */
 static int frame_file(const char *name, long *num)
 {
-    static const char *const sets[] = {"fluid_", "boundary_", "diffuse_", "bodies_", "surfaces_", "frame_", NULL};
+    static const char *const sets[] = {"fluid_", "boundary_", "diffuse_", "bodies_", "surfaces_", "liquid_", "frame_", NULL};
     for (int k = 0; sets[k]; k++) {
         size_t l = strlen(sets[k]);
         if (strncmp(name, sets[k], l) != 0) continue;
@@ -80,7 +81,8 @@ static int frame_file(const char *name, long *num)
         int digits = 0;
         while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
         if (!digits) return 0;
-        if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png")) {
+        if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj") ||
+            !strcmp(p, ".geo")) {
             *num = v;
             return 1;
         }
@@ -107,6 +109,8 @@ static int is_run_file(const char *name)
                                         "diffuse_counts.png", "frames.mp4", NULL};
     for (int k = 0; names[k]; k++)
         if (!strcmp(name, names[k])) return 1;
+    size_t len = strlen(name); /* the .pvd collections (io/meshing.c) */
+    if (len > 4 && !strcmp(name + len - 4, ".pvd")) return 1;
     return is_temporary(name);
 }
 
@@ -232,7 +236,8 @@ static int write_set(const pfsph_scene *s, const char *dir, const char *name, in
                        .write_id = (s->output.fields & PFSPH_OUT_ID) != 0,
                        .write_speed = (s->output.fields & PFSPH_OUT_SPEED) != 0,
                        .aux_name = aux,
-                       .time = time};
+                       .time = time,
+                       .diffuse = !strcmp(name, "diffuse")};
     int rc;
     if (s->output.vtp) {
         snprintf(path, sizeof path, "%s/frames/%s_%05d.vtp", dir, name, frame);
@@ -318,6 +323,17 @@ static void bodies_rows(FILE *f, int frame, const pfsph_sim *sim)
     fflush(f);
 }
 
+/* Liquid surface meshes (output.surface) and the .pvd collections, after a frame's sets. */
+static int write_frame_extras(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid,
+                              double t, pfsph_error *err)
+{
+    int rc = PFSPH_OK;
+    if (s->output.surface.on) rc = pfsph_mesh_frame(s, dir, frame, fluid, t, NULL, err);
+    if (!rc && (s->output.vtp || (s->output.surface.on && s->output.surface.vtp)))
+        rc = pfsph_write_pvd_collections(dir, s->output.frame_interval / s->fps, err);
+    return rc;
+}
+
 static int write_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_sim *sim,
                        pfsph_error *err)
 {
@@ -348,6 +364,7 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
     const pfsph_particles *d = pfsph_sim_diffuse(sim);
     if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);
     if (!rc && B) rc = write_bodies(s, dir, frame, c->boundary, B, t, err);
+    if (!rc) rc = write_frame_extras(s, dir, frame, c->fluid, t, err);
     return rc;
 }
 
@@ -633,6 +650,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     int frame = frame0, written = 0;
     if (!resume) {
         fputs(header, csv);
+        pfsph_sim_prime_output(sim);
         rc = write_frame(s, dir, 0, sim, err);
         if (!rc) written++;
         csv_row(csv, 0, sim);

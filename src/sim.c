@@ -18,6 +18,7 @@
 #include "pfsph/thermostat.h"
 #include "physics/boundary.h"
 #include "physics/density.h"
+#include "physics/eos.h"
 #include "physics/solver.h"
 #include "physics/viscosity.h"
 #include "scene/shapes.h"
@@ -943,6 +944,23 @@ int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_par
     sim->ctx.step = st->step;
     sim->ctx.dt = st->stats.dt;
     return PFSPH_OK;
+}
+
+/* Frame 0's densities and pressures (issue 14): the grid sort and density summation a step
+ * begins with, and the Tait pressure of that density (the iterative solvers' own pressures need a
+ * step). Sorting an unsorted set here or in the first step gives the same order. */
+void pfsph_sim_prime_output(pfsph_sim *sim)
+{
+    blowup_info bad;
+    pfsph_error err;
+    const pfsph_scene *s = &sim->scene;
+    st_grid(sim, &bad, &err);
+    st_density(sim, &bad, &err); /* a blow-up is the first step's to report */
+    double rlo, rhi, rho_common = 0;
+    if (s->pressure_scale == PFSPH_PRESSURE_COMMON && pfsph_scene_density_range(s, &rlo, &rhi) && rlo > 0)
+        rho_common = rhi;
+    pfsph__tait(&sim->ctx, sim->ctx.nd, sim->sound_speed * sim->sound_speed / s->gamma, s->gamma, rho_common,
+                sim->fluid.p);
 }
 
 /* ---- changing the model while it runs (sim.h; docs/viewer.md) ---- */

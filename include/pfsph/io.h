@@ -8,13 +8,16 @@
 
 #include "pfsph/particles.h"
 
-/* What to write besides positions, velocities, density, pressure, phase (always written). */
+/* What to write besides positions, velocities, density, pressure, phase (always written, but see
+ * `diffuse`). */
 typedef struct pfsph_io_opts {
     int dim;              /* 2 or 3: 2D files still carry z = 0 */
     bool write_id;        /* uint32 "id" */
     bool write_speed;     /* float "speed" = |v| */
     const char *aux_name; /* name for the aux field, NULL to skip it (e.g. "volume", "lifetime") */
     double time;          /* simulated time, stored as field data / comment */
+    bool diffuse;         /* a diffuse set: the class is written as "type" (0 spray, 1 foam,
+                           * 2 bubble), no density or pressure (readers put "type" in phase) */
 } pfsph_io_opts;
 
 int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o,

@@ -12,6 +12,10 @@ typedef struct pfsph_render_opts {
     bool video;            /* also frames.mp4 via ffmpeg when present */
     int first, last;       /* frame range, last < 0 for all */
     bool quiet;            /* kept for callers; the library never prints (see progress) */
+    bool all_walls;        /* 3D: keep the walls that face the camera (default: cut away) */
+    bool no_legend;        /* no colour bar for the coloured field */
+    bool particles;        /* draw the fluid's particles even where frames/liquid_NNNNN.ply
+                            * (a surface mesh, shaded as water) exists */
     /* After each PNG: done of total frames, the file written (may be NULL); and a message
      * (the video written). Either may be NULL; both get `user`. */
     void (*progress)(int done, int total, const char *path, void *user);

@@ -101,6 +101,15 @@ typedef struct pfsph_body_def {
     pfsph_keyframe keys[PFSPH_MAX_KEYFRAMES];
 } pfsph_body_def;
 
+/* output.surface: liquid surface meshes while running (docs/surfaces.md) */
+typedef struct pfsph_surface_output {
+    bool on;
+    bool ply, obj, vtp; /* formats */
+    bool isotropic;     /* spherical kernels instead of Yu & Turk's anisotropic ones */
+    int smoothing;      /* Taubin passes */
+    double cell;        /* marching-cubes cell / spacing (0: default 0.5) */
+} pfsph_surface_output;
+
 typedef struct pfsph_output {
     char dir[PFSPH_PATH_LEN]; /* run directory */
     bool vtp, ply;            /* formats */
@@ -108,6 +117,7 @@ typedef struct pfsph_output {
     unsigned fields;          /* bitmask of extra fields, see PFSPH_OUT_* */
     int frame_interval;       /* write every n-th frame (1 = every frame) */
     int checkpoint_interval;  /* checkpoint every n-th frame (0 = never); docs/checkpoints.md */
+    pfsph_surface_output surface;
 } pfsph_output;
 
 enum { PFSPH_OUT_ID = 1u << 0, PFSPH_OUT_SPEED = 1u << 1 };

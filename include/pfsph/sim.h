@@ -35,6 +35,9 @@ void pfsph_sim_destroy(pfsph_sim *sim);
 int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err);
 /* Advance to exactly time t. */
 int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err);
+/* Before the first frame of a fresh run: sort, sum densities and set the Tait (equation of state)
+ * pressures, so frame 0 carries real values. */
+void pfsph_sim_prime_output(pfsph_sim *sim);
 
 double pfsph_sim_time(const pfsph_sim *sim);
 uint64_t pfsph_sim_steps(const pfsph_sim *sim);

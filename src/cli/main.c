@@ -10,6 +10,8 @@
 #include <unistd.h>
 
 #include "pfsph/bodies.h"
+#include "pfsph/houdini.h"
+#include "pfsph/meshing.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/render.h"
 #include "pfsph/run.h"
@@ -24,7 +26,9 @@ static const char *USAGE =
     "       pfsph run --resume RUN_DIR [--threads N] [--end T] [--render] [--quiet]\n"
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
-    "                            [--size WxH]\n"
+    "                            [--size WxH] [--particles] [--all-walls] [--no-legend]\n"
+    "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
+    "       pfsph export RUN_DIR --houdini\n"
     "       pfsph view [SCENE | RUN_DIR] [--screenshot FILE --frames N] [...]\n"
     "       pfsph --version\n"
     "       pfsph help [COMMAND]    (or pfsph COMMAND --help)\n";
@@ -36,6 +40,8 @@ static const char *HELP =
     "  run      simulate a scene into a run directory (frames, stats.csv, summary.json)\n"
     "  check    validate a scene: particle counts, memory estimate, coefficients\n"
     "  render   PNG previews (and an mp4) of a run directory's frames\n"
+    "  export   Houdini geometry (.geo) of a run directory's fluid frames\n"
+    "  mesh     liquid surface meshes (PLY, OBJ, VTP) of a 3D run directory's fluid frames\n"
     "  view     a window: a scene simulated live, or a run directory replayed\n"
     "  help     this text, or a command's: pfsph help run\n"
     "  --version  the version, precision and OpenMP thread count\n"
@@ -80,14 +86,46 @@ static const char *HELP_CHECK =
 
 static const char *HELP_RENDER =
     "usage: pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure] [--size WxH]\n"
+    "                            [--particles] [--all-walls] [--no-legend]\n"
     "\n"
     "Render the frames of RUN_DIR/frames into RUN_DIR/png/frame_NNNNN.png with the scene's\n"
     "camera (RUN_DIR/scene.json).\n"
     "\n"
     "  --video                 also RUN_DIR/frames.mp4 (needs ffmpeg on the PATH)\n"
+    "  --particles             fluid particles even where liquid meshes exist (frames/liquid_*.ply,\n"
+    "                          `pfsph mesh`), which are otherwise drawn as a water surface\n"
+    "  --all-walls             3D: keep the tank walls facing the camera (cut away by default,\n"
+    "                          so that what stands in the tank shows)\n"
+    "  --no-legend             no colour bar for the field the fluid is coloured by\n"
     "  --color-by FIELD        phase, speed, density or pressure (default: the scene camera's)\n"
     "  --size WxH              image size in pixels, 16..16384 each (default: the camera's)\n"
     "  -h, --help              this text\n";
+
+static const char *HELP_MESH =
+    "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
+    "\n"
+    "Reconstruct the liquid surface of every fluid frame of RUN_DIR (a finished or stopped 3D\n"
+    "run) into RUN_DIR/frames/liquid_NNNNN.{ply,obj,vtp}, one closed mesh per fluid phase with\n"
+    "the phase per face, and rewrite the .pvd collections. Anisotropic kernels (Yu & Turk 2013);\n"
+    "docs/surfaces.md. Settings default to the scene's output.surface.\n"
+    "\n"
+    "  --formats LIST  comma-separated: ply, obj, vtp (default: the scene's, else ply,vtp)\n"
+    "  --smooth N      Taubin smoothing passes of the mesh, 0..100 (default 0)\n"
+    "  --isotropic     spherical kernels instead of anisotropic ones\n"
+    "  --threads N     OpenMP threads (the meshes are the same bytes for any count)\n"
+    "  -h, --help      this text\n"
+    "\n"
+    "A 2D run is refused (exit status 2): meshes are 3D only.\n";
+
+static const char *HELP_EXPORT =
+    "usage: pfsph export RUN_DIR --houdini\n"
+    "\n"
+    "Write every fluid frame of RUN_DIR as Houdini ASCII geometry, RUN_DIR/frames/fluid_NNNNN.geo:\n"
+    "points with the attributes v, density, pressure, phase and id (id is 0 unless the run wrote\n"
+    "ids: output.fields [\"id\"]). docs/surfaces.md#houdini.\n"
+    "\n"
+    "  --houdini   the format (the only one so far)\n"
+    "  -h, --help  this text\n";
 
 static int is_help(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h"); }
 
@@ -484,6 +522,9 @@ static int cmd_render(int argc, char **argv)
             fputs(HELP_RENDER, stdout);
             return 0;
         } else if (!strcmp(a, "--video")) o.video = true;
+        else if (!strcmp(a, "--particles")) o.particles = true;
+        else if (!strcmp(a, "--all-walls")) o.all_walls = true;
+        else if (!strcmp(a, "--no-legend")) o.no_legend = true;
         else if (!strcmp(a, "--color-by")) {
             if (++i >= argc) return usage_error("%s needs a field", a);
             o.color_by = argv[i];
@@ -504,6 +545,86 @@ static int cmd_render(int argc, char **argv)
         return exit_code(rc);
     }
     printf("rendered %d frames into %s/png\n", count, dir);
+    return 0;
+}
+
+static int cmd_export(int argc, char **argv)
+{
+    const char *dir = NULL;
+    bool houdini = false;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (is_help(a)) {
+            fputs(HELP_EXPORT, stdout);
+            return 0;
+        } else if (!strcmp(a, "--houdini")) houdini = true;
+        else if (a[0] == '-') return usage_error("unknown option '%s'", a);
+        else if (!dir) dir = a;
+        else return usage_error("unexpected argument '%s'", a);
+    }
+    if (!dir) return usage_error("%s", "export needs a run directory");
+    if (!houdini) return usage_error("%s", "export needs a format: --houdini");
+    pfsph_error err = {0};
+    int count = 0;
+    int rc = pfsph_export_houdini(dir, &count, &err);
+    if (rc) {
+        print_error(NULL, err.msg);
+        return exit_code(rc);
+    }
+    printf("exported %d frames into %s/frames/fluid_NNNNN.geo\n", count, dir);
+    return 0;
+}
+
+static int cmd_mesh(int argc, char **argv)
+{
+    const char *dir = NULL;
+    pfsph_surface_output so = {.on = true};
+    bool set = false;
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (is_help(a)) {
+            fputs(HELP_MESH, stdout);
+            return 0;
+        } else if (!strcmp(a, "--formats")) {
+            if (++i >= argc) return usage_error("%s needs a list", a);
+            so.ply = strstr(argv[i], "ply") != NULL;
+            so.obj = strstr(argv[i], "obj") != NULL;
+            so.vtp = strstr(argv[i], "vtp") != NULL;
+            char tmp[256];
+            snprintf(tmp, sizeof tmp, "%s", argv[i]);
+            for (char *t = strtok(tmp, ","); t; t = strtok(NULL, ","))
+                if (strcmp(t, "ply") && strcmp(t, "obj") && strcmp(t, "vtp"))
+                    return usage_error("--formats: unknown format '%s' (ply, obj, vtp)", t);
+            set = true;
+        } else if (!strcmp(a, "--smooth")) {
+            char *end = NULL;
+            long v = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : -1;
+            if (i + 1 >= argc || *end || v < 0 || v > 100)
+                return usage_error("--smooth: '%s' is not 0..100", i + 1 < argc ? argv[i + 1] : "");
+            so.smoothing = (int)v;
+            i++;
+            set = true;
+        } else if (!strcmp(a, "--isotropic")) so.isotropic = set = true;
+        else if (!strcmp(a, "--threads")) {
+            char *end = NULL;
+            long v = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : -1;
+            if (i + 1 >= argc || *end || v < 1 || v > 1024)
+                return usage_error("--threads: '%s' is not 1..1024", i + 1 < argc ? argv[i + 1] : "");
+            omp_set_num_threads((int)v);
+            i++;
+        } else if (a[0] == '-') return usage_error("unknown option '%s'", a);
+        else if (!dir) dir = a;
+        else return usage_error("unexpected argument '%s'", a);
+    }
+    if (!dir) return usage_error("%s", "mesh needs a run directory");
+    pfsph_error err = {0};
+    int count = 0;
+    int rc = pfsph_mesh_run(dir, set ? &so : NULL, &count, &err);
+    if (rc) {
+        print_error(NULL, err.msg);
+        return exit_code(rc);
+    }
+    printf("meshed %d frames into %s/frames/liquid_NNNNN.*\n", count, dir);
     return 0;
 }
 
@@ -538,6 +659,8 @@ int main(int argc, char **argv)
         else if (!strcmp(topic, "run")) fputs(HELP_RUN, stdout);
         else if (!strcmp(topic, "check")) fputs(HELP_CHECK, stdout);
         else if (!strcmp(topic, "render")) fputs(HELP_RENDER, stdout);
+        else if (!strcmp(topic, "mesh")) fputs(HELP_MESH, stdout);
+        else if (!strcmp(topic, "export")) fputs(HELP_EXPORT, stdout);
         else if (!strcmp(topic, "view")) {
             char h[] = "--help";
             char *v[] = {h, NULL};
@@ -549,6 +672,8 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);
     if (!strcmp(cmd, "check")) return cmd_check(argc - 2, argv + 2);
     if (!strcmp(cmd, "render")) return cmd_render(argc - 2, argv + 2);
+    if (!strcmp(cmd, "mesh")) return cmd_mesh(argc - 2, argv + 2);
+    if (!strcmp(cmd, "export")) return cmd_export(argc - 2, argv + 2);
     if (!strcmp(cmd, "view")) return cmd_view(argc - 2, argv + 2);
     return usage_error("unknown command '%s'", cmd);
 }

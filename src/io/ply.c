@@ -29,8 +29,9 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
     pfsph__enc_printf(&e, "comment time %.17g\n", o->time);
     pfsph__enc_printf(&e, "element vertex %zu\n", n);
     static const char *const names[] = {"x", "y", "z", "vx", "vy", "vz", "density", "pressure"};
-    for (int k = 0; k < 8; k++) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, names[k]);
-    pfsph__enc_printf(&e, "property uchar phase\n");
+    const int nreal = o->diffuse ? 6 : 8; /* diffuse sets: no density, pressure */
+    for (int k = 0; k < nreal; k++) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, names[k]);
+    pfsph__enc_printf(&e, "property uchar %s\n", o->diffuse ? "type" : "phase");
     if (o->write_id) pfsph__enc_printf(&e, "property uint id\n");
     if (o->write_speed) pfsph__enc_printf(&e, "property %s speed\n", REAL_PLY);
     if (o->aux_name) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, o->aux_name);
@@ -44,8 +45,10 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
         pfsph__enc_put(&e, &ps->vx[i], rs);
         pfsph__enc_put(&e, &ps->vy[i], rs);
         pfsph__enc_put(&e, d2 ? &zero : &ps->vz[i], rs);
-        pfsph__enc_put(&e, &ps->rho[i], rs);
-        pfsph__enc_put(&e, &ps->p[i], rs);
+        if (!o->diffuse) {
+            pfsph__enc_put(&e, &ps->rho[i], rs);
+            pfsph__enc_put(&e, &ps->p[i], rs);
+        }
         pfsph__enc_put(&e, &ps->phase[i], 1);
         if (o->write_id) pfsph__enc_put(&e, &ps->id[i], 4);
         if (o->write_speed) {
@@ -195,8 +198,8 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
             rdst[k] = ps->f[r]; /* x y z vx vy vz rho p are the first 8 fields, in this order */
             kind[k] = 1;
             if (r < 3) have_xyz[r] = true;
-        } else if (strcmp(pr->name, "phase") == 0) {
-            if (pr->type != PFSPH__T_U8) BAD("property 'phase' must be uchar");
+        } else if (strcmp(pr->name, "phase") == 0 || strcmp(pr->name, "type") == 0) {
+            if (pr->type != PFSPH__T_U8) BAD("property '%s' must be uchar", pr->name);
             kind[k] = 2;
         } else if (strcmp(pr->name, "id") == 0) {
             if (pr->type != PFSPH__T_U32) BAD("property 'id' must be uint");

@@ -2,6 +2,7 @@
  * disc with per-pixel depth, Lambert + ambient + a little specular), z-buffered, supersampled
  * 2x2, then written with libpng through the atomic writer; optionally an ffmpeg video. */
 #include "pfsph/render.h"
+#include "pfsph/surface_mesh.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -362,9 +363,29 @@ typedef struct splat_set {
     size_t n, cap;
 } splat_set;
 
+/* The walls of a tank that face the camera (3D): particles within `m` of a face of the
+ * boundary's box on the camera's side, sideways or above (never the floor), so that what stands
+ * inside the tank shows. */
+typedef struct cutaway {
+    bool on;
+    double lo[3], hi[3], m;
+    int up; /* the axis against gravity */
+} cutaway;
+
+static bool cut_away(const cutaway *cw, const cam *c, const double p[3])
+{
+    if (!cw || !cw->on) return false;
+    for (int a = 0; a < 3; a++) {
+        if (c->eye[a] > cw->hi[a] && p[a] > cw->hi[a] - cw->m) return true;
+        if (a != cw->up && c->eye[a] < cw->lo[a] && p[a] < cw->lo[a] + cw->m) return true;
+    }
+    return false;
+}
+
 static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, double rad,
                    int layer, int kind /* 0 fluid, 1 boundary, 2 diffuse, 3 bodies */,
-                   const pfsph_scene *sc, int by, double vref, int ssf)
+                   const pfsph_scene *sc, int by, double vref, int ssf, const cutaway *cw,
+                   double range[2])
 {
     if (ss->n + ps->n > ss->cap) {
         size_t cap = ss->n + ps->n;
@@ -376,9 +397,11 @@ static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, doubl
     double lo = 0, hi = 1;
     if (kind == 0 && by != COLOR_PHASE) field_range(ps, by, &lo, &hi);
     if (kind == 0 && by == COLOR_SPEED && vref > 0) hi = vref;
+    if (range) range[0] = lo, range[1] = hi;
     for (size_t i = 0; i < ps->n; i++) {
         double p[3] = {ps->x[i], ps->y[i], sc->dim == 2 ? 0.0 : ps->z[i]};
         if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
+        if (kind == 1 && cut_away(cw, c, p)) continue;
         splat *s = &ss->s[ss->n];
         if (!project(c, p, rad, s)) continue;
         s->layer = (uint8_t)layer;
@@ -511,6 +534,31 @@ static void draw_text(uint8_t *rgb, int w, int h, int x0, int y0, int sc, const 
     }
 }
 
+/* A colour bar at the right edge for the field the fluid is coloured by, its range at the ends
+ * (the numbers in the built-in font: digits, '.', '-', 'e'). */
+static void draw_legend(uint8_t *rgb, int w, int h, int sc, const double range[2])
+{
+    const int bw = 10 * sc, bh = h / 3, x0 = w - bw - 8 * sc - 40 * sc, y0 = h / 3;
+    if (x0 < 0 || bh < 8) return;
+    for (int y = 0; y < bh; y++) {
+        float c[3];
+        colormap(1.0 - (double)y / (bh - 1), c);
+        for (int x = 0; x < bw; x++) {
+            uint8_t *p = rgb + 3 * ((size_t)(y0 + y) * w + x0 + x);
+            for (int k = 0; k < 3; k++) p[k] = (uint8_t)lrint(c[k] * 255.0f);
+        }
+    }
+    for (int e = 0; e < 2; e++) {
+        char num[32], out[32];
+        snprintf(num, sizeof num, "%.3g", range[1 - e]);
+        size_t j = 0; /* "1.5e+03" -> "1.5e03": the font has no '+' */
+        for (const char *t = num; *t && j + 1 < sizeof out; t++)
+            if (*t != '+') out[j++] = *t;
+        out[j] = 0;
+        draw_text(rgb, w, h, x0 + bw + 3 * sc, e ? y0 + bh - 7 * sc : y0, sc, out);
+    }
+}
+
 /* ---- PNG ------------------------------------------------------------------------------- */
 
 typedef struct membuf {
@@ -572,6 +620,7 @@ typedef struct ctx {
     cam c;
     int ss;       /* supersampling factor */
     int out_w, out_h;
+    bool all_walls, no_legend;
     int color_by;
     double vref;  /* speed colour scale: sqrt(2 g H) of the first frame's fluid, 0 if none */
     image im;
@@ -580,11 +629,127 @@ typedef struct ctx {
     size_t *bstart;
     size_t bcap;
     uint8_t *rgb;
+    float *mn;     /* camera-space normals of liquid-mesh pixels (layer 0, id MESH_ID) */
 } ctx;
 
+#define MESH_ID UINT32_MAX
+
+/* The liquid surface (frames/liquid_NNNNN.ply, io/meshing.c's layout) into m; -1 when absent. */
+static int read_liquid(const char *path, pfsph_surface_mesh *m)
+{
+    memset(m, 0, sizeof *m);
+    unsigned char *d = NULL;
+    size_t len;
+    pfsph_error e;
+    FILE *f = fopen(path, "rb");
+    if (!f) return -1;
+    fclose(f);
+    if (pfsph__read_file(path, &d, &len, &e)) return -1;
+    const char *h = (const char *)d, *end = strstr(h, "end_header\n"), *ev = strstr(h, "element vertex "),
+               *ef = strstr(h, "element face ");
+    size_t nv = 0, nt = 0;
+    int ok = end && ev && ef && sscanf(ev, "element vertex %zu", &nv) == 1 && sscanf(ef, "element face %zu", &nt) == 1 &&
+             strstr(h, "property float nz") && strstr(h, "property uchar phase");
+    size_t off = ok ? (size_t)(end - h) + 11 : 0;
+    ok = ok && nv < (1u << 31) && nt < (1u << 31) && off + nv * 24 + nt * 14 == len;
+    if (ok) {
+        m->v = malloc(3 * (nv ? nv : 1) * sizeof *m->v);
+        m->n = malloc(3 * (nv ? nv : 1) * sizeof *m->n);
+        m->tri = malloc(3 * (nt ? nt : 1) * sizeof *m->tri);
+        ok = m->v && m->n && m->tri;
+    }
+    for (size_t i = 0; ok && i < nv; i++) {
+        float q[6];
+        for (int k = 0; k < 6; k++) pfsph__get_le(&q[k], d + off + 24 * i + 4 * k, 4);
+        for (int k = 0; k < 3; k++) m->v[3 * i + k] = q[k], m->n[3 * i + k] = q[3 + k];
+    }
+    for (size_t t = 0; ok && t < nt; t++) {
+        const unsigned char *r = d + off + 24 * nv + 14 * t;
+        for (int k = 0; k < 3; k++) {
+            pfsph__get_le(&m->tri[3 * t + k], r + 1 + 4 * k, 4);
+            if (r[0] != 3 || m->tri[3 * t + k] >= nv) ok = 0;
+        }
+    }
+    free(d);
+    if (!ok) {
+        pfsph_surface_mesh_free(m);
+        return -1;
+    }
+    m->nverts = nv;
+    m->ntris = nt;
+    return 0;
+}
+
+/* Depth-test the liquid's triangles into layer 0 (serial: the same pixels for any thread count). */
+static void raster_mesh(ctx *x, const pfsph_surface_mesh *m)
+{
+    const cam *c = &x->c;
+    image *im = &x->im;
+    for (size_t t = 0; t < m->ntris; t++) {
+        splat s[3];
+        float n[3][3];
+        int ok = 1;
+        for (int k = 0; k < 3; k++) {
+            uint32_t v = m->tri[3 * t + k];
+            double p[3] = {m->v[3 * v], m->v[3 * v + 1], m->v[3 * v + 2]};
+            if (!project(c, p, 0, &s[k])) ok = 0;
+            double nw[3] = {m->n[3 * v], m->n[3 * v + 1], m->n[3 * v + 2]};
+            n[k][0] = (float)dot3(nw, c->right);
+            n[k][1] = (float)dot3(nw, c->up);
+            n[k][2] = (float)-dot3(nw, c->fwd);
+        }
+        if (!ok) continue;
+        float area = (s[1].sx - s[0].sx) * (s[2].sy - s[0].sy) - (s[2].sx - s[0].sx) * (s[1].sy - s[0].sy);
+        if (!(fabsf(area) > 1e-12f)) continue;
+        float xa = fminf(s[0].sx, fminf(s[1].sx, s[2].sx)), xb = fmaxf(s[0].sx, fmaxf(s[1].sx, s[2].sx));
+        float ya = fminf(s[0].sy, fminf(s[1].sy, s[2].sy)), yb = fmaxf(s[0].sy, fmaxf(s[1].sy, s[2].sy));
+        int x0 = (int)floorf(xa), x1 = (int)ceilf(xb), y0 = (int)floorf(ya), y1 = (int)ceilf(yb);
+        if (x0 < 0) x0 = 0;
+        if (y0 < 0) y0 = 0;
+        if (x1 > im->w - 1) x1 = im->w - 1;
+        if (y1 > im->h - 1) y1 = im->h - 1;
+        for (int py = y0; py <= y1; py++)
+            for (int px = x0; px <= x1; px++) {
+                float fx = (float)px + 0.5f, fy = (float)py + 0.5f, w[3];
+                for (int k = 0; k < 3; k++) {
+                    const splat *a = &s[(k + 1) % 3], *b = &s[(k + 2) % 3];
+                    w[k] = ((b->sx - a->sx) * (fy - a->sy) - (fx - a->sx) * (b->sy - a->sy)) / area;
+                }
+                if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
+                float z = w[0] * s[0].depth + w[1] * s[1].depth + w[2] * s[2].depth;
+                size_t o = (size_t)py * (size_t)im->w + (size_t)px;
+                if (!(z < im->z[0][o])) continue;
+                im->z[0][o] = z;
+                im->id[0][o] = MESH_ID;
+                for (int k = 0; k < 3; k++) x->mn[3 * o + k] = w[0] * n[0][k] + w[1] * n[1][k] + w[2] * n[2][k];
+            }
+    }
+}
+
+/* Water: a blue body, Lambert light, a sharp highlight and Schlick's Fresnel towards the sky. */
+static void shade_water(const float nin[3], float out[3])
+{
+    static const float L[3] = {-0.45f, 0.62f, 0.64f}, Hv[3] = {-0.2116f, 0.2915f, 0.9328f};
+    static const float base[3] = {0.13f, 0.38f, 0.72f}, sky[3] = {0.86f, 0.91f, 0.96f};
+    float len = sqrtf(nin[0] * nin[0] + nin[1] * nin[1] + nin[2] * nin[2]);
+    float n[3] = {0, 0, 1};
+    if (len > 0)
+        for (int k = 0; k < 3; k++) n[k] = nin[k] / len;
+    if (n[2] < 0) n[2] = -n[2];
+    float diff = fmaxf(0.0f, n[0] * L[0] + n[1] * L[1] + n[2] * L[2]);
+    float sp = fmaxf(0.0f, n[0] * Hv[0] + n[1] * Hv[1] + n[2] * Hv[2]);
+    float spec = powf(sp, 60.0f);
+    float fr = 0.04f + 0.96f * powf(1.0f - n[2], 5.0f);
+    for (int k = 0; k < 3; k++) {
+        float v = base[k] * (0.35f + 0.65f * diff) * (1 - fr) + sky[k] * fr + 0.7f * spec;
+        out[k] = v < 0 ? 0 : (v > 1 ? 1 : v);
+    }
+}
+
 static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_particles *bnd,
-                        const pfsph_particles *bod, const pfsph_particles *dif, int frame,
-                        double time, const char *png_path, pfsph_error *err)
+                        const pfsph_particles *bod, const pfsph_particles *dif,
+                        const pfsph_surface_mesh *liq, int frame, double time, const char *png_path,
+                        pfsph_error *err)
 {
     const pfsph_scene *sc = x->sc;
     const double r = sc->particle_radius > 0 ? sc->particle_radius : 0.01;
@@ -595,16 +760,28 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     /* 2D fluid discs are drawn a little larger than the particle so that a block of fluid
      * reads as a surface rather than a lattice with holes (spacing is 2r). */
     const int ssf = x->ss;
+    cutaway cw = {.on = !d2 && bnd && bnd->n && !x->all_walls, .m = 5 * r, .up = 1};
+    if (cw.on) {
+        box3 bb;
+        box_empty(&bb);
+        box_add(&bb, bnd);
+        memcpy(cw.lo, bb.lo, sizeof cw.lo);
+        memcpy(cw.hi, bb.hi, sizeof cw.hi);
+        for (int a = 0; a < 3; a++)
+            if (fabs(sc->gravity[a]) > fabs(sc->gravity[cw.up])) cw.up = a;
+    }
+    double range[2] = {0, 1};
     if (bnd &&
-        (rc = add_set(&x->sp, &x->c, bnd, d2 ? 0.9 * r : r, 1, 1, sc, COLOR_PHASE, 0, ssf)))
+        (rc = add_set(&x->sp, &x->c, bnd, d2 ? 0.9 * r : r, 1, 1, sc, COLOR_PHASE, 0, ssf, &cw, NULL)))
         goto oom;
-    if ((rc = add_set(&x->sp, &x->c, fluid, d2 ? 1.3 * r : r, 0, 0, sc, x->color_by, x->vref,
-                      ssf)))
+    const bool mesh = liq && liq->ntris && !d2; /* the liquid's surface instead of its particles */
+    if (!mesh && (rc = add_set(&x->sp, &x->c, fluid, d2 ? 1.3 * r : r, 0, 0, sc, x->color_by, x->vref,
+                               ssf, NULL, range)))
         goto oom;
-    if (dif && (rc = add_set(&x->sp, &x->c, dif, 0.4 * r, 0, 2, sc, COLOR_PHASE, 0, ssf)))
+    if (dif && (rc = add_set(&x->sp, &x->c, dif, 0.4 * r, 0, 2, sc, COLOR_PHASE, 0, ssf, NULL, NULL)))
         goto oom;
     /* rigid bodies are drawn solid in their phase's colour, not as translucent walls */
-    if (bod && (rc = add_set(&x->sp, &x->c, bod, r, 0, 3, sc, COLOR_PHASE, 0, ssf)))
+    if (bod && (rc = add_set(&x->sp, &x->c, bod, r, 0, 3, sc, COLOR_PHASE, 0, ssf, NULL, NULL)))
         goto oom;
 
     if (x->sp.n > UINT32_MAX)
@@ -662,6 +839,10 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
         splat_band(&x->im, x->sp.s, x->bidx + x->bstart[b], x->bstart[b + 1] - x->bstart[b], y0,
                    y1);
     }
+    if (mesh) {
+        if (!x->mn && !(x->mn = malloc(3 * npix * sizeof *x->mn))) goto oom;
+        raster_mesh(x, liq);
+    }
 
     /* Composite and downsample: boundary walls in front of fluid are translucent in 3D. */
     const int ss = x->ss, ow = x->out_w, oh = x->out_h;
@@ -680,7 +861,10 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
                     double c[3];
                     float sc3[3];
                     bool hf = x->im.z[0][o] < FLT_MAX, hb = x->im.z[1][o] < FLT_MAX;
-                    if (hf) {
+                    if (hf && x->im.id[0][o] == MESH_ID) {
+                        shade_water(x->mn + 3 * o, sc3);
+                        for (int k = 0; k < 3; k++) c[k] = sc3[k];
+                    } else if (hf) {
                         shade(&x->sp.s[x->im.id[0][o]], px, py, false, sc3);
                         for (int k = 0; k < 3; k++) c[k] = sc3[k];
                     } else {
@@ -703,6 +887,7 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     snprintf(cap, sizeof cap, "frame %d  t=%.3f s", frame, time);
     int tsc = oh >= 400 ? 2 : 1;
     draw_text(x->rgb, ow, oh, 6 * tsc, oh - 9 * tsc - 4, tsc, cap);
+    if (x->color_by != COLOR_PHASE && !mesh && !x->no_legend) draw_legend(x->rgb, ow, oh, tsc, range);
 
     membuf m = {0};
     if (png_encode(x->rgb, ow, oh, &m) != 0) {
@@ -863,6 +1048,8 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
 
     const char *cby = o->color_by ? o->color_by : sc->camera.color_by;
     x.color_by = color_code(cby);
+    x.all_walls = o->all_walls;
+    x.no_legend = o->no_legend;
     if (x.color_by < 0) {
         rc = pfsph_fail(err, PFSPH_EINPUT,
                         "color_by '%s': expected phase, speed, density or pressure", cby);
@@ -952,9 +1139,13 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
             setup_camera(&x.c, sc, &fb);
             x.vref = speed_scale(sc, &fluid);
         }
+        pfsph_surface_mesh liq;
+        snprintf(path, sizeof path, "%s/liquid_%05d.ply", fdir, f);
+        int have_liq = o->particles ? -1 : read_liquid(path, &liq);
         snprintf(path, sizeof path, "%s/frame_%05d.png", pdir, f);
-        rc = render_frame(&x, &fluid, bi >= 0 ? &bnd : NULL, ri >= 0 ? &both : NULL, di >= 0 ? &dif : NULL, f,
-                          t, path, err);
+        rc = render_frame(&x, &fluid, bi >= 0 ? &bnd : NULL, ri >= 0 ? &both : NULL, di >= 0 ? &dif : NULL,
+                          have_liq == 0 ? &liq : NULL, f, t, path, err);
+        if (have_liq == 0) pfsph_surface_mesh_free(&liq);
         if (rc != PFSPH_OK) goto out;
         rendered++;
         if (o->progress) o->progress(rendered, total, path, o->user);
@@ -979,6 +1170,7 @@ out:
     free(x.bidx);
     free(x.bstart);
     free(x.rgb);
+    free(x.mn);
     free(sc);
     return rc;
 }

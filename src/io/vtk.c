@@ -36,7 +36,7 @@ static void put_reals(pfsph__enc *e, const pfsph_real *a, size_t n)
 int pfsph__check_aux_name(const char *path, const char *name, pfsph_error *err)
 {
     static const char *const taken[] = {"x", "y", "z", "vx", "vy", "vz", "velocity", "density",
-                                        "pressure", "phase", "id", "speed", "Points",
+                                        "pressure", "phase", "type", "id", "speed", "Points",
                                         "TimeValue", "connectivity", "offsets"};
     size_t len = strlen(name);
     if (len == 0 || len > 64)
@@ -76,9 +76,11 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
     int na = 0;
     arr[na++] = (vtp_array){A_TIME, "TimeValue", "Float64", 1, 8};
     arr[na++] = (vtp_array){A_VEL, "velocity", REAL_VTK, 3, 3 * rs * n};
-    arr[na++] = (vtp_array){A_RHO, "density", REAL_VTK, 1, rs * n};
-    arr[na++] = (vtp_array){A_P, "pressure", REAL_VTK, 1, rs * n};
-    arr[na++] = (vtp_array){A_PHASE, "phase", "UInt8", 1, n};
+    if (!o->diffuse) {
+        arr[na++] = (vtp_array){A_RHO, "density", REAL_VTK, 1, rs * n};
+        arr[na++] = (vtp_array){A_P, "pressure", REAL_VTK, 1, rs * n};
+    }
+    arr[na++] = (vtp_array){A_PHASE, o->diffuse ? "type" : "phase", "UInt8", 1, n};
     if (o->write_id) arr[na++] = (vtp_array){A_ID, "id", "UInt32", 1, 4 * (uint64_t)n};
     if (o->write_speed) arr[na++] = (vtp_array){A_SPEED, "speed", REAL_VTK, 1, rs * n};
     if (o->aux_name) arr[na++] = (vtp_array){A_AUX, o->aux_name, REAL_VTK, 1, rs * n};
@@ -103,7 +105,8 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
         case A_VEL:
             pfsph__enc_printf(&e, "    <Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
                  "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n", n, n);
-            pfsph__enc_printf(&e, "      <PointData Scalars=\"density\" Vectors=\"velocity\">\n");
+            pfsph__enc_printf(&e, "      <PointData Scalars=\"%s\" Vectors=\"velocity\">\n",
+                              o->diffuse ? "type" : "density");
             break;
         case A_POINTS: pfsph__enc_printf(&e, "      </PointData>\n      <Points>\n"); break;
         case A_CONN: pfsph__enc_printf(&e, "      </Points>\n      <Verts>\n"); break;
@@ -439,8 +442,8 @@ int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_er
             if (strcmp(a->name, "velocity") == 0) {
                 if (a->ncomp != 3 || !is_real) BAD("velocity must be 3 real components");
                 dst[0] = ps->vx, dst[1] = ps->vy, dst[2] = ps->vz;
-            } else if (strcmp(a->name, "phase") == 0) {
-                if (a->ncomp != 1 || a->type != PFSPH__T_U8) BAD("phase must be UInt8");
+            } else if (strcmp(a->name, "phase") == 0 || strcmp(a->name, "type") == 0) {
+                if (a->ncomp != 1 || a->type != PFSPH__T_U8) BAD("phase/type must be UInt8");
                 dst8 = ps->phase;
             } else if (strcmp(a->name, "id") == 0) {
                 if (a->ncomp != 1 || a->type != PFSPH__T_U32) BAD("id must be UInt32");

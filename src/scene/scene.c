@@ -756,15 +756,54 @@ static int check_blocks(parser *p)
     return PFSPH_OK;
 }
 
+/* output.surface: true, false or {"formats", "smoothing", "isotropic", "cell"} */
+static int parse_surface(parser *p, const cJSON *v)
+{
+    pfsph_surface_output *o = &p->s->output.surface;
+    if (!v) return PFSPH_OK;
+    const char *P = "$.output.surface";
+    if (cJSON_IsBool(v)) o->on = cJSON_IsTrue(v);
+    else if (cJSON_IsObject(v)) {
+        static const char *const keys[] = {"formats", "smoothing", "isotropic", "cell", NULL};
+        TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
+        o->on = true;
+        TRY(pfsph__json_int(v, P, "smoothing", 0, 100, &o->smoothing, &p->ctx));
+        TRY(pfsph__json_bool(v, P, "isotropic", &o->isotropic, &p->ctx));
+        TRY(pfsph__json_number(v, P, "cell", 0.2, 2.0, &o->cell, &p->ctx));
+        const cJSON *f = get(v, "formats");
+        if (f) {
+            if (!cJSON_IsArray(f) || !cJSON_GetArraySize(f))
+                return pfsph__json_fail(&p->ctx, "$.output.surface.formats",
+                                        "expected a non-empty array of strings (\"ply\", \"obj\", \"vtp\")");
+            o->ply = o->obj = o->vtp = false;
+            int i = 0;
+            for (const cJSON *e = f->child; e; e = e->next, i++) {
+                char ep[64];
+                path_index(ep, sizeof ep, "$.output.surface.formats", i);
+                const char *n = cJSON_IsString(e) ? e->valuestring : "";
+                if (!strcmp(n, "ply")) o->ply = true;
+                else if (!strcmp(n, "obj")) o->obj = true;
+                else if (!strcmp(n, "vtp")) o->vtp = true;
+                else return pfsph__json_fail(&p->ctx, ep, "unknown format (expected \"ply\", \"obj\" or \"vtp\")");
+            }
+        }
+    } else
+        return pfsph__json_fail(&p->ctx, P, "expected true, false or an object (formats, smoothing, isotropic, cell)");
+    if (o->on && p->s->dim != 3)
+        return pfsph__json_fail(&p->ctx, P, "surface meshes are made for 3D scenes only (this scene is 2D)");
+    return PFSPH_OK;
+}
+
 static int parse_output(parser *p, const cJSON *root)
 {
     pfsph_output *o = &p->s->output;
     const cJSON *v = get(root, "output");
     if (!v) return PFSPH_OK;
     static const char *const keys[] = {"directory", "formats", "fields", "boundary",
-                                       "frame_interval", "checkpoint_interval", NULL};
+                                       "frame_interval", "checkpoint_interval", "surface", NULL};
     const char *P = "$.output";
     TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
+    TRY(parse_surface(p, get(v, "surface")));
     TRY(pfsph__json_string(v, P, "directory", o->dir, sizeof o->dir, &p->ctx));
     if (get(v, "directory") && !o->dir[0])
         return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
@@ -928,6 +967,7 @@ void pfsph_scene_defaults(pfsph_scene *s)
     s->output.fields = 0;
     s->output.frame_interval = 1;
     s->output.checkpoint_interval = 10;
+    s->output.surface = (pfsph_surface_output){.on = false, .ply = true, .obj = false, .vtp = true};
     s->camera.set = false;
     s->camera.up[1] = 1.0;
     s->camera.eye[2] = 1.0;

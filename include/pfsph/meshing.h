@@ -1,0 +1,34 @@
+/* Liquid surface files and run-directory collections: the fluid's surface mesh per frame as
+ * binary PLY, OBJ and VTK PolyData (phase per face), `pfsph mesh RUN_DIR`, and the ParaView .pvd
+ * collections that make a run one time series. docs/surfaces.md. */
+#ifndef PFSPH_MESHING_H
+#define PFSPH_MESHING_H
+
+#include "pfsph/particles.h"
+#include "pfsph/scene.h"
+#include "pfsph/surface_mesh.h"
+
+/* Atomic writers. PLY: binary little-endian, vertex x y z nx ny nz (float), face
+ * vertex_indices (uchar count, uint indices) and uchar phase. OBJ: v, vn and f v//vn lines, one
+ * group "phase_<k>" per phase. VTP: points, Normals (point data), phase (cell data), TimeValue. */
+int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err);
+int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err);
+int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err);
+
+/* Reconstruct the surface of a frame's fluid particles with the scene's output.surface settings
+ * and write RUN/frames/liquid_NNNNN.{ply,obj,vtp} (the formats it names). A 2D scene is
+ * PFSPH_EINPUT (meshes are 3D only). st (may be NULL) receives the statistics (arrays freed). */
+int pfsph_mesh_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid, double time,
+                     pfsph_surface_mesh *st, pfsph_error *err);
+
+/* Mesh every fluid frame of a finished run (RUN/scene.json, RUN/frames/fluid_NNNNN.vtp or .ply),
+ * then rewrite the .pvd collections. `over` (may be NULL) replaces the scene's output.surface.
+ * *frames gets the number meshed. */
+int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frames, pfsph_error *err);
+
+/* Rewrite RUN/<set>.pvd for every frame set with .vtp files in RUN/frames (fluid, boundary,
+ * diffuse, bodies, surfaces, liquid), frame k at time k * frame_dt; atomic, so a collection is
+ * valid whenever a run stops. */
+int pfsph_write_pvd_collections(const char *dir, double frame_dt, pfsph_error *err);
+
+#endif

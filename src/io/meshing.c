@@ -1,0 +1,298 @@
+/* Liquid surface files (PLY, OBJ, VTP with the phase per face), meshing a run's frames, and the
+ * ParaView .pvd collections of a run directory. */
+#include "pfsph/meshing.h"
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "io/io_internal.h"
+#include "pfsph/io.h"
+
+static int finish(pfsph__enc *e, pfsph__afile *af, pfsph_error *err)
+{
+    int rc = pfsph__enc_flush(e);
+    pfsph__enc_free(e);
+    if (rc != PFSPH_OK) {
+        pfsph__afile_abort(af);
+        return rc;
+    }
+    return pfsph__afile_commit(af, err);
+}
+
+int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
+{
+    pfsph__afile af;
+    pfsph__enc e;
+    int rc = pfsph__enc_open(&e, &af, path, err);
+    if (rc != PFSPH_OK) return rc;
+    pfsph__enc_printf(&e, "ply\nformat binary_little_endian 1.0\ncomment pfsph %s liquid surface\n", PFSPH_VERSION);
+    pfsph__enc_printf(&e, "comment time %.17g\n", time);
+    pfsph__enc_printf(&e, "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
+                      "property float nx\nproperty float ny\nproperty float nz\n", m->nverts);
+    pfsph__enc_printf(&e, "element face %zu\nproperty list uchar uint vertex_indices\nproperty uchar phase\n"
+                      "end_header\n", m->ntris);
+    for (size_t i = 0; i < m->nverts; i++) {
+        for (int k = 0; k < 3; k++) {
+            float v = (float)m->v[3 * i + k];
+            pfsph__enc_put(&e, &v, 4);
+        }
+        for (int k = 0; k < 3; k++) pfsph__enc_put(&e, &m->n[3 * i + k], 4);
+    }
+    const uint8_t three = 3;
+    for (size_t t = 0; t < m->ntris; t++) {
+        pfsph__enc_put(&e, &three, 1);
+        for (int k = 0; k < 3; k++) pfsph__enc_put(&e, &m->tri[3 * t + k], 4);
+        pfsph__enc_put(&e, &m->phase[t], 1);
+    }
+    return finish(&e, &af, err);
+}
+
+int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
+{
+    pfsph__afile af;
+    pfsph__enc e;
+    int rc = pfsph__enc_open(&e, &af, path, err);
+    if (rc != PFSPH_OK) return rc;
+    pfsph__enc_printf(&e, "# pfsph %s liquid surface, time %.17g s\n", PFSPH_VERSION, time);
+    for (size_t i = 0; i < m->nverts; i++)
+        pfsph__enc_printf(&e, "v %.7g %.7g %.7g\n", m->v[3 * i], m->v[3 * i + 1], m->v[3 * i + 2]);
+    for (size_t i = 0; i < m->nverts; i++)
+        pfsph__enc_printf(&e, "vn %.5f %.5f %.5f\n", m->n[3 * i], m->n[3 * i + 1], m->n[3 * i + 2]);
+    for (size_t t = 0; t < m->ntris; t++) {
+        if (t == 0 || m->phase[t] != m->phase[t - 1]) pfsph__enc_printf(&e, "g phase_%d\n", m->phase[t]);
+        uint32_t a = m->tri[3 * t] + 1, b = m->tri[3 * t + 1] + 1, c = m->tri[3 * t + 2] + 1;
+        pfsph__enc_printf(&e, "f %u//%u %u//%u %u//%u\n", a, a, b, b, c, c);
+    }
+    return finish(&e, &af, err);
+}
+
+int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
+{
+    pfsph__afile af;
+    pfsph__enc e;
+    int rc = pfsph__enc_open(&e, &af, path, err);
+    if (rc != PFSPH_OK) return rc;
+    pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n");
+    pfsph__enc_printf(&e, "<FieldData>\n<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n</FieldData>\n", time);
+    pfsph__enc_printf(&e, "<Piece NumberOfPoints=\"%zu\" NumberOfPolys=\"%zu\">\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n", m->nverts, m->ntris);
+    for (size_t i = 0; i < m->nverts; i++)
+        pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", m->v[3 * i], m->v[3 * i + 1], m->v[3 * i + 2]);
+    pfsph__enc_printf(&e, "</DataArray>\n</Points>\n<PointData Normals=\"Normals\">\n<DataArray type=\"Float32\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (size_t i = 0; i < m->nverts; i++)
+        pfsph__enc_printf(&e, "%.5f %.5f %.5f\n", m->n[3 * i], m->n[3 * i + 1], m->n[3 * i + 2]);
+    pfsph__enc_printf(&e, "</DataArray>\n</PointData>\n<Polys>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n");
+    for (size_t t = 0; t < m->ntris; t++)
+        pfsph__enc_printf(&e, "%u %u %u\n", m->tri[3 * t], m->tri[3 * t + 1], m->tri[3 * t + 2]);
+    pfsph__enc_printf(&e, "</DataArray>\n<DataArray type=\"UInt32\" Name=\"offsets\" format=\"ascii\">\n");
+    for (size_t t = 1; t <= m->ntris; t++) pfsph__enc_printf(&e, "%zu\n", 3 * t);
+    pfsph__enc_printf(&e, "</DataArray>\n</Polys>\n<CellData Scalars=\"phase\">\n<DataArray type=\"UInt8\" Name=\"phase\" format=\"ascii\">\n");
+    for (size_t t = 0; t < m->ntris; t++) pfsph__enc_printf(&e, "%d\n", m->phase[t]);
+    pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
+    return finish(&e, &af, err);
+}
+
+static int mesh_particles(const pfsph_surface_output *so, double spacing, const char *dir, int frame,
+                          const pfsph_particles *ps, double time, pfsph_surface_mesh *st, pfsph_error *err)
+{
+    double *x = malloc(3 * (ps->n ? ps->n : 1) * sizeof *x);
+    if (!x) return pfsph_fail(err, PFSPH_ENOMEM, "surface: out of memory");
+    for (size_t i = 0; i < ps->n; i++) {
+        x[3 * i] = ps->x[i];
+        x[3 * i + 1] = ps->y[i];
+        x[3 * i + 2] = ps->z[i];
+    }
+    pfsph_surface_opts o;
+    pfsph_surface_opts_default(&o, spacing);
+    o.isotropic = so->isotropic;
+    o.smooth_iters = so->smoothing;
+    o.cell = so->cell;
+    pfsph_surface_mesh m;
+    int rc = pfsph_surface_reconstruct(x, ps->phase, ps->n, &o, &m, err);
+    free(x);
+    if (rc) return rc;
+    char path[PFSPH_PATH_LEN + 64];
+    if (so->ply) {
+        snprintf(path, sizeof path, "%s/frames/liquid_%05d.ply", dir, frame);
+        rc = pfsph_write_surface_ply(path, &m, time, err);
+    }
+    if (!rc && so->obj) {
+        snprintf(path, sizeof path, "%s/frames/liquid_%05d.obj", dir, frame);
+        rc = pfsph_write_surface_obj(path, &m, time, err);
+    }
+    if (!rc && so->vtp) {
+        snprintf(path, sizeof path, "%s/frames/liquid_%05d.vtp", dir, frame);
+        rc = pfsph_write_surface_vtp(path, &m, time, err);
+    }
+    free(m.v);
+    free(m.n);
+    free(m.tri);
+    free(m.phase);
+    m.v = NULL;
+    m.n = NULL;
+    m.tri = NULL;
+    m.phase = NULL;
+    if (st) *st = m;
+    return rc;
+}
+
+int pfsph_mesh_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid, double time,
+                     pfsph_surface_mesh *st, pfsph_error *err)
+{
+    if (s->dim != 3)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: surface meshes are made for 3D scenes only (this one is 2D)",
+                          s->source);
+    return mesh_particles(&s->output.surface, 2 * s->particle_radius, dir, frame, fluid, time, st, err);
+}
+
+/* frame files "<set>_NNNNN.<ext>" in RUN/frames: the largest number, -1 when none */
+static long last_frame(const char *frames, const char *set, const char *ext)
+{
+    DIR *d = opendir(frames);
+    if (!d) return -1;
+    long last = -1;
+    size_t ls = strlen(set), le = strlen(ext);
+    for (struct dirent *de; (de = readdir(d));) {
+        const char *n = de->d_name;
+        size_t len = strlen(n);
+        if (len != ls + 1 + 5 + 1 + le || strncmp(n, set, ls) || n[ls] != '_' || n[ls + 6] != '.' ||
+            strcmp(n + ls + 7, ext))
+            continue;
+        long k = 0;
+        int ok = 1;
+        for (int i = 0; i < 5; i++) {
+            if (n[ls + 1 + i] < '0' || n[ls + 1 + i] > '9') ok = 0;
+            k = 10 * k + (n[ls + 1 + i] - '0');
+        }
+        if (ok && k > last) last = k;
+    }
+    closedir(d);
+    return last;
+}
+
+int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frames, pfsph_error *err)
+{
+    char path[PFSPH_PATH_LEN + 64], frames_dir[PFSPH_PATH_LEN + 16];
+    *frames = 0;
+    snprintf(path, sizeof path, "%s/scene.json", dir);
+    FILE *probe = fopen(path, "rb");
+    if (!probe) return pfsph_fail(err, PFSPH_EINPUT, "%s: not a run directory (no readable scene.json)", dir);
+    fclose(probe);
+    pfsph_scene *s = malloc(sizeof *s);
+    if (!s) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    int rc = pfsph_scene_load(s, path, err);
+    if (rc) {
+        free(s);
+        return rc;
+    }
+    if (s->dim != 3) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: a 2D run: surface meshes are made for 3D runs only; nothing written",
+                        dir);
+        free(s);
+        return rc;
+    }
+    pfsph_surface_output so = over ? *over : s->output.surface;
+    if (!so.ply && !so.obj && !so.vtp) so.ply = so.vtp = true;
+    snprintf(frames_dir, sizeof frames_dir, "%s/frames", dir);
+    const char *ext = "vtp";
+    long last = last_frame(frames_dir, "fluid", ext);
+    if (last < 0) {
+        ext = "ply";
+        last = last_frame(frames_dir, "fluid", ext);
+    }
+    if (last < 0) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: no fluid frames (frames/fluid_NNNNN.vtp or .ply)", dir);
+        free(s);
+        return rc;
+    }
+    const double frame_dt = s->output.frame_interval / s->fps;
+    for (long k = 0; k <= last && !rc; k++) {
+        snprintf(path, sizeof path, "%s/fluid_%05ld.%s", frames_dir, k, ext);
+        FILE *f = fopen(path, "rb");
+        if (!f) continue; /* a gap (frame_interval, a resume) */
+        fclose(f);
+        pfsph_particles ps;
+        double t = k * frame_dt;
+        rc = ext[0] == 'v' ? pfsph_read_vtp(path, &ps, &t, err) : pfsph_read_ply(path, &ps, &t, err);
+        if (rc) break;
+        rc = mesh_particles(&so, 2 * s->particle_radius, dir, (int)k, &ps, t, NULL, err);
+        pfsph_particles_free(&ps);
+        if (!rc) (*frames)++;
+    }
+    if (!rc && so.vtp) rc = pfsph_write_pvd_collections(dir, frame_dt, err);
+    free(s);
+    return rc;
+}
+
+static int long_cmp(const void *a, const void *b)
+{
+    long x = *(const long *)a, y = *(const long *)b;
+    return x < y ? -1 : (x > y);
+}
+
+int pfsph_write_pvd_collections(const char *dir, double frame_dt, pfsph_error *err)
+{
+    enum { NSETS = 6 };
+    static const char *const sets[NSETS] = {"fluid", "boundary", "diffuse", "bodies", "surfaces", "liquid"};
+    char frames_dir[PFSPH_PATH_LEN + 16], path[PFSPH_PATH_LEN + 64];
+    snprintf(frames_dir, sizeof frames_dir, "%s/frames", dir);
+    long *num[NSETS] = {NULL};
+    size_t n[NSETS] = {0}, cap[NSETS] = {0};
+    int rc = PFSPH_OK;
+    /* one pass over the directory: the frame numbers of "<set>_NNNNN.vtp" */
+    DIR *d = opendir(frames_dir);
+    if (!d) return PFSPH_OK;
+    for (struct dirent *de; (de = readdir(d)) && !rc;) {
+        const char *nm = de->d_name;
+        size_t len = strlen(nm);
+        if (len < 11 || strcmp(nm + len - 4, ".vtp")) continue;
+        for (int k = 0; k < NSETS; k++) {
+            size_t ls = strlen(sets[k]);
+            if (len != ls + 10 || strncmp(nm, sets[k], ls) || nm[ls] != '_') continue;
+            long v = 0;
+            int ok = 1;
+            for (int i = 0; i < 5; i++) {
+                char c = nm[ls + 1 + i];
+                if (c < '0' || c > '9') ok = 0;
+                v = 10 * v + (c - '0');
+            }
+            if (!ok) continue;
+            if (n[k] == cap[k]) {
+                size_t nc = cap[k] ? 2 * cap[k] : 64;
+                long *t = realloc(num[k], nc * sizeof *t);
+                if (!t) {
+                    rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+                    break;
+                }
+                num[k] = t;
+                cap[k] = nc;
+            }
+            num[k][n[k]++] = v;
+        }
+    }
+    closedir(d);
+    for (int k = 0; k < NSETS && !rc; k++) {
+        if (!n[k]) continue;
+        qsort(num[k], n[k], sizeof *num[k], long_cmp);
+        const size_t line = 160; /* one DataSet line is at most about 100 characters */
+        size_t bcap = 256 + n[k] * line, len = 0;
+        char *buf = malloc(bcap);
+        if (!buf) {
+            rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+            break;
+        }
+        len += (size_t)snprintf(buf + len, bcap - len, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
+                                "version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
+        for (size_t i = 0; i < n[k]; i++)
+            len += (size_t)snprintf(buf + len, line,
+                                    "<DataSet timestep=\"%.9g\" group=\"\" part=\"0\" file=\"frames/%s_%05ld.vtp\"/>\n",
+                                    (double)num[k][i] * frame_dt, sets[k], num[k][i]);
+        len += (size_t)snprintf(buf + len, bcap - len, "</Collection>\n</VTKFile>\n");
+        snprintf(path, sizeof path, "%s/%s.pvd", dir, sets[k]);
+        rc = pfsph_write_file_atomic(path, buf, len, err);
+        free(buf);
+    }
+    for (int k = 0; k < NSETS; k++) free(num[k]);
+    return rc;
+}
