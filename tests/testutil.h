@@ -18,6 +18,11 @@ int tu_write_file(const char *path, const char *text);
 /* Run a shell command, capturing stdout+stderr into out (truncated to cap). Returns the exit
  * status (or -1). */
 int tu_run(const char *cmd, char *out, size_t cap);
+/* A whole file, NUL-terminated (len excludes the NUL); fails the test if it cannot be read.
+ * Free with free(). */
+unsigned char *tu_slurp(const char *path, size_t *len);
+/* dir_a/name and dir_b/name have the same bytes (fails the test otherwise, naming both). */
+void tu_assert_same_file(const char *dir_a, const char *dir_b, const char *name);
 
 
 /* A gas bubble in a liquid (test_pf_rising_bubble, test_pf_density_ratio), measured over the

@@ -25,6 +25,19 @@ typedef struct pfsph_render_opts {
 
 /* Render every frame of RUN_DIR/frames into RUN_DIR/png/frame_NNNNN.png. Returns the number of
  * frames rendered through *count. */
+/* The frames of one particle set in a run's frames/ directory: the numbers of
+ * "<prefix>NNNNN.vtp" (preferred) or ".ply", sorted (the renderer and the viewer's replay). */
+typedef struct pfsph_frame_list {
+    int *num;
+    char *ply; /* 1 where only a .ply exists for that number */
+    int n, cap;
+} pfsph_frame_list;
+
+int pfsph_frame_list_read(const char *dir, const char *prefix, pfsph_frame_list *fl, pfsph_error *err);
+void pfsph_frame_list_free(pfsph_frame_list *fl);
+/* Index of the entry numbered f, or -1. */
+int pfsph_frame_list_find(const pfsph_frame_list *fl, int f);
+
 int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count,
                      pfsph_error *err);
 

@@ -43,6 +43,14 @@ static inline double pfsph_thermostat_kT(const pfsph_ctx *ctx)
     return pp && pp->enabled && pp->thermo.enabled ? pp->thermo.kT_resolved : 0.0;
 }
 
+/* 2 kT visc_c / dt with visc_c = 2 (d + 2), the Morris viscosity's constant: the noise of a pair
+ * is sqrt(amp * kT-factor * Gamma / visc_c) (0 without a temperature or a step). */
+static inline double pfsph__thermo_amp(const pfsph_ctx *ctx)
+{
+    const double kT = pfsph_thermostat_kT(ctx);
+    return kT > 0 && ctx->dt > 0 ? 2.0 * kT / ctx->dt * (double)(2 * (ctx->dim + 2)) : 0.0;
+}
+
 /* Phase a's temperature relative to kT: rho_a / rho_ref (the liquid kT was set for), so that
  * every phase has the same thermal speed; at equal kT a gas 10-1000x lighter would move
  * 3-32x faster than its liquid and leave its bubble. Solids and unknown densities: 1. */

@@ -29,14 +29,9 @@ extern char **environ;
 
 /* ---- frame files ------------------------------------------------------------------------ */
 
-typedef struct frame_list {
-    int *num;
-    char *ply; /* 1 where only a .ply exists for that number */
-    int n, cap;
-} frame_list;
+typedef pfsph_frame_list frame_list;
 
-/* Collect the numbers of "<prefix>NNNNN.vtp" (preferred) or ".ply" in dir, sorted. */
-static int list_frames(const char *dir, const char *prefix, frame_list *fl, pfsph_error *err)
+int pfsph_frame_list_read(const char *dir, const char *prefix, frame_list *fl, pfsph_error *err)
 {
     memset(fl, 0, sizeof *fl);
     DIR *d = opendir(dir);
@@ -91,7 +86,7 @@ static int list_frames(const char *dir, const char *prefix, frame_list *fl, pfsp
     return rc;
 }
 
-static void free_list(frame_list *fl)
+void pfsph_frame_list_free(frame_list *fl)
 {
     free(fl->num);
     free(fl->ply);
@@ -1012,7 +1007,7 @@ static int newest_le(const frame_list *fl, int f)
     return best;
 }
 
-static int find_num(const frame_list *fl, int f)
+int pfsph_frame_list_find(const frame_list *fl, int f)
 {
     for (int i = 0; i < fl->n; i++)
         if (fl->num[i] == f) return i;
@@ -1066,10 +1061,10 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
     x.c.w = x.out_w * x.ss;
     x.c.h = x.out_h * x.ss;
 
-    if ((rc = list_frames(fdir, "fluid_", &fl, err))) goto out;
-    if ((rc = list_frames(fdir, "boundary_", &bl, err))) goto out;
-    if ((rc = list_frames(fdir, "diffuse_", &dl, err))) goto out;
-    if ((rc = list_frames(fdir, "bodies_", &rl, err))) goto out;
+    if ((rc = pfsph_frame_list_read(fdir, "fluid_", &fl, err))) goto out;
+    if ((rc = pfsph_frame_list_read(fdir, "boundary_", &bl, err))) goto out;
+    if ((rc = pfsph_frame_list_read(fdir, "diffuse_", &dl, err))) goto out;
+    if ((rc = pfsph_frame_list_read(fdir, "bodies_", &rl, err))) goto out;
     if (fl.n == 0) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: no fluid_NNNNN.vtp or .ply frames", fdir);
         goto out;
@@ -1122,10 +1117,10 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
             bnd_loaded = bl.num[bi];
         }
         /* rigid bodies move: their particles of this frame */
-        int ri = find_num(&rl, f);
+        int ri = pfsph_frame_list_find(&rl, f);
         pfsph_particles_free(&both);
         if (ri >= 0 && (rc = read_frame(fdir, "bodies_", f, rl.ply[ri], &both, NULL, err))) goto out;
-        int di = find_num(&dl, f);
+        int di = pfsph_frame_list_find(&dl, f);
         pfsph_particles_free(&dif);
         if (di >= 0 && (rc = read_frame(fdir, "diffuse_", f, dl.ply[di], &dif, NULL, err)))
             goto out;
@@ -1158,10 +1153,10 @@ out:
     pfsph_particles_free(&bnd);
     pfsph_particles_free(&dif);
     pfsph_particles_free(&both);
-    free_list(&fl);
-    free_list(&bl);
-    free_list(&dl);
-    free_list(&rl);
+    pfsph_frame_list_free(&fl);
+    pfsph_frame_list_free(&bl);
+    pfsph_frame_list_free(&dl);
+    pfsph_frame_list_free(&rl);
     for (int l = 0; l < 2; l++) {
         free(x.im.z[l]);
         free(x.im.id[l]);

@@ -762,8 +762,7 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
     /* particles dropped from the boundary set (a body that left the grid) must not keep their
      * last force: only the present ones are written below */
     memset(B->fp, 0, 3 * (size_t)B->np * sizeof(double));
-    const double kT = pfsph_thermostat_kT(ctx);
-    const double amp = kT > 0 && ctx->dt > 0 ? 2.0 * kT / ctx->dt * (double)(2 * (ctx->dim + 2)) : 0;
+    const double amp = pfsph__thermo_amp(ctx);
     const uint64_t wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
 #pragma omp parallel for schedule(static)
     for (size_t j = 0; j < nb; j++) {
@@ -789,7 +788,7 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
                                      (f->vz[i] - b->vz[j]) * dz;
                     /* friction: the fluid gains m_i nu visc_c V_b (v_ib . x_ib)/(r^2+eps) grad W */
                     s -= ctx->mass[f->phase[i]] * visc_c * nui * vol * vdx / (r2 + eps) * dw;
-                    if (kT > 0 && r2 > 0) {
+                    if (amp > 0 && r2 > 0) {
                         /* the thermostat's random force on the fluid, reversed (thermostat.c:
                          * the same expression, same draw) */
                         double rr = sqrt((double)r2);

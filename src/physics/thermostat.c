@@ -6,15 +6,14 @@
 
 void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
 {
-    const double kT = pfsph_thermostat_kT(ctx);
-    if (!(kT > 0) || !(ctx->dt > 0)) return;
+    const double amp = pfsph__thermo_amp(ctx);
+    if (!(amp > 0)) return;
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
     const pfsph_real h2 = k->h * k->h, eps = (pfsph_real)0.01 * h2;
     /* viscosity.c's friction between i and j, as a force: m_i visc_c nu_ij / n_j r^2 |W'/r| /
      * (r^2 + eps) times (v_ij . e_ij) e_ij, visc_c = 2 (d + 2). The noise amplitude is
-     * sqrt(2 kT Gamma / dt); the 2 kT / dt and visc_c are folded into one constant. */
-    const double amp = 2.0 * kT / ctx->dt * (double)(2 * (ctx->dim + 2));
+     * sqrt(2 kT Gamma / dt); the 2 kT / dt and visc_c are folded into amp. */
     /* one thermal speed for all phases: phase a at kT rho_a / rho_ref, a pair at the colder
      * of the two (a gas by a liquid must not be shaken at the liquid's temperature) */
     double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];

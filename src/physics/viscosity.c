@@ -25,7 +25,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     double amp = 0, ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     uint64_t key = 0, wkey = 0;
     if (thermo) {
-        amp = 2.0 * pfsph_thermostat_kT(ctx) / ctx->dt * (double)(2 * (ctx->dim + 2));
+        amp = pfsph__thermo_amp(ctx);
         for (int a = 0; a < ctx->nphases; a++)
             for (int c = 0; c < ctx->nphases; c++)
                 ts[a][c] = fmin(pfsph_thermostat_scale(ctx, a), pfsph_thermostat_scale(ctx, c));

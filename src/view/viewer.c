@@ -299,67 +299,7 @@ static void live_post(live *L, const vcmd *q)
 
 /* ---- replay mode: the frames of a run directory --------------------------------------- */
 
-typedef struct flist {
-    int *num;
-    char *ply;
-    int n, cap;
-} flist;
-
-static int list_frames(const char *dir, const char *prefix, flist *fl)
-{
-    memset(fl, 0, sizeof *fl);
-    DIR *d = opendir(dir);
-    if (!d) return -1;
-    size_t pl = strlen(prefix);
-    struct dirent *de;
-    while ((de = readdir(d))) {
-        const char *nm = de->d_name;
-        if (strncmp(nm, prefix, pl) != 0) continue;
-        const char *q = nm + pl;
-        int digits = 0;
-        long v = 0;
-        while (q[digits] >= '0' && q[digits] <= '9' && digits < 9) v = v * 10 + (q[digits++] - '0');
-        if (digits < 5) continue;
-        bool vtp = strcmp(q + digits, ".vtp") == 0, ply = strcmp(q + digits, ".ply") == 0;
-        if (!vtp && !ply) continue;
-        int i;
-        for (i = 0; i < fl->n && fl->num[i] != (int)v; i++) {}
-        if (i < fl->n) {
-            if (vtp) fl->ply[i] = 0;
-            continue;
-        }
-        if (fl->n == fl->cap) {
-            int cap = fl->cap ? 2 * fl->cap : 64;
-            int *nn = realloc(fl->num, (size_t)cap * sizeof *nn);
-            if (nn) fl->num = nn;
-            char *np = realloc(fl->ply, (size_t)cap);
-            if (np) fl->ply = np;
-            if (!nn || !np) break;
-            fl->cap = cap;
-        }
-        fl->num[fl->n] = (int)v;
-        fl->ply[fl->n] = ply;
-        fl->n++;
-    }
-    closedir(d);
-    for (int i = 1; i < fl->n; i++)
-        for (int j = i; j > 0 && fl->num[j - 1] > fl->num[j]; j--) {
-            int t = fl->num[j];
-            fl->num[j] = fl->num[j - 1];
-            fl->num[j - 1] = t;
-            char c = fl->ply[j];
-            fl->ply[j] = fl->ply[j - 1];
-            fl->ply[j - 1] = c;
-        }
-    return 0;
-}
-
-static void flist_free(flist *fl)
-{
-    free(fl->num);
-    free(fl->ply);
-    memset(fl, 0, sizeof *fl);
-}
+typedef pfsph_frame_list flist;
 
 typedef struct replay {
     char fdir[PFSPH_PATH_LEN + 16];
@@ -379,13 +319,6 @@ static int read_set(const char *dir, const char *prefix, int num, bool ply, pfsp
     return ply ? pfsph_read_ply(path, ps, t, err) : pfsph_read_vtp(path, ps, t, err);
 }
 
-static int find_num(const flist *fl, int f)
-{
-    for (int i = 0; i < fl->n; i++)
-        if (fl->num[i] == f) return i;
-    return -1;
-}
-
 /* Load fluid frame index k (and the boundary, bodies and diffuse files of its number). */
 static int replay_load(replay *R, int k, vframe *f, pfsph_error *err)
 {
@@ -399,7 +332,7 @@ static int replay_load(replay *R, int k, vframe *f, pfsph_error *err)
         if ((rc = read_set(R->fdir, "boundary_", R->bnd.num[bi], R->bnd.ply[bi], &f->walls, NULL, err))) return rc;
         R->loaded_bnd = R->bnd.num[bi];
     }
-    int ri = find_num(&R->bod, num), di = find_num(&R->dif, num);
+    int ri = pfsph_frame_list_find(&R->bod, num), di = pfsph_frame_list_find(&R->dif, num);
     f->bodies.n = f->diffuse.n = 0;
     if (ri >= 0 && (rc = read_set(R->fdir, "bodies_", num, R->bod.ply[ri], &f->bodies, NULL, err))) return rc;
     if (di >= 0 && (rc = read_set(R->fdir, "diffuse_", num, R->dif.ply[di], &f->diffuse, NULL, err))) return rc;
@@ -1318,20 +1251,21 @@ int pfsph_view_main(int argc, char **argv)
         replay *R = &A->R;
         snprintf(R->fdir, sizeof R->fdir, "%s/frames", o->input);
         R->loaded_bnd = -1;
-        if (list_frames(R->fdir, "fluid_", &R->fluid) != 0) {
-            rc = pfsph_fail(&err, PFSPH_EINPUT, "%s: cannot open: %s", R->fdir, strerror(errno));
+        if (pfsph_frame_list_read(R->fdir, "fluid_", &R->fluid, &err) != PFSPH_OK) {
+            rc = PFSPH_EINPUT;
             goto fail;
         }
-        list_frames(R->fdir, "boundary_", &R->bnd);
-        list_frames(R->fdir, "diffuse_", &R->dif);
-        list_frames(R->fdir, "bodies_", &R->bod);
+        pfsph_error skip; /* the other sets are optional */
+        pfsph_frame_list_read(R->fdir, "boundary_", &R->bnd, &skip);
+        pfsph_frame_list_read(R->fdir, "diffuse_", &R->dif, &skip);
+        pfsph_frame_list_read(R->fdir, "bodies_", &R->bod, &skip);
         if (R->fluid.n == 0) {
             rc = pfsph_fail(&err, PFSPH_EINPUT, "%s: no fluid_NNNNN.vtp or .ply frames", R->fdir);
             goto fail;
         }
         int k = 0;
         if (o->frame >= 0) {
-            k = find_num(&R->fluid, o->frame);
+            k = pfsph_frame_list_find(&R->fluid, o->frame);
             if (k < 0) {
                 rc = pfsph_fail(&err, PFSPH_EINPUT, "--frame %d: %s has frames %d..%d and not this one", o->frame,
                                 R->fdir, R->fluid.num[0], R->fluid.num[R->fluid.n - 1]);
@@ -1368,7 +1302,7 @@ int pfsph_view_main(int argc, char **argv)
     A->cam0 = A->cam;
     A->vref = speed_scale(A->scene, &f0->fluid);
     if (!A->is_live && o->frame >= 0) {
-        int k = find_num(&A->R.fluid, o->frame);
+        int k = pfsph_frame_list_find(&A->R.fluid, o->frame);
         if ((rc = replay_load(&A->R, k, &A->rf, &err))) goto fail;
     }
 
@@ -1400,10 +1334,10 @@ out:
         for (int k = 0; k < 3; k++) vframe_free(&A->L.fr[k]);
     } else {
         vframe_free(&A->rf);
-        flist_free(&A->R.fluid);
-        flist_free(&A->R.bnd);
-        flist_free(&A->R.dif);
-        flist_free(&A->R.bod);
+        pfsph_frame_list_free(&A->R.fluid);
+        pfsph_frame_list_free(&A->R.bnd);
+        pfsph_frame_list_free(&A->R.dif);
+        pfsph_frame_list_free(&A->R.bod);
     }
     free(A->spr);
     free(A->scene);

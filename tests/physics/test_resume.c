@@ -31,35 +31,6 @@ static const char *SCENE =
     "               \"lifetime_min\": 0.5, \"lifetime_max\": 2},\n"
     " \"output\": {\"formats\": [\"vtp\"], \"fields\": [\"id\", \"speed\"], \"checkpoint_interval\": %d}}\n";
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) fprintf(stderr, "cannot open %s\n", path);
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc((size_t)n + 1);
-    assert_int_equal(fread(b, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *len = (size_t)n;
-    return b;
-}
-
-static void assert_same_file(const char *dir_a, const char *dir_b, const char *name)
-{
-    char pa[1024], pb[1024];
-    snprintf(pa, sizeof pa, "%s/%s", dir_a, name);
-    snprintf(pb, sizeof pb, "%s/%s", dir_b, name);
-    size_t la, lb;
-    unsigned char *a = slurp(pa, &la), *b = slurp(pb, &lb);
-    if (la != lb || memcmp(a, b, la) != 0) fprintf(stderr, "%s and %s differ\n", pa, pb);
-    assert_int_equal(la, lb);
-    assert_memory_equal(a, b, la);
-    free(a);
-    free(b);
-}
-
 static void parse(pfsph_scene *s, int ckpt_interval)
 {
     char json[4096];
@@ -81,14 +52,14 @@ static void run(const pfsph_scene *s, const char *dir, double end, bool resume)
 
 static void compare_runs(const char *a, const char *b)
 {
-    assert_same_file(a, b, "frames/fluid_00010.vtp");
-    assert_same_file(a, b, "frames/fluid_00007.vtp");
-    assert_same_file(a, b, "frames/diffuse_00010.vtp");
-    assert_same_file(a, b, "frames/diffuse_00007.vtp");
-    assert_same_file(a, b, "stats.csv");
-    assert_same_file(a, b, "frames/bodies_00010.vtp");
-    assert_same_file(a, b, "frames/surfaces_00010.vtp");
-    assert_same_file(a, b, "bodies.csv");
+    tu_assert_same_file(a, b, "frames/fluid_00010.vtp");
+    tu_assert_same_file(a, b, "frames/fluid_00007.vtp");
+    tu_assert_same_file(a, b, "frames/diffuse_00010.vtp");
+    tu_assert_same_file(a, b, "frames/diffuse_00007.vtp");
+    tu_assert_same_file(a, b, "stats.csv");
+    tu_assert_same_file(a, b, "frames/bodies_00010.vtp");
+    tu_assert_same_file(a, b, "frames/surfaces_00010.vtp");
+    tu_assert_same_file(a, b, "bodies.csv");
 }
 
 static char full_dir[1024];
@@ -109,7 +80,7 @@ static void test_resume_library(void **st)
     size_t len;
     char p[1100];
     snprintf(p, sizeof p, "%s/frames/diffuse_00010.vtp", part);
-    unsigned char *b = slurp(p, &len);
+    unsigned char *b = tu_slurp(p, &len);
     assert_null(strstr((char *)b, "NumberOfPoints=\"0\""));
     free(b);
 }
@@ -137,7 +108,7 @@ static void test_resume_fallback_cli(void **st)
     assert_null(f);
     snprintf(ck, sizeof ck, "%s/checkpoints/ckpt_00006.bin", dir);
     size_t len;
-    unsigned char *b = slurp(ck, &len);
+    unsigned char *b = tu_slurp(ck, &len);
     b[len / 2] ^= 0x04;
     f = fopen(ck, "wb");
     assert_non_null(f);
@@ -155,7 +126,7 @@ static void test_resume_fallback_cli(void **st)
     /* resumed from frame 4: summary says so */
     char sum[1200];
     snprintf(sum, sizeof sum, "%s/summary.json", dir);
-    b = slurp(sum, &len);
+    b = tu_slurp(sum, &len);
     assert_non_null(strstr((char *)b, "\"resumed_from_frame\":\t4"));
     free(b);
 }

@@ -241,35 +241,6 @@ static void test_threads(void **st)
     free(x[1]);
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) fprintf(stderr, "cannot open %s\n", path);
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc((size_t)n + 1);
-    assert_int_equal(fread(b, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *len = (size_t)n;
-    return b;
-}
-
-static void same_file(const char *a, const char *b, const char *name)
-{
-    char pa[1200], pb[1200];
-    snprintf(pa, sizeof pa, "%s/%s", a, name);
-    snprintf(pb, sizeof pb, "%s/%s", b, name);
-    size_t la, lb;
-    unsigned char *x = slurp(pa, &la), *y = slurp(pb, &lb);
-    if (la != lb || memcmp(x, y, la)) fprintf(stderr, "%s and %s differ\n", pa, pb);
-    assert_int_equal(la, lb);
-    assert_memory_equal(x, y, la);
-    free(x);
-    free(y);
-}
-
 static void run(const pfsph_scene *s, const char *dir, double end, bool resume)
 {
     pfsph_run_opts o = {.out_dir = dir, .end_time = end, .resume = resume};
@@ -293,10 +264,10 @@ static void test_resume(void **st)
     run(&s, full, -1, false);
     run(&s, part, 0.06, false); /* frames 0..3, checkpoint at 2 */
     run(&s, part, 0.1, true);
-    same_file(full, part, "frames/fluid_00005.vtp");
-    same_file(full, part, "frames/fluid_00004.vtp");
-    same_file(full, part, "bodies.csv");
-    same_file(full, part, "stats.csv");
+    tu_assert_same_file(full, part, "frames/fluid_00005.vtp");
+    tu_assert_same_file(full, part, "frames/fluid_00004.vtp");
+    tu_assert_same_file(full, part, "bodies.csv");
+    tu_assert_same_file(full, part, "stats.csv");
 }
 
 int main(int argc, char **argv)
