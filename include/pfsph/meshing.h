@@ -15,6 +15,14 @@ int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, doubl
 int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err);
 int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err);
 
+/* Read a triangle mesh PLY as pfsph writes them (binary little-endian, vertices then faces):
+ * the liquid's frames/liquid_NNNNN.ply (x y z nx ny nz, faces tagged `phase`) and the bodies'
+ * frames/surfaces_NNNNN.ply (x y z, faces tagged `body`). *m is overwritten (free with
+ * pfsph_surface_mesh_free): v, tri, phase (the face's uchar `phase` or `body`, else 0), n NULL
+ * when the file has no nx ny nz; the statistics are 0. *time (may be NULL) from "comment time".
+ * PFSPH_EINPUT naming the path for a malformed file or a face that is not a triangle. */
+int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time, pfsph_error *err);
+
 /* Reconstruct the surface of a frame's fluid particles with the scene's output.surface settings
  * and write RUN/frames/liquid_NNNNN.{ply,obj,vtp} (the formats it names). A 2D scene is
  * PFSPH_EINPUT (meshes are 3D only). st (may be NULL) receives the statistics (arrays freed). */

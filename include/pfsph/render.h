@@ -14,8 +14,9 @@ typedef struct pfsph_render_opts {
     bool quiet;            /* kept for callers; the library never prints (see progress) */
     bool all_walls;        /* 3D: keep the walls that face the camera (default: cut away) */
     bool no_legend;        /* no colour bar for the coloured field */
-    bool particles;        /* draw the fluid's particles even where frames/liquid_NNNNN.ply
-                            * (a surface mesh, shaded as water) exists */
+    bool particles;        /* draw the fluid's and the bodies' particles even where
+                            * frames/liquid_NNNNN.ply (a surface mesh, shaded as water) and
+                            * frames/surfaces_NNNNN.ply (the bodies' meshes) exist */
     /* After each PNG: done of total frames, the file written (may be NULL); and a message
      * (the video written). Either may be NULL; both get `user`. */
     void (*progress)(int done, int total, const char *path, void *user);
@@ -58,6 +59,20 @@ struct pfsph_particles;
 void pfsph_render_camera_for(const struct pfsph_scene *s, const struct pfsph_particles *fluid,
                              const struct pfsph_particles *boundary, int w, int h,
                              pfsph_render_camera *out);
+
+/* The cut-away of `pfsph render` (3D): the tank walls that face the camera are left out so
+ * that what stands inside the tank shows, namely wall particles within 5 particle radii of a
+ * face of the walls' bounding box on the eye's side, sideways or above, never the floor (the
+ * face gravity points to). init: off in 2D, or when walls is NULL or empty. hides: whether the
+ * wall particle at p is left out for a camera at eye (the live viewer asks as it orbits). */
+typedef struct pfsph_cutaway {
+    bool on;
+    double lo[3], hi[3]; /* the walls' box [m] */
+    double m;            /* depth of the cut [m] */
+    int up;              /* the axis against gravity */
+} pfsph_cutaway;
+void pfsph_cutaway_init(pfsph_cutaway *cw, const struct pfsph_scene *s, const struct pfsph_particles *walls);
+bool pfsph_cutaway_hides(const pfsph_cutaway *cw, const double eye[3], const double p[3]);
 
 /* Encode 8-bit RGB rows (top first) as a PNG and write it atomically. */
 int pfsph_write_png_rgb(const char *path, const uint8_t *rgb, int w, int h, pfsph_error *err);

@@ -34,6 +34,8 @@ enum pfsph__type { PFSPH__T_NONE = 0, PFSPH__T_I8, PFSPH__T_U8, PFSPH__T_I16, PF
                    PFSPH__T_I32, PFSPH__T_U32, PFSPH__T_I64, PFSPH__T_U64, PFSPH__T_F32,
                    PFSPH__T_F64 };
 size_t pfsph__type_size(int type);
+/* A PLY scalar type name ("float", "uint8", ...) as its code; PFSPH__T_NONE if unknown. */
+int pfsph__ply_type(const char *s);
 /* Decode one little-endian value of the given type as a double (exact for every type we write:
  * float, double, uint8, uint32). */
 double pfsph__get_as_double(int type, const unsigned char *src);

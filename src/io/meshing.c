@@ -3,6 +3,8 @@
 #include "pfsph/meshing.h"
 
 #include <dirent.h>
+#include <inttypes.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,6 +93,161 @@ int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, doubl
     for (size_t t = 0; t < m->ntris; t++) pfsph__enc_printf(&e, "%d\n", m->phase[t]);
     pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
     return finish(&e, &af, err);
+}
+
+/* ---- reader ---------------------------------------------------------------------------- */
+
+#define SURF_MAX_PROPS 32
+
+typedef struct surf_prop {
+    int type;
+    size_t offset; /* within a vertex record; faces: after the index list */
+    char name[80];
+} surf_prop;
+
+int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time, pfsph_error *err)
+{
+    memset(m, 0, sizeof *m);
+    if (time) *time = 0;
+    unsigned char *buf;
+    size_t len;
+    int rc = pfsph__read_file(path, &buf, &len, err);
+    if (rc != PFSPH_OK) return rc;
+#define BAD(...)                                                                           \
+    do {                                                                                   \
+        char m_[400];                                                                      \
+        snprintf(m_, sizeof m_, __VA_ARGS__);                                              \
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid surface PLY: %s", path, m_);       \
+        goto done;                                                                         \
+    } while (0)
+    surf_prop vp[SURF_MAX_PROPS], fp[SURF_MAX_PROPS];
+    int nvp = 0, nfp = 0, elem = 0; /* elem: 0 none yet, 1 vertex, 2 face */
+    size_t vrec = 0, frec = 0;      /* bytes of a vertex record; of a face's scalars */
+    uint64_t nv = 0, nt = 0;
+    int cnt_type = PFSPH__T_NONE, idx_type = PFSPH__T_NONE;
+    bool have_format = false, have_face = false;
+    size_t pos = 0, lineno = 0;
+    char line[256];
+    for (;;) {
+        const unsigned char *nl = memchr(buf + pos, '\n', len - pos);
+        if (!nl || (size_t)(nl - buf) > 65536) BAD("no end_header line");
+        size_t ll = (size_t)(nl - (buf + pos));
+        if (ll >= sizeof line) BAD("header line %zu too long", lineno + 1);
+        memcpy(line, buf + pos, ll);
+        line[ll] = 0;
+        if (ll && line[ll - 1] == '\r') line[--ll] = 0;
+        pos = (size_t)(nl - buf) + 1;
+        lineno++;
+        char w[5][80];
+        int nw = sscanf(line, "%79s %79s %79s %79s %79s", w[0], w[1], w[2], w[3], w[4]);
+        if (lineno == 1) {
+            if (nw != 1 || strcmp(w[0], "ply") != 0) BAD("missing 'ply' magic");
+            continue;
+        }
+        if (nw <= 0) continue;
+        if (strcmp(w[0], "end_header") == 0) break;
+        if (strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0) {
+            double t;
+            char tail;
+            if (time && sscanf(line, "comment time %lf %c", &t, &tail) == 1) *time = t;
+            continue;
+        }
+        if (strcmp(w[0], "format") == 0) {
+            if (nw != 3 || strcmp(w[1], "binary_little_endian") || strcmp(w[2], "1.0"))
+                BAD("format must be binary_little_endian 1.0");
+            have_format = true;
+        } else if (strcmp(w[0], "element") == 0) {
+            /* pfsph's order: vertices, then faces (every reader of ours and Blender's agree) */
+            bool isv = nw == 3 && !strcmp(w[1], "vertex") && elem == 0;
+            bool isf = nw == 3 && !strcmp(w[1], "face") && elem == 1;
+            if (!isv && !isf) BAD("line %zu: expected 'element vertex N' then 'element face N'", lineno);
+            if (pfsph__parse_u64(w[2], isv ? &nv : &nt) != 0) BAD("line %zu: bad element count", lineno);
+            elem = isv ? 1 : 2;
+            have_face = have_face || isf;
+        } else if (strcmp(w[0], "property") == 0) {
+            if (elem == 0) BAD("line %zu: property before element", lineno);
+            if (nw == 5 && !strcmp(w[1], "list")) {
+                if (elem != 2 || nfp || cnt_type != PFSPH__T_NONE ||
+                    (strcmp(w[4], "vertex_indices") && strcmp(w[4], "vertex_index")))
+                    BAD("line %zu: the only list must be the face's first property, vertex_indices", lineno);
+                cnt_type = pfsph__ply_type(w[2]);
+                idx_type = pfsph__ply_type(w[3]);
+                if (cnt_type != PFSPH__T_U8 || (idx_type != PFSPH__T_U32 && idx_type != PFSPH__T_I32))
+                    BAD("line %zu: vertex_indices must be 'list uchar uint' (or int)", lineno);
+                continue;
+            }
+            if (nw != 3) BAD("line %zu: bad property", lineno);
+            int t = pfsph__ply_type(w[1]);
+            if (t == PFSPH__T_NONE) BAD("line %zu: unknown type '%s'", lineno, w[1]);
+            surf_prop *pr = elem == 1 ? vp : fp;
+            int *np = elem == 1 ? &nvp : &nfp;
+            size_t *rec = elem == 1 ? &vrec : &frec;
+            if (*np == SURF_MAX_PROPS) BAD("too many properties");
+            if (elem == 2 && cnt_type == PFSPH__T_NONE) BAD("line %zu: vertex_indices must come first", lineno);
+            pr[*np].type = t;
+            pr[*np].offset = *rec;
+            snprintf(pr[*np].name, sizeof pr[*np].name, "%s", w[2]);
+            *rec += pfsph__type_size(t);
+            (*np)++;
+        } else {
+            BAD("line %zu: unexpected '%s'", lineno, w[0]);
+        }
+    }
+    if (!have_format) BAD("no format line");
+    if (!have_face || cnt_type == PFSPH__T_NONE) BAD("no face element with vertex_indices");
+    if (nv >= (1u << 31) || nt >= (1u << 31)) BAD("too many vertices or faces");
+    int ix[3] = {-1, -1, -1}, in[3] = {-1, -1, -1}, itag = -1;
+    static const char *const pn[6] = {"x", "y", "z", "nx", "ny", "nz"};
+    for (int k = 0; k < nvp; k++)
+        for (int j = 0; j < 6; j++)
+            if (!strcmp(vp[k].name, pn[j])) {
+                if (vp[k].type != PFSPH__T_F32 && vp[k].type != PFSPH__T_F64)
+                    BAD("property '%s' must be float or double", pn[j]);
+                if (j < 3) ix[j] = k;
+                else in[j - 3] = k;
+            }
+    if (ix[0] < 0 || ix[1] < 0 || ix[2] < 0) BAD("missing x, y or z");
+    const bool normals = in[0] >= 0 && in[1] >= 0 && in[2] >= 0;
+    /* the face's tag: the liquid's phase, or the body of a body surface */
+    for (int k = 0; k < nfp; k++)
+        if ((!strcmp(fp[k].name, "phase") || !strcmp(fp[k].name, "body")) && fp[k].type == PFSPH__T_U8) itag = k;
+    const size_t isz = 4, frecord = 1 + 3 * isz + frec;
+    size_t avail = len - pos;
+    if ((vrec && nv > avail / vrec) || nv * vrec + nt * frecord != avail)
+        BAD("%zu bytes of data, expected %" PRIu64 " vertices of %zu bytes and %" PRIu64
+            " triangles of %zu bytes", avail, nv, vrec, nt, frecord);
+    m->v = malloc(3 * (nv ? nv : 1) * sizeof *m->v);
+    m->n = normals ? malloc(3 * (nv ? nv : 1) * sizeof *m->n) : NULL;
+    m->tri = malloc(3 * (nt ? nt : 1) * sizeof *m->tri);
+    m->phase = calloc(nt ? nt : 1, 1);
+    if (!m->v || (normals && !m->n) || !m->tri || !m->phase) {
+        rc = pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
+        goto done;
+    }
+    const unsigned char *d = buf + pos;
+    for (size_t i = 0; i < nv; i++, d += vrec) {
+        for (int k = 0; k < 3; k++) m->v[3 * i + k] = pfsph__get_as_double(vp[ix[k]].type, d + vp[ix[k]].offset);
+        if (normals)
+            for (int k = 0; k < 3; k++)
+                m->n[3 * i + k] = (float)pfsph__get_as_double(vp[in[k]].type, d + vp[in[k]].offset);
+    }
+    for (size_t t = 0; t < nt; t++, d += frecord) {
+        if (d[0] != 3) BAD("face %zu has %d vertices (triangles only)", t, d[0]);
+        for (int k = 0; k < 3; k++) {
+            double v = pfsph__get_as_double(idx_type, d + 1 + isz * k);
+            if (!(v >= 0 && v < (double)nv)) BAD("face %zu: vertex index %.0f out of range", t, v);
+            m->tri[3 * t + k] = (uint32_t)v;
+        }
+        if (itag >= 0) m->phase[t] = d[1 + 3 * isz + fp[itag].offset];
+    }
+    m->nverts = (size_t)nv;
+    m->ntris = (size_t)nt;
+    rc = PFSPH_OK;
+done:
+#undef BAD
+    if (rc != PFSPH_OK) pfsph_surface_mesh_free(m);
+    free(buf);
+    return rc;
 }
 
 static int mesh_particles(const pfsph_surface_output *so, double spacing, const char *dir, int frame,

@@ -69,7 +69,7 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
 
 /* ---- reader ---------------------------------------------------------------------------- */
 
-static int ply_type(const char *s)
+int pfsph__ply_type(const char *s)
 {
     static const struct { const char *n; int t; } map[] = {
         {"char", PFSPH__T_I8},    {"int8", PFSPH__T_I8},       {"uchar", PFSPH__T_U8},
@@ -153,7 +153,7 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
             if (!have_vertex) BAD("line %zu: property before element", lineno);
             if (nw != 3) BAD("line %zu: bad property (lists are not supported)", lineno);
             if (np == MAX_PROPS) BAD("too many properties");
-            int t = ply_type(w2);
+            int t = pfsph__ply_type(w2);
             if (t == PFSPH__T_NONE) BAD("line %zu: unknown type '%s'", lineno, w2);
             for (int k = 0; k < np; k++)
                 if (strcmp(props[k].name, w3) == 0) BAD("duplicate property '%s'", w3);

@@ -20,6 +20,7 @@
 
 #include "io/io_internal.h"
 #include "pfsph/io.h"
+#include "pfsph/meshing.h"
 #include "pfsph/scene.h"
 
 extern char **environ;
@@ -358,28 +359,41 @@ typedef struct splat_set {
     size_t n, cap;
 } splat_set;
 
-/* The walls of a tank that face the camera (3D): particles within `m` of a face of the
- * boundary's box on the camera's side, sideways or above (never the floor), so that what stands
- * inside the tank shows. */
-typedef struct cutaway {
-    bool on;
-    double lo[3], hi[3], m;
-    int up; /* the axis against gravity */
-} cutaway;
+/* The walls of a tank that face the camera (3D): particles within 5 particle radii of a face of
+ * the walls' box on the camera's side, sideways or above (never the floor: "up" is the axis
+ * gravity acts along), so that what stands inside the tank shows. Shared with the live viewer,
+ * which asks again for every eye position as it orbits. */
+void pfsph_cutaway_init(pfsph_cutaway *cw, const pfsph_scene *s, const pfsph_particles *walls)
+{
+    memset(cw, 0, sizeof *cw);
+    cw->up = 1;
+    if (s->dim == 2 || !walls || !walls->n) return;
+    const double r = s->particle_radius > 0 ? s->particle_radius : 0.01;
+    box3 bb;
+    box_empty(&bb);
+    box_add(&bb, walls);
+    if (!(bb.lo[0] <= bb.hi[0])) return;
+    cw->on = true;
+    cw->m = 5 * r;
+    memcpy(cw->lo, bb.lo, sizeof cw->lo);
+    memcpy(cw->hi, bb.hi, sizeof cw->hi);
+    for (int a = 0; a < 3; a++)
+        if (fabs(s->gravity[a]) > fabs(s->gravity[cw->up])) cw->up = a;
+}
 
-static bool cut_away(const cutaway *cw, const cam *c, const double p[3])
+bool pfsph_cutaway_hides(const pfsph_cutaway *cw, const double eye[3], const double p[3])
 {
     if (!cw || !cw->on) return false;
     for (int a = 0; a < 3; a++) {
-        if (c->eye[a] > cw->hi[a] && p[a] > cw->hi[a] - cw->m) return true;
-        if (a != cw->up && c->eye[a] < cw->lo[a] && p[a] < cw->lo[a] + cw->m) return true;
+        if (eye[a] > cw->hi[a] && p[a] > cw->hi[a] - cw->m) return true;
+        if (a != cw->up && eye[a] < cw->lo[a] && p[a] < cw->lo[a] + cw->m) return true;
     }
     return false;
 }
 
 static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, double rad,
                    int layer, int kind /* 0 fluid, 1 boundary, 2 diffuse, 3 bodies */,
-                   const pfsph_scene *sc, int by, double vref, int ssf, const cutaway *cw,
+                   const pfsph_scene *sc, int by, double vref, int ssf, const pfsph_cutaway *cw,
                    double range[2])
 {
     if (ss->n + ps->n > ss->cap) {
@@ -396,7 +410,7 @@ static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, doubl
     for (size_t i = 0; i < ps->n; i++) {
         double p[3] = {ps->x[i], ps->y[i], sc->dim == 2 ? 0.0 : ps->z[i]};
         if (!isfinite(p[0]) || !isfinite(p[1]) || !isfinite(p[2])) continue;
-        if (kind == 1 && cut_away(cw, c, p)) continue;
+        if (kind == 1 && pfsph_cutaway_hides(cw, c->eye, p)) continue;
         splat *s = &ss->s[ss->n];
         if (!project(c, p, rad, s)) continue;
         s->layer = (uint8_t)layer;
@@ -629,54 +643,26 @@ typedef struct ctx {
 
 #define MESH_ID UINT32_MAX
 
-/* The liquid surface (frames/liquid_NNNNN.ply, io/meshing.c's layout) into m; -1 when absent. */
-static int read_liquid(const char *path, pfsph_surface_mesh *m)
+/* Layer-0 ids at or above BODY_ID0 are pixels of a body's mesh (body = id - BODY_ID0); MESH_ID
+ * the liquid's. Splats never come near: their count is checked against UINT32_MAX - 512. */
+#define BODY_ID0 (UINT32_MAX - 257u)
+
+/* A mesh file of frame f (frames/<prefix>NNNNN.ply) into m; -1 when absent or unreadable, so
+ * that a missing or broken mesh falls back to the particles. */
+static int read_mesh(const char *fdir, const char *prefix, int f, pfsph_surface_mesh *m)
 {
+    char path[PFSPH_PATH_LEN + 64];
+    snprintf(path, sizeof path, "%s/%s%05d.ply", fdir, prefix, f);
     memset(m, 0, sizeof *m);
-    unsigned char *d = NULL;
-    size_t len;
+    if (access(path, R_OK) != 0) return -1;
     pfsph_error e;
-    FILE *f = fopen(path, "rb");
-    if (!f) return -1;
-    fclose(f);
-    if (pfsph__read_file(path, &d, &len, &e)) return -1;
-    const char *h = (const char *)d, *end = strstr(h, "end_header\n"), *ev = strstr(h, "element vertex "),
-               *ef = strstr(h, "element face ");
-    size_t nv = 0, nt = 0;
-    int ok = end && ev && ef && sscanf(ev, "element vertex %zu", &nv) == 1 && sscanf(ef, "element face %zu", &nt) == 1 &&
-             strstr(h, "property float nz") && strstr(h, "property uchar phase");
-    size_t off = ok ? (size_t)(end - h) + 11 : 0;
-    ok = ok && nv < (1u << 31) && nt < (1u << 31) && off + nv * 24 + nt * 14 == len;
-    if (ok) {
-        m->v = malloc(3 * (nv ? nv : 1) * sizeof *m->v);
-        m->n = malloc(3 * (nv ? nv : 1) * sizeof *m->n);
-        m->tri = malloc(3 * (nt ? nt : 1) * sizeof *m->tri);
-        ok = m->v && m->n && m->tri;
-    }
-    for (size_t i = 0; ok && i < nv; i++) {
-        float q[6];
-        for (int k = 0; k < 6; k++) pfsph__get_le(&q[k], d + off + 24 * i + 4 * k, 4);
-        for (int k = 0; k < 3; k++) m->v[3 * i + k] = q[k], m->n[3 * i + k] = q[3 + k];
-    }
-    for (size_t t = 0; ok && t < nt; t++) {
-        const unsigned char *r = d + off + 24 * nv + 14 * t;
-        for (int k = 0; k < 3; k++) {
-            pfsph__get_le(&m->tri[3 * t + k], r + 1 + 4 * k, 4);
-            if (r[0] != 3 || m->tri[3 * t + k] >= nv) ok = 0;
-        }
-    }
-    free(d);
-    if (!ok) {
-        pfsph_surface_mesh_free(m);
-        return -1;
-    }
-    m->nverts = nv;
-    m->ntris = nt;
-    return 0;
+    return pfsph_read_surface_ply(path, m, NULL, &e) == PFSPH_OK ? 0 : -1;
 }
 
-/* Depth-test the liquid's triangles into layer 0 (serial: the same pixels for any thread count). */
-static void raster_mesh(ctx *x, const pfsph_surface_mesh *m)
+/* Depth-test a mesh's triangles into layer 0 (serial: the same pixels for any thread count):
+ * bodies (id BODY_ID0 + the face's body) with the face's own normal, so that boxes keep their
+ * edges; the liquid (MESH_ID) with its smooth vertex normals. */
+static void raster_mesh(ctx *x, const pfsph_surface_mesh *m, bool bodies)
 {
     const cam *c = &x->c;
     image *im = &x->im;
@@ -688,7 +674,16 @@ static void raster_mesh(ctx *x, const pfsph_surface_mesh *m)
             uint32_t v = m->tri[3 * t + k];
             double p[3] = {m->v[3 * v], m->v[3 * v + 1], m->v[3 * v + 2]};
             if (!project(c, p, 0, &s[k])) ok = 0;
-            double nw[3] = {m->n[3 * v], m->n[3 * v + 1], m->n[3 * v + 2]};
+            double nw[3];
+            if (bodies || !m->n) {
+                const double *a = m->v + 3 * m->tri[3 * t], *b = m->v + 3 * m->tri[3 * t + 1],
+                             *q = m->v + 3 * m->tri[3 * t + 2];
+                double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {q[0] - a[0], q[1] - a[1], q[2] - a[2]};
+                cross3(e1, e2, nw);
+                norm3(nw);
+            } else {
+                for (int j = 0; j < 3; j++) nw[j] = m->n[3 * v + j];
+            }
             n[k][0] = (float)dot3(nw, c->right);
             n[k][1] = (float)dot3(nw, c->up);
             n[k][2] = (float)-dot3(nw, c->fwd);
@@ -715,7 +710,7 @@ static void raster_mesh(ctx *x, const pfsph_surface_mesh *m)
                 size_t o = (size_t)py * (size_t)im->w + (size_t)px;
                 if (!(z < im->z[0][o])) continue;
                 im->z[0][o] = z;
-                im->id[0][o] = MESH_ID;
+                im->id[0][o] = bodies ? BODY_ID0 + (m->phase[t] < 255 ? m->phase[t] : 255) : MESH_ID;
                 for (int k = 0; k < 3; k++) x->mn[3 * o + k] = w[0] * n[0][k] + w[1] * n[1][k] + w[2] * n[2][k];
             }
     }
@@ -741,9 +736,35 @@ static void shade_water(const float nin[3], float out[3])
     }
 }
 
+/* A body's mesh: the particles' look (shade()) with the surface's own normal. */
+static void shade_solid(const float nin[3], const float col[3], float out[3])
+{
+    static const float L[3] = {-0.45f, 0.62f, 0.64f}, Hv[3] = {-0.2116f, 0.2915f, 0.9328f};
+    float len = sqrtf(nin[0] * nin[0] + nin[1] * nin[1] + nin[2] * nin[2]);
+    float n[3] = {0, 0, 1};
+    if (len > 0)
+        for (int k = 0; k < 3; k++) n[k] = nin[k] / len;
+    if (n[2] < 0)
+        for (int k = 0; k < 3; k++) n[k] = -n[k];
+    float diff = fmaxf(0.0f, n[0] * L[0] + n[1] * L[1] + n[2] * L[2]);
+    float spec = powf(fmaxf(0.0f, n[0] * Hv[0] + n[1] * Hv[1] + n[2] * Hv[2]), 28.0f);
+    for (int k = 0; k < 3; k++) {
+        float v = col[k] * (0.32f + 0.68f * diff) + 0.22f * spec;
+        out[k] = v < 0 ? 0 : (v > 1 ? 1 : v);
+    }
+}
+
+/* The colour of body b of the bodies' surface file: its phase's, as its particles are drawn. */
+static void body_color(const pfsph_scene *sc, int b, float col[3])
+{
+    col[0] = 0.8f, col[1] = 0.2f, col[2] = 0.8f;
+    if (b < sc->nbodies && sc->bodies[b].phase >= 0 && sc->bodies[b].phase < sc->nphases)
+        memcpy(col, sc->phases[sc->bodies[b].phase].color, 3 * sizeof *col);
+}
+
 static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_particles *bnd,
                         const pfsph_particles *bod, const pfsph_particles *dif,
-                        const pfsph_surface_mesh *liq, int frame, double time, const char *png_path,
+                        const pfsph_surface_mesh *liq, const pfsph_surface_mesh *bmesh, int frame, double time, const char *png_path,
                         pfsph_error *err)
 {
     const pfsph_scene *sc = x->sc;
@@ -755,16 +776,8 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     /* 2D fluid discs are drawn a little larger than the particle so that a block of fluid
      * reads as a surface rather than a lattice with holes (spacing is 2r). */
     const int ssf = x->ss;
-    cutaway cw = {.on = !d2 && bnd && bnd->n && !x->all_walls, .m = 5 * r, .up = 1};
-    if (cw.on) {
-        box3 bb;
-        box_empty(&bb);
-        box_add(&bb, bnd);
-        memcpy(cw.lo, bb.lo, sizeof cw.lo);
-        memcpy(cw.hi, bb.hi, sizeof cw.hi);
-        for (int a = 0; a < 3; a++)
-            if (fabs(sc->gravity[a]) > fabs(sc->gravity[cw.up])) cw.up = a;
-    }
+    pfsph_cutaway cw;
+    pfsph_cutaway_init(&cw, sc, x->all_walls ? NULL : bnd);
     double range[2] = {0, 1};
     if (bnd &&
         (rc = add_set(&x->sp, &x->c, bnd, d2 ? 0.9 * r : r, 1, 1, sc, COLOR_PHASE, 0, ssf, &cw, NULL)))
@@ -776,10 +789,11 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     if (dif && (rc = add_set(&x->sp, &x->c, dif, 0.4 * r, 0, 2, sc, COLOR_PHASE, 0, ssf, NULL, NULL)))
         goto oom;
     /* rigid bodies are drawn solid in their phase's colour, not as translucent walls */
-    if (bod && (rc = add_set(&x->sp, &x->c, bod, r, 0, 3, sc, COLOR_PHASE, 0, ssf, NULL, NULL)))
+    const bool bmeshes = bmesh && bmesh->ntris && !d2; /* the bodies' surfaces instead of their particles */
+    if (bod && !bmeshes && (rc = add_set(&x->sp, &x->c, bod, r, 0, 3, sc, COLOR_PHASE, 0, ssf, NULL, NULL)))
         goto oom;
 
-    if (x->sp.n > UINT32_MAX)
+    if (x->sp.n > UINT32_MAX - 512)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: too many particles", png_path);
     /* Bin splats into bands of rows: a splat goes to every band it overlaps. */
     const int W = x->c.w, H = x->c.h, nb = (H + BAND - 1) / BAND;
@@ -834,9 +848,10 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
         splat_band(&x->im, x->sp.s, x->bidx + x->bstart[b], x->bstart[b + 1] - x->bstart[b], y0,
                    y1);
     }
-    if (mesh) {
+    if (mesh || bmeshes) {
         if (!x->mn && !(x->mn = malloc(3 * npix * sizeof *x->mn))) goto oom;
-        raster_mesh(x, liq);
+        if (mesh) raster_mesh(x, liq, false);
+        if (bmeshes) raster_mesh(x, bmesh, true);
     }
 
     /* Composite and downsample: boundary walls in front of fluid are translucent in 3D. */
@@ -858,6 +873,11 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
                     bool hf = x->im.z[0][o] < FLT_MAX, hb = x->im.z[1][o] < FLT_MAX;
                     if (hf && x->im.id[0][o] == MESH_ID) {
                         shade_water(x->mn + 3 * o, sc3);
+                        for (int k = 0; k < 3; k++) c[k] = sc3[k];
+                    } else if (hf && x->im.id[0][o] >= BODY_ID0) {
+                        float bc[3];
+                        body_color(sc, (int)(x->im.id[0][o] - BODY_ID0), bc);
+                        shade_solid(x->mn + 3 * o, bc, sc3);
                         for (int k = 0; k < 3; k++) c[k] = sc3[k];
                     } else if (hf) {
                         shade(&x->sp.s[x->im.id[0][o]], px, py, false, sc3);
@@ -1134,13 +1154,19 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
             setup_camera(&x.c, sc, &fb);
             x.vref = speed_scale(sc, &fluid);
         }
-        pfsph_surface_mesh liq;
-        snprintf(path, sizeof path, "%s/liquid_%05d.ply", fdir, f);
-        int have_liq = o->particles ? -1 : read_liquid(path, &liq);
+        pfsph_surface_mesh liq, bm;
+        /* the liquid needs its normals (smooth shading); a file without them counts as absent */
+        int have_liq = o->particles ? -1 : read_mesh(fdir, "liquid_", f, &liq);
+        if (have_liq == 0 && !liq.n) {
+            pfsph_surface_mesh_free(&liq);
+            have_liq = -1;
+        }
+        int have_bm = o->particles ? -1 : read_mesh(fdir, "surfaces_", f, &bm);
         snprintf(path, sizeof path, "%s/frame_%05d.png", pdir, f);
         rc = render_frame(&x, &fluid, bi >= 0 ? &bnd : NULL, ri >= 0 ? &both : NULL, di >= 0 ? &dif : NULL,
-                          have_liq == 0 ? &liq : NULL, f, t, path, err);
+                          have_liq == 0 ? &liq : NULL, have_bm == 0 ? &bm : NULL, f, t, path, err);
         if (have_liq == 0) pfsph_surface_mesh_free(&liq);
+        if (have_bm == 0) pfsph_surface_mesh_free(&bm);
         if (rc != PFSPH_OK) goto out;
         rendered++;
         if (o->progress) o->progress(rendered, total, path, o->user);

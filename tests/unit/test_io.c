@@ -9,6 +9,9 @@
 #include <unistd.h>
 
 #include "pfsph/io.h"
+#include "pfsph/mesh.h"
+#include "pfsph/meshing.h"
+#include "pfsph/surface_io.h"
 #include "testutil.h"
 
 typedef int (*writer_fn)(const char *, const pfsph_particles *, const pfsph_io_opts *,
@@ -426,6 +429,107 @@ static void test_ply_corrupt(void **state)
     free(b);
 }
 
+/* The surface mesh reader (the renderer's and the viewer's): a liquid mesh (normals, faces
+ * tagged by phase) and a bodies' surface file (no normals, faces tagged by body) read back as
+ * written (positions and normals are floats in the file, so exactly their float values), and
+ * malformed files refused with the path named. */
+static void surface_reject(const char *path, const char *what)
+{
+    pfsph_surface_mesh m;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_read_surface_ply(path, &m, NULL, &err), PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, path));
+    if (what) assert_non_null(strstr(err.msg, what));
+    assert_null(m.v);
+    assert_null(m.tri);
+}
+
+static void test_surface_ply_roundtrip(void **state)
+{
+    (void)state;
+    const char *dir = tu_tmpdir();
+    char path[512], bad[512];
+    pfsph_error err = {0};
+    /* a liquid: a tetrahedron of two phases */
+    double v[12] = {0.1, 0.2, 0.3, 1.0 / 3, 0, 0, 0, 1.25, 0, 0, 0, -2.5e-3};
+    float nn[12] = {0.57735f, 0.57735f, 0.57735f, 1, 0, 0, 0, 1, 0, 0, 0, -1};
+    uint32_t tri[12] = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2};
+    uint8_t ph[4] = {0, 0, 2, 2};
+    pfsph_surface_mesh w = {.nverts = 4, .ntris = 4, .v = v, .n = nn, .tri = tri, .phase = ph};
+    snprintf(path, sizeof path, "%s/liquid_00003.ply", dir);
+    assert_int_equal(pfsph_write_surface_ply(path, &w, 0.125, &err), PFSPH_OK);
+    pfsph_surface_mesh m;
+    double t = -1;
+    assert_int_equal(pfsph_read_surface_ply(path, &m, &t, &err), PFSPH_OK);
+    assert_true(t == 0.125);
+    assert_int_equal(m.nverts, 4);
+    assert_int_equal(m.ntris, 4);
+    assert_non_null(m.n);
+    for (int i = 0; i < 12; i++) {
+        assert_true(m.v[i] == (double)(float)v[i]);
+        assert_true(m.n[i] == nn[i]);
+        assert_int_equal(m.tri[i], tri[i]);
+    }
+    for (int i = 0; i < 4; i++) assert_int_equal(m.phase[i], ph[i]);
+    pfsph_surface_mesh_free(&m);
+
+    /* bodies: a box and a sphere in one file, faces tagged 0 and 1 */
+    pfsph_mesh b[2];
+    const double half[3] = {0.1, 0.05, 0.2};
+    assert_int_equal(pfsph_mesh_box(&b[0], half), PFSPH_OK);
+    assert_int_equal(pfsph_mesh_sphere(&b[1], 0.07, 12), PFSPH_OK);
+    pfsph_body_pose pose[2] = {{"box", {0, 0, 0}, {1, 0, 0, 0}}, {"ball", {1, 2, 3}, {1, 0, 0, 0}}};
+    snprintf(path, sizeof path, "%s/surfaces_00003.ply", dir);
+    assert_int_equal(pfsph_write_surfaces_ply(path, b, 2, pose, 0.5, &err), PFSPH_OK);
+    assert_int_equal(pfsph_read_surface_ply(path, &m, &t, &err), PFSPH_OK);
+    assert_true(t == 0.5);
+    assert_null(m.n);
+    assert_int_equal(m.nverts, b[0].nverts + b[1].nverts);
+    assert_int_equal(m.ntris, b[0].ntris + b[1].ntris);
+    for (size_t i = 0; i < m.ntris; i++) {
+        int body = i < b[0].ntris ? 0 : 1;
+        size_t ti = body ? i - b[0].ntris : i;
+        assert_int_equal(m.phase[i], body);
+        for (int k = 0; k < 3; k++) {
+            uint32_t want = b[body].tri[3 * ti + k] + (body ? (uint32_t)b[0].nverts : 0);
+            assert_int_equal(m.tri[3 * i + k], want);
+            const double *pv = b[body].v + 3 * b[body].tri[3 * ti + k];
+            for (int c = 0; c < 3; c++) assert_true(m.v[3 * want + c] == (double)(float)pv[c]);
+        }
+    }
+    pfsph_surface_mesh_free(&m);
+
+    /* malformed: short data, a quad, an index out of range, a bad list, particles */
+    size_t n;
+    unsigned char *d = slurp(path, &n);
+    snprintf(bad, sizeof bad, "%s/bad.ply", dir);
+    dump(bad, d, n - 1);
+    surface_reject(bad, "bytes of data");
+    const unsigned char *hdr = (const unsigned char *)strstr((const char *)d, "end_header\n");
+    size_t nv = b[0].nverts + b[1].nverts;
+    size_t f0 = (size_t)(hdr - d) + 11 + 12 * nv; /* the first face record: count, 3 indices */
+    unsigned char *c = malloc(n);
+    memcpy(c, d, n);
+    c[f0] = 4;
+    dump(bad, c, n);
+    surface_reject(bad, "triangles only");
+    memcpy(c, d, n);
+    uint32_t big = (uint32_t)nv;
+    memcpy(c + f0 + 5, &big, 4);
+    dump(bad, c, n);
+    surface_reject(bad, "out of range");
+    free(c);
+    patched(d, n, "list uchar uint", "list uint uint", bad);
+    surface_reject(bad, "vertex_indices");
+    patched(d, n, "element face", "element edge", bad);
+    surface_reject(bad, NULL);
+    patched(d, n, "binary_little_endian", "ascii", bad);
+    surface_reject(bad, "format");
+    free(d);
+    pfsph_mesh_free(&b[0]);
+    pfsph_mesh_free(&b[1]);
+}
+
 /* When VTK's Python bindings are installed (Debian: python3-vtk9), VTK's own reader -- the one
  * ParaView uses -- must accept the file and see the same data. Skipped otherwise. */
 static void test_vtp_opens_in_vtk(void **state)
@@ -480,7 +584,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_ply_header),         cmocka_unit_test(test_speed_field),
         cmocka_unit_test(test_write_errors),       cmocka_unit_test(test_atomic_keeps_old_file),
         cmocka_unit_test(test_vtp_corrupt),        cmocka_unit_test(test_ply_corrupt),
-        cmocka_unit_test(test_vtp_opens_in_vtk),
+        cmocka_unit_test(test_vtp_opens_in_vtk),   cmocka_unit_test(test_surface_ply_roundtrip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
