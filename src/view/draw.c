@@ -11,8 +11,13 @@ typedef struct layer {
     GLuint fbo, col, depth;
 } layer;
 
+struct pfsph_vmesh {
+    GLuint vao, vbo, ebo;
+    size_t nv, ni; /* vertices; indices (0: unindexed) */
+};
+
 struct pfsph_vdraw {
-    GLuint sprite_prog, comp_prog, over_prog;
+    GLuint sprite_prog, comp_prog, over_prog, mesh_prog;
     GLuint quad_vbo, inst_vbo, sprite_vao, empty_vao, over_vbo, over_vao;
     layer L[2];
     GLuint final_fbo, final_col;
@@ -70,6 +75,44 @@ static const char *SPRITE_FS =
     "  o = vec4(clamp(vcol * sh + 0.22 * spec * relief, 0.0, 1.0), 1.0);\n"
     "  vec4 cl = proj * vec4(vc.xy + uv * vr, vc.z + nz * vr, 1.0);\n"
     "  gl_FragDepth = clamp(cl.z / cl.w * 0.5 + 0.5, 0.0, 1.0);\n"
+    "}\n";
+
+/* Meshes: the liquid shaded as render.c's shade_water, bodies as its shade_solid, both on the
+ * normal in camera coordinates (x right, y up, z towards the viewer) as the renderer has it. */
+static const char *MESH_VS =
+    "#version 330 core\n"
+    "layout(location = 0) in vec3 pos;\n"
+    "layout(location = 1) in vec3 nrm;\n"
+    "layout(location = 2) in vec3 col;\n"
+    "uniform mat4 view, proj;\n"
+    "out vec3 vn;\n"
+    "out vec3 vcol;\n"
+    "void main() {\n"
+    "  vn = mat3(view) * nrm; vcol = col;\n"
+    "  gl_Position = proj * (view * vec4(pos, 1.0));\n"
+    "}\n";
+
+static const char *MESH_FS =
+    "#version 330 core\n"
+    "in vec3 vn;\n"
+    "in vec3 vcol;\n"
+    "uniform int water;\n"
+    "out vec4 o;\n"
+    "void main() {\n"
+    "  const vec3 L = vec3(-0.45, 0.62, 0.64), H = vec3(-0.2116, 0.2915, 0.9328);\n"
+    "  float len = length(vn);\n"
+    "  vec3 n = len > 0.0 ? vn / len : vec3(0.0, 0.0, 1.0);\n"
+    "  if (water == 1) {\n"
+    "    const vec3 base = vec3(0.13, 0.38, 0.72), sky = vec3(0.86, 0.91, 0.96);\n"
+    "    n.z = abs(n.z);\n"
+    "    float diff = max(dot(n, L), 0.0), spec = pow(max(dot(n, H), 0.0), 60.0);\n"
+    "    float fr = 0.04 + 0.96 * pow(1.0 - n.z, 5.0);\n"
+    "    o = vec4(clamp(base * (0.35 + 0.65 * diff) * (1.0 - fr) + sky * fr + 0.7 * spec, 0.0, 1.0), 1.0);\n"
+    "  } else {\n"
+    "    if (n.z < 0.0) n = -n;\n"
+    "    float diff = max(dot(n, L), 0.0), spec = pow(max(dot(n, H), 0.0), 28.0);\n"
+    "    o = vec4(clamp(vcol * (0.32 + 0.68 * diff) + 0.22 * spec, 0.0, 1.0), 1.0);\n"
+    "  }\n"
     "}\n";
 
 static const char *COMP_VS =
@@ -176,7 +219,8 @@ pfsph_vdraw *pfsph_vdraw_create(char *msg, size_t cap)
     d->sprite_prog = program(SPRITE_VS, SPRITE_FS, msg, cap);
     d->comp_prog = d->sprite_prog ? program(COMP_VS, COMP_FS, msg, cap) : 0;
     d->over_prog = d->comp_prog ? program(OVER_VS, OVER_FS, msg, cap) : 0;
-    if (!d->over_prog) {
+    d->mesh_prog = d->over_prog ? program(MESH_VS, MESH_FS, msg, cap) : 0;
+    if (!d->mesh_prog) {
         pfsph_vdraw_destroy(d);
         return NULL;
     }
@@ -234,6 +278,7 @@ void pfsph_vdraw_destroy(pfsph_vdraw *d)
     if (d->sprite_prog) glDeleteProgram(d->sprite_prog);
     if (d->comp_prog) glDeleteProgram(d->comp_prog);
     if (d->over_prog) glDeleteProgram(d->over_prog);
+    if (d->mesh_prog) glDeleteProgram(d->mesh_prog);
     free(d->ov);
     free(d);
 }
@@ -321,6 +366,66 @@ void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size
     glBindBuffer(GL_ARRAY_BUFFER, d->inst_vbo);
     glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(n * sizeof *s), s, GL_STREAM_DRAW);
     glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)n);
+    glBindVertexArray(0);
+    glDisable(GL_DEPTH_TEST);
+}
+
+pfsph_vmesh *pfsph_vmesh_create(void)
+{
+    pfsph_vmesh *m = calloc(1, sizeof *m);
+    if (!m) return NULL;
+    glGenVertexArrays(1, &m->vao);
+    glBindVertexArray(m->vao);
+    glGenBuffers(1, &m->vbo);
+    glGenBuffers(1, &m->ebo);
+    glBindBuffer(GL_ARRAY_BUFFER, m->vbo);
+    for (int a = 0; a < 3; a++) {
+        glEnableVertexAttribArray((GLuint)a);
+        glVertexAttribPointer((GLuint)a, 3, GL_FLOAT, GL_FALSE, 9 * sizeof(float), (void *)(3 * a * sizeof(float)));
+    }
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ebo); /* part of the VAO's state */
+    glBindVertexArray(0);
+    return m;
+}
+
+void pfsph_vmesh_upload(pfsph_vmesh *m, const float *vert, size_t nv, const uint32_t *idx, size_t ni)
+{
+    glBindVertexArray(m->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, m->vbo);
+    /* a replayed frame is uploaded once and drawn many times (orbiting): static draw */
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(nv * 9 * sizeof(float)), nv ? vert : NULL, GL_STATIC_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((idx ? ni : 0) * sizeof(uint32_t)), idx && ni ? idx : NULL,
+                 GL_STATIC_DRAW);
+    glBindVertexArray(0);
+    m->nv = nv;
+    m->ni = idx ? ni : 0;
+}
+
+void pfsph_vmesh_destroy(pfsph_vmesh *m)
+{
+    if (!m) return;
+    glDeleteBuffers(1, &m->vbo);
+    glDeleteBuffers(1, &m->ebo);
+    glDeleteVertexArrays(1, &m->vao);
+    free(m);
+}
+
+void pfsph_vdraw_mesh(pfsph_vdraw *d, const pfsph_vmesh *m, int water)
+{
+    if (!m || !m->nv) return;
+    glBindFramebuffer(GL_FRAMEBUFFER, d->L[0].fbo);
+    glViewport(0, 0, d->ss * d->w, d->ss * d->h);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE); /* the nearest face wins by depth, as in the renderer */
+    glUseProgram(d->mesh_prog);
+    glUniformMatrix4fv(glGetUniformLocation(d->mesh_prog, "view"), 1, GL_FALSE, d->view);
+    glUniformMatrix4fv(glGetUniformLocation(d->mesh_prog, "proj"), 1, GL_FALSE, d->proj);
+    glUniform1i(glGetUniformLocation(d->mesh_prog, "water"), water ? 1 : 0);
+    glBindVertexArray(m->vao);
+    if (m->ni) glDrawElements(GL_TRIANGLES, (GLsizei)m->ni, GL_UNSIGNED_INT, (void *)0);
+    else glDrawArrays(GL_TRIANGLES, 0, (GLsizei)m->nv);
     glBindVertexArray(0);
     glDisable(GL_DEPTH_TEST);
 }

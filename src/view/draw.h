@@ -32,6 +32,18 @@ void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const
                        int ortho, double f, int walls3d);
 /* Draw n sprites into layer 0 (fluid, bodies, diffuse) or 1 (walls). */
 void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size_t n);
+/* A triangle mesh held by the GPU (one vertex buffer, and an index buffer when indexed). */
+typedef struct pfsph_vmesh pfsph_vmesh;
+/* Vertices of 9 floats: position [m], unit normal, colour 0..1. idx (ni entries, 3 per
+ * triangle) may be NULL: then every three vertices are a triangle (faces with their own
+ * normals). Replaces what the mesh held. NULL from create when out of memory. */
+pfsph_vmesh *pfsph_vmesh_create(void);
+void pfsph_vmesh_upload(pfsph_vmesh *m, const float *vert, size_t nv, const uint32_t *idx, size_t ni);
+void pfsph_vmesh_destroy(pfsph_vmesh *m);
+/* Draw a mesh into layer 0: water = 1 shades it as `pfsph render` shades the liquid (a blue
+ * body, Lambert light, a highlight and Fresnel towards the sky; the colours are ignored),
+ * water = 0 as a solid in its vertex colours with the particles' light. */
+void pfsph_vdraw_mesh(pfsph_vdraw *d, const pfsph_vmesh *m, int water);
 /* Composite the layers over the background into the frame. */
 void pfsph_vdraw_composite(pfsph_vdraw *d);
 /* Overlay, in pixels from the top left: a filled rectangle, text (3x5 font scaled by sc; letters

@@ -20,9 +20,11 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "pfsph/bodies.h"
 #include "pfsph/io.h"
+#include "pfsph/meshing.h"
 #include "pfsph/render.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
@@ -33,7 +35,7 @@ const char *const pfsph_view_help =
     "usage: pfsph view [SCENE | RUN_DIR] [--size WxH] [--color-by FIELD] [--frame N]\n"
     "                  [--threads N] [--paused] [--screenshot FILE.png --frames N]\n"
     "                  [--dump DIR] [--hide walls,bodies,diffuse] [--no-overlay]\n"
-    "                  [--samples 1|2] [--bench SECONDS]\n"
+    "                  [--samples 1|2] [--bench SECONDS] [--particles] [--all-walls]\n"
     "\n"
     "Live mode (SCENE, a JSON file; none: the embedded default scene): the scene is simulated\n"
     "in the window, step by step, as `pfsph run` does. Replay mode (RUN_DIR, a run directory):\n"
@@ -53,13 +55,16 @@ const char *const pfsph_view_help =
     "  --samples 1|2      samples per pixel along each axis (default 2, as `pfsph render`;\n"
     "                     1 in a window on a software renderer, for speed)\n"
     "  --bench SECONDS    draw continuously for SECONDS, print frames/s and steps/s, exit\n"
+    "  --particles        replay: start with particles where the run has liquid or body meshes\n"
+    "  --all-walls        3D: keep the walls that face the camera (default: cut away)\n"
     "\n"
     "Mouse: left drag orbits (2D: pans), right or middle drag (or shift + left) pans, wheel\n"
     "zooms, ctrl + left drag moves a kinematic body (live, bodies without keyframes); replay:\n"
     "click or drag the slider. Keys: space pause/play, N single step (live) or\n"
     "next frame, P previous frame, Home/End first/last frame, R reset, C colour field,\n"
-    "W walls, B bodies, D diffuse, F reset the camera, S save pfsph_view_NNN.png, H help,\n"
-    "Esc or Q quit. Live only:\n"
+    "W walls, B bodies, D diffuse, X cut-away of the walls facing the camera (3D), M meshes /\n"
+    "particles (replay), F reset the camera, S save pfsph_view_NNN.png, H help, Esc or Q quit.\n"
+    "Live only:\n"
     "G gravity on/off, [ and ] turn gravity by 15 degrees, Tab next phase pair, + and - raise\n"
     "or lower its coefficient / surface tension (x1.25) or contact angle (10 degrees).\n";
 
@@ -78,6 +83,10 @@ typedef struct vframe {
     double time;
     uint64_t steps;
     int number; /* replay: the frame number */
+    /* replay: the frame's liquid surface (frames/liquid_NNNNN.ply) and the bodies' meshes
+     * (frames/surfaces_NNNNN.ply), ntris 0 where absent; mesh_new: not yet sent to the GPU */
+    pfsph_surface_mesh liquid, bmesh;
+    bool mesh_new;
 } vframe;
 
 static void vframe_free(vframe *f)
@@ -86,6 +95,8 @@ static void vframe_free(vframe *f)
     pfsph_particles_free(&f->walls);
     pfsph_particles_free(&f->bodies);
     pfsph_particles_free(&f->diffuse);
+    pfsph_surface_mesh_free(&f->liquid);
+    pfsph_surface_mesh_free(&f->bmesh);
 }
 
 /* Copy the particles of s whose id is in [lo, hi) into d (d grows; NULL s empties d). */
@@ -336,6 +347,19 @@ static int replay_load(replay *R, int k, vframe *f, pfsph_error *err)
     f->bodies.n = f->diffuse.n = 0;
     if (ri >= 0 && (rc = read_set(R->fdir, "bodies_", num, R->bod.ply[ri], &f->bodies, NULL, err))) return rc;
     if (di >= 0 && (rc = read_set(R->fdir, "diffuse_", num, R->dif.ply[di], &f->diffuse, NULL, err))) return rc;
+    /* the meshes through the io layer's reader; a liquid without normals cannot be shaded as
+     * water, so it counts as absent (as in `pfsph render`) */
+    pfsph_surface_mesh_free(&f->liquid);
+    pfsph_surface_mesh_free(&f->bmesh);
+    char path[PFSPH_PATH_LEN + 64];
+    snprintf(path, sizeof path, "%s/liquid_%05d.ply", R->fdir, num);
+    if (access(path, F_OK) == 0) {
+        if ((rc = pfsph_read_surface_ply(path, &f->liquid, NULL, err))) return rc;
+        if (!f->liquid.n) pfsph_surface_mesh_free(&f->liquid);
+    }
+    snprintf(path, sizeof path, "%s/surfaces_%05d.ply", R->fdir, num);
+    if (access(path, F_OK) == 0 && (rc = pfsph_read_surface_ply(path, &f->bmesh, NULL, err))) return rc;
+    f->mesh_new = true;
     f->number = num;
     R->cur = k;
     return PFSPH_OK;
@@ -349,7 +373,7 @@ typedef struct opts {
     const char *color_by;
     int frame;
     int threads;
-    bool paused, no_overlay;
+    bool paused, no_overlay, particles, all_walls;
     const char *screenshot, *dump;
     bool hide_walls, hide_bodies, hide_diffuse;
     int frames;
@@ -370,6 +394,11 @@ typedef struct app {
     double vref;        /* speed colour scale */
     int by;
     bool show_walls, show_bodies, show_diffuse, show_help;
+    bool show_surface;  /* replay: meshes where the run has them (M toggles) */
+    bool cut_walls;     /* 3D: the walls facing the camera cut away (X toggles) */
+    pfsph_vmesh *gl_liquid, *gl_bodies; /* the shown frame's meshes on the GPU */
+    float *mv;          /* vertex staging for the uploads */
+    size_t mv_cap;
     int pair_a, pair_b; /* selected phase pair (live) */
     bool gravity_off;
     double g_saved[3];
@@ -451,7 +480,7 @@ static const float DIFFUSE_COL[3][3] = {{0.98f, 0.98f, 0.98f}, {0.80f, 0.82f, 0.
 
 /* kind: 0 fluid, 1 walls, 2 diffuse, 3 bodies (as the renderer colours them) */
 static size_t add_sprites(app *A, size_t n0, const pfsph_particles *ps, double rad, double zoff, int kind,
-                          double lo, double hi)
+                          double lo, double hi, const pfsph_cutaway *cw)
 {
     const pfsph_scene *sc = A->scene;
     if (n0 + ps->n > A->spr_cap) {
@@ -468,6 +497,10 @@ static size_t add_sprites(app *A, size_t n0, const pfsph_particles *ps, double r
         s->y = (float)ps->y[i];
         s->z = (float)(sc->dim == 2 ? zoff : ps->z[i]);
         if (!isfinite(s->x) || !isfinite(s->y) || !isfinite(s->z)) continue;
+        if (cw) {
+            const double p[3] = {ps->x[i], ps->y[i], ps->z[i]};
+            if (pfsph_cutaway_hides(cw, A->cam.eye, p)) continue;
+        }
         s->r = (float)rad;
         s->pad = 0;
         float col[3] = {0.8f, 0.2f, 0.8f};
@@ -571,10 +604,19 @@ static void overlay(app *A, double lo, double hi)
              f->bodies.n, f->diffuse.n, A->show_walls ? "" : "  (WALLS HIDDEN)",
              A->show_bodies ? "" : "  (BODIES HIDDEN)", A->show_diffuse ? "" : "  (DIFFUSE HIDDEN)");
     panel_text(A, 6 * s, y, s, line, INK);
+    const bool meshes = !A->is_live && sc->dim == 3 && (A->rf.liquid.ntris || A->rf.bmesh.ntris);
+    if (meshes) {
+        y += lh;
+        snprintf(line, sizeof line, "MESHES: LIQUID %zu, BODIES %zu TRIANGLES  %s", A->rf.liquid.ntris,
+                 A->rf.bmesh.ntris, A->show_surface ? "(M: PARTICLES)" : "HIDDEN (M: MESHES)");
+        panel_text(A, 6 * s, y, s, line, INK);
+    }
 
-    /* legend, bottom right */
+    /* legend, bottom right (none for a liquid drawn as water: the field does not colour it) */
     float lw = 120 * s, bx = A->fb_w - lw - 10 * s, by = A->fb_h - (A->is_live ? 14 : 26) * s;
-    if (A->by == BY_PHASE) {
+    if (meshes && A->show_surface && A->rf.liquid.ntris && A->by != BY_PHASE) {
+        /* nothing */
+    } else if (A->by == BY_PHASE) {
         float yy = by;
         for (int p = sc->nphases - 1; p >= 0; p--) {
             if (sc->phases[p].kind == PFSPH_PHASE_SOLID && !sc->phases[p].color_set) continue;
@@ -620,6 +662,66 @@ static void overlay(app *A, double lo, double hi)
     }
 }
 
+/* Room for m floats in the staging array; false when out of memory. */
+static bool mv_reserve(app *A, size_t m)
+{
+    if (m <= A->mv_cap) return true;
+    float *q = realloc(A->mv, m * sizeof *q);
+    if (!q) return false;
+    A->mv = q;
+    A->mv_cap = m;
+    return true;
+}
+
+/* The replayed frame's meshes into their vertex buffers (once per frame loaded): the liquid
+ * welded, with its smooth normals and an index buffer; the bodies as separate triangles with
+ * each face's own normal (boxes keep their edges, as in the renderer) in their phase's colour. */
+static void upload_meshes(app *A)
+{
+    vframe *f = &A->rf;
+    f->mesh_new = false;
+    if (!A->gl_liquid) A->gl_liquid = pfsph_vmesh_create();
+    if (!A->gl_bodies) A->gl_bodies = pfsph_vmesh_create();
+    if (!A->gl_liquid || !A->gl_bodies) return;
+    const pfsph_surface_mesh *m = &f->liquid;
+    if (m->ntris && m->n && mv_reserve(A, 9 * m->nverts)) {
+        for (size_t i = 0; i < m->nverts; i++) {
+            float *v = A->mv + 9 * i;
+            for (int k = 0; k < 3; k++) v[k] = (float)m->v[3 * i + k], v[3 + k] = m->n[3 * i + k], v[6 + k] = 0;
+        }
+        pfsph_vmesh_upload(A->gl_liquid, A->mv, m->nverts, m->tri, 3 * m->ntris);
+    } else {
+        pfsph_vmesh_upload(A->gl_liquid, NULL, 0, NULL, 0);
+    }
+    m = &f->bmesh;
+    const pfsph_scene *sc = A->scene;
+    if (m->ntris && mv_reserve(A, 27 * m->ntris)) {
+        for (size_t t = 0; t < m->ntris; t++) {
+            const double *p[3];
+            for (int k = 0; k < 3; k++) p[k] = m->v + 3 * m->tri[3 * t + k];
+            double e1[3], e2[3], nn[3];
+            for (int k = 0; k < 3; k++) e1[k] = p[1][k] - p[0][k], e2[k] = p[2][k] - p[0][k];
+            nn[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            nn[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            nn[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            double l = sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+            if (l > 0)
+                for (int k = 0; k < 3; k++) nn[k] /= l;
+            float col[3] = {0.8f, 0.2f, 0.8f};
+            int b = m->phase[t];
+            if (b < sc->nbodies && sc->bodies[b].phase >= 0 && sc->bodies[b].phase < sc->nphases)
+                memcpy(col, sc->phases[sc->bodies[b].phase].color, sizeof col);
+            for (int c = 0; c < 3; c++) {
+                float *v = A->mv + 27 * t + 9 * c;
+                for (int k = 0; k < 3; k++) v[k] = (float)p[c][k], v[3 + k] = (float)nn[k], v[6 + k] = col[k];
+            }
+        }
+        pfsph_vmesh_upload(A->gl_bodies, A->mv, 3 * m->ntris, NULL, 0);
+    } else {
+        pfsph_vmesh_upload(A->gl_bodies, NULL, 0, NULL, 0);
+    }
+}
+
 static void draw_frame(app *A)
 {
     const vframe *f = A->shown;
@@ -634,12 +736,22 @@ static void draw_frame(app *A)
     /* radii as the renderer's: 2D fluid discs a little larger than the particle, walls smaller
      * and behind (4 r) */
     size_t n = 0;
-    if (A->show_walls) n = add_sprites(A, 0, &f->walls, d2 ? 0.9 * r : r, -4 * r, 1, 0, 1);
+    /* the renderer's cut-away, asked again for the eye of every frame drawn: orbiting round
+     * the tank opens the side the camera is on */
+    pfsph_cutaway cw;
+    pfsph_cutaway_init(&cw, sc, A->cut_walls ? &f->walls : NULL);
+    if (A->show_walls) n = add_sprites(A, 0, &f->walls, d2 ? 0.9 * r : r, -4 * r, 1, 0, 1, &cw);
     pfsph_vdraw_sprites(A->draw, 1, A->spr, n);
-    n = add_sprites(A, 0, &f->fluid, d2 ? 1.3 * r : r, 0, 0, lo, hi);
-    if (A->show_diffuse) n = add_sprites(A, n, &f->diffuse, 0.4 * r, 0, 2, 0, 1);
-    if (A->show_bodies) n = add_sprites(A, n, &f->bodies, r, 0, 3, 0, 1);
+    /* meshes instead of particles where the run has them, as `pfsph render` does */
+    if (f->mesh_new) upload_meshes(A);
+    const bool liq = A->show_surface && !d2 && A->rf.liquid.ntris && !A->is_live;
+    const bool bmesh = A->show_surface && !d2 && A->rf.bmesh.ntris && !A->is_live;
+    n = liq ? 0 : add_sprites(A, 0, &f->fluid, d2 ? 1.3 * r : r, 0, 0, lo, hi, NULL);
+    if (A->show_diffuse) n = add_sprites(A, n, &f->diffuse, 0.4 * r, 0, 2, 0, 1, NULL);
+    if (A->show_bodies && !bmesh) n = add_sprites(A, n, &f->bodies, r, 0, 3, 0, 1, NULL);
     pfsph_vdraw_sprites(A->draw, 0, A->spr, n);
+    if (liq) pfsph_vdraw_mesh(A->draw, A->gl_liquid, 1);
+    if (bmesh && A->show_bodies) pfsph_vdraw_mesh(A->draw, A->gl_bodies, 0);
     pfsph_vdraw_composite(A->draw);
     if (!A->o.no_overlay) {
         overlay(A, lo, hi);
@@ -730,6 +842,8 @@ static void on_key(GLFWwindow *w, int key, int sc, int action, int mods)
     case GLFW_KEY_W: A->show_walls = !A->show_walls; return;
     case GLFW_KEY_B: A->show_bodies = !A->show_bodies; return;
     case GLFW_KEY_D: A->show_diffuse = !A->show_diffuse; return;
+    case GLFW_KEY_X: A->cut_walls = !A->cut_walls; return;
+    case GLFW_KEY_M: A->show_surface = !A->show_surface; return;
     case GLFW_KEY_H: A->show_help = !A->show_help; return;
     case GLFW_KEY_F: A->cam = A->cam0; return;
     case GLFW_KEY_S: A->save_next = true; return;
@@ -972,6 +1086,8 @@ static int parse_opts(int argc, char **argv, opts *o)
             o->samples = atoi(v);
             i++;
         } else if (!strcmp(a, "--paused")) o->paused = true;
+        else if (!strcmp(a, "--particles")) o->particles = true;
+        else if (!strcmp(a, "--all-walls")) o->all_walls = true;
         else if (!strcmp(a, "--no-overlay")) o->no_overlay = true;
         else if (a[0] == '-') return usage("unknown option '%s'", a);
         else if (!o->input) o->input = a;
@@ -1168,6 +1284,9 @@ static int run_window(app *A)
             glfwWaitEventsTimeout(A->is_live ? 0.005 : 0.01);
         }
     }
+    pfsph_vmesh_destroy(A->gl_liquid);
+    pfsph_vmesh_destroy(A->gl_bodies);
+    A->gl_liquid = A->gl_bodies = NULL;
     pfsph_vdraw_destroy(A->draw);
     glfwDestroyWindow(A->win);
     glfwTerminate();
@@ -1227,6 +1346,8 @@ int pfsph_view_main(int argc, char **argv)
     A->show_walls = !o->hide_walls;
     A->show_bodies = !o->hide_bodies;
     A->show_diffuse = !o->hide_diffuse;
+    A->show_surface = !o->particles;
+    A->cut_walls = !o->all_walls;
 
     if (A->is_live) {
         live *L = &A->L;
@@ -1340,6 +1461,7 @@ out:
         pfsph_frame_list_free(&A->R.bod);
     }
     free(A->spr);
+    free(A->mv);
     free(A->scene);
     free(A);
     return status;

@@ -1,6 +1,7 @@
 /* `pfsph view` under a display (xvfb-run in CI, CMakeLists.txt): a live 2D scene drawn for 20
  * frames covers the pixels its particles' positions predict; replaying a run shows the frame
- * the PNG renderer shows (2D and 3D, same camera); bad input. Skipped in builds without the
+ * the PNG renderer shows (2D and 3D, same camera, walls cut away or not; a run with a rigid
+ * body and liquid meshes drawn as meshes, and the mesh toggle); bad input. Skipped in builds without the
  * viewer or without a display. */
 #include <math.h>
 #include <png.h>
@@ -38,6 +39,24 @@ static const char *SCENE3D =
     " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0, 0], \"max\": [0.6, 0.4, 0.4], \"open_top\": true,"
     "   \"layers\": 2, \"phase\": \"wall\"}],"
     " \"output\": {\"formats\": [\"vtp\"], \"boundary\": true},"
+    " \"camera\": {\"width\": 320, \"height\": 240}}";
+
+/* A 3D tank with a wooden crate (a rigid body) beside a water column, meshed while it runs
+ * (output.surface) and with PLY output, so that the run has frames/liquid_NNNNN.ply and
+ * frames/surfaces_NNNNN.ply: replay draws both meshes, as `pfsph render` does. */
+static const char *SCENE3D_MESH =
+    "{\"name\": \"viewer test 3D meshes\", \"dimension\": 3, \"particle_radius\": 0.01,"
+    " \"gravity\": [0, -9.81, 0], \"domain\": {\"min\": [-0.1, -0.1, -0.1], \"max\": [0.5, 0.5, 0.4]},"
+    " \"solver\": {\"type\": \"dfsph\"}, \"time\": {\"end\": 0.08, \"fps\": 25},"
+    " \"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": 1e-3,"
+    "   \"color\": [0.2, 0.4, 0.9]}, {\"name\": \"wall\", \"kind\": \"solid\"},"
+    "   {\"name\": \"wood\", \"kind\": \"solid\", \"rest_density\": 600, \"color\": [0.85, 0.55, 0.2]}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [0.16, 0.2, 0.3], \"phase\": \"water\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0, 0], \"max\": [0.4, 0.3, 0.3], \"open_top\": true,"
+    "   \"layers\": 2, \"phase\": \"wall\"}],"
+    " \"bodies\": [{\"name\": \"crate\", \"shape\": \"box\", \"half_extents\": [0.05, 0.04, 0.05],"
+    "   \"position\": [0.28, 0.1, 0.15], \"rotation\": [0, 30, 0], \"density\": 600, \"phase\": \"wood\"}],"
+    " \"output\": {\"formats\": [\"vtp\", \"ply\"], \"boundary\": true, \"surface\": true},"
     " \"camera\": {\"width\": 320, \"height\": 240}}";
 
 typedef struct img {
@@ -180,73 +199,106 @@ static void test_live_2d(void **state)
     free(sc);
 }
 
-/* Replay of frame `frame` of a run against the renderer's PNG of it. Coarse: both masks in
- * 4 x 4 pixel blocks (a block is on when half its pixels are), the renderer's caption rows
- * left out; and the mean colour difference over pixels both call particles. Measured: IoU 1.0
- * and a difference of 0.0006 (2D) and 0.0004 (3D) of full scale; asked: IoU >= 0.98 (a block
- * or two of 1,000 to 2,300 may tip) and at most 0.02 (5 levels of 255). */
-static void compare_replay(const char *scene_text, const char *name, int frame, double min_iou, double max_diff)
+/* The run of a scene (once per name, reused by later comparisons). */
+static void make_run(const char *scene_text, const char *name, char *run, size_t cap)
 {
     const char *dir = tu_tmpdir();
-    char scene[600], run[600], cmd[2400], out[4096], shot[700], ref[700];
+    char scene[600], cmd[2400], out[4096], probe[700];
+    snprintf(run, cap, "%s/run_%s", dir, name);
+    snprintf(probe, sizeof probe, "%s/scene.json", run);
+    FILE *f = fopen(probe, "r");
+    if (f) {
+        fclose(f);
+        return;
+    }
     write_scene(dir, name, scene_text, scene, sizeof scene);
-    snprintf(run, sizeof run, "%s/run_%s", dir, name);
     snprintf(cmd, sizeof cmd, "%s run %s -o %s --quiet --threads 2", tu_pfsph_bin(), scene, run);
     int st = tu_run(cmd, out, sizeof out);
     if (st) print_message("%s", out);
     assert_int_equal(st, 0);
-    /* the renderer's plain picture: every wall, no colour bar (the viewer draws neither) */
-    snprintf(cmd, sizeof cmd, "%s render %s --all-walls --no-legend", tu_pfsph_bin(), run);
-    st = tu_run(cmd, out, sizeof out);
+}
+
+/* The viewer's screenshot of frame `frame` (extra options `vargs`) into shot. */
+static void view_shot(const char *run, int frame, const char *vargs, const char *shot)
+{
+    char cmd[2400], out[4096];
+    snprintf(cmd, sizeof cmd, "%s view %s --frame %d --screenshot %s --frames 3 --no-overlay %s", tu_pfsph_bin(), run,
+             frame, shot, vargs);
+    int st = tu_run(cmd, out, sizeof out);
+    print_message("%s", out);
+    assert_int_equal(st, 0);
+}
+
+/* Coarse masks: 4 x 4 pixel blocks (a block is on when half its pixels are), the renderer's
+ * caption rows left out. */
+#define BLK 4
+static unsigned char *block_mask(const img *m)
+{
+    unsigned char *k = mask_of(m);
+    const int bw = m->w / BLK, bh = (m->h - 20) / BLK; /* the caption sits in the last 13 rows */
+    unsigned char *c = calloc((size_t)bw * bh, 1);
+    for (int y = 0; y < bh; y++)
+        for (int x = 0; x < bw; x++) {
+            int sum = 0;
+            for (int v = 0; v < BLK; v++)
+                for (int u = 0; u < BLK; u++) sum += k[(size_t)(y * BLK + v) * m->w + (size_t)(x * BLK + u)];
+            c[(size_t)y * bw + x] = sum * 2 >= BLK * BLK;
+        }
+    free(k);
+    return c;
+}
+
+/* Mean colour difference (fraction of full scale) over the pixels both images call particles,
+ * above the caption. */
+static double colour_diff(const img *a, const img *b, size_t *both)
+{
+    unsigned char *ma = mask_of(a), *mb = mask_of(b);
+    double diff = 0;
+    *both = 0;
+    for (int y = 0; y < a->h - 20; y++)
+        for (int x = 0; x < a->w; x++) {
+            size_t o = (size_t)y * a->w + x;
+            if (!ma[o] || !mb[o]) continue;
+            for (int c = 0; c < 3; c++) diff += fabs((double)a->rgb[3 * o + c] - b->rgb[3 * o + c]) / 255.0 / 3;
+            (*both)++;
+        }
+    free(ma);
+    free(mb);
+    return *both ? diff / *both : 1;
+}
+
+/* Replay of frame `frame` of a run against the renderer's PNG of it (render options rargs,
+ * viewer options vargs). Coarse: the block masks' IoU, and the mean colour difference over
+ * pixels both call particles. Measured: IoU 1.0 and a difference of 0.0006 (2D) and 0.0004
+ * (3D) of full scale; asked: IoU >= 0.98 (a block or two of 1,000 to 2,300 may tip) and at
+ * most 0.02 (5 levels of 255). */
+static void compare_replay(const char *scene_text, const char *name, int frame, const char *rargs, const char *vargs,
+                           double min_iou, double max_diff)
+{
+    char run[600], cmd[2400], out[4096], shot[700], ref[700];
+    make_run(scene_text, name, run, sizeof run);
+    snprintf(cmd, sizeof cmd, "%s render %s --no-legend %s", tu_pfsph_bin(), run, rargs);
+    int st = tu_run(cmd, out, sizeof out);
     if (st) print_message("%s", out);
     assert_int_equal(st, 0);
     snprintf(shot, sizeof shot, "%s/replay.png", run);
-    snprintf(cmd, sizeof cmd, "%s view %s --frame %d --screenshot %s --frames 3 --no-overlay", tu_pfsph_bin(), run,
-             frame, shot);
-    st = tu_run(cmd, out, sizeof out);
-    print_message("%s", out);
-    assert_int_equal(st, 0);
+    view_shot(run, frame, vargs, shot);
     snprintf(ref, sizeof ref, "%s/png/frame_%05d.png", run, frame);
     img a = read_png(ref), b = read_png(shot);
     assert_int_equal(a.w, b.w);
     assert_int_equal(a.h, b.h);
-    unsigned char *ma = mask_of(&a), *mb = mask_of(&b);
-    const int B = 4, bw = a.w / B, bh = (a.h - 20) / B; /* the caption sits in the last 13 rows */
-    unsigned char *ca = calloc((size_t)bw * bh, 1), *cb = calloc((size_t)bw * bh, 1);
-    for (int y = 0; y < bh; y++)
-        for (int x = 0; x < bw; x++) {
-            int sa = 0, sb = 0;
-            for (int v = 0; v < B; v++)
-                for (int u = 0; u < B; u++) {
-                    size_t o = (size_t)(y * B + v) * a.w + (size_t)(x * B + u);
-                    sa += ma[o];
-                    sb += mb[o];
-                }
-            ca[(size_t)y * bw + x] = sa * 2 >= B * B;
-            cb[(size_t)y * bw + x] = sb * 2 >= B * B;
-        }
-    size_t na, nb;
-    double q = iou(ca, cb, (size_t)bw * bh, &na, &nb);
-    double diff = 0;
-    size_t both = 0;
-    for (int y = 0; y < a.h - 20; y++)
-        for (int x = 0; x < a.w; x++) {
-            size_t o = (size_t)y * a.w + x;
-            if (!ma[o] || !mb[o]) continue;
-            for (int c = 0; c < 3; c++) diff += fabs((double)a.rgb[3 * o + c] - b.rgb[3 * o + c]) / 255.0 / 3;
-            both++;
-        }
-    diff = both ? diff / both : 1;
-    print_message("%s frame %d: %zu blocks (renderer) / %zu (viewer), IoU %.4f (at least %.2f); mean colour "
-                  "difference %.4f (at most %.2f) over %zu pixels\n", name, frame, na, nb, q, min_iou, diff, max_diff,
-                  both);
+    unsigned char *ca = block_mask(&a), *cb = block_mask(&b);
+    size_t na, nb, both;
+    double q = iou(ca, cb, (size_t)(a.w / BLK) * ((a.h - 20) / BLK), &na, &nb);
+    double diff = colour_diff(&a, &b, &both);
+    print_message("%s frame %d [render %s / view %s]: %zu blocks (renderer) / %zu (viewer), IoU %.4f (at least %.2f); "
+                  "mean colour difference %.4f (at most %.2f) over %zu pixels\n", name, frame, rargs, vargs, na, nb, q,
+                  min_iou, diff, max_diff, both);
     assert_true(na > 100);
     assert_true(q >= min_iou);
     assert_true(diff <= max_diff);
     free(ca);
     free(cb);
-    free(ma);
-    free(mb);
     free(a.rgb);
     free(b.rgb);
 }
@@ -255,14 +307,52 @@ static void test_replay_2d(void **state)
 {
     (void)state;
     if (!viewer_available()) skip();
-    compare_replay(SCENE2D, "replay2d.json", 3, 0.98, 0.02);
+    compare_replay(SCENE2D, "replay2d.json", 3, "", "", 0.98, 0.02);
 }
 
+/* 3D: with the walls facing the camera cut away (the default of both, the decision shared:
+ * pfsph_cutaway_*), and with every wall. */
 static void test_replay_3d(void **state)
 {
     (void)state;
     if (!viewer_available()) skip();
-    compare_replay(SCENE3D, "replay3d.json", 2, 0.98, 0.02);
+    compare_replay(SCENE3D, "replay3d.json", 2, "", "", 0.98, 0.02);
+    compare_replay(SCENE3D, "replay3d.json", 2, "--all-walls", "--all-walls", 0.98, 0.02);
+}
+
+/* A run with a rigid body and liquid meshes: replay draws the liquid as water and the crate as
+ * its mesh, as the renderer does (IoU and colour as above); with --particles (the M key's other
+ * state) both draw particles again and still agree; and the toggle changes the picture: the
+ * share of the scene's pixels whose colour moves by more than 40/255 in some channel. */
+static void test_replay_meshes(void **state)
+{
+    (void)state;
+    if (!viewer_available()) skip();
+    compare_replay(SCENE3D_MESH, "replay_mesh.json", 2, "", "", 0.98, 0.02);
+    compare_replay(SCENE3D_MESH, "replay_mesh.json", 2, "--particles", "--particles", 0.98, 0.02);
+    char run[600], s1[700], s2[700];
+    make_run(SCENE3D_MESH, "replay_mesh.json", run, sizeof run);
+    snprintf(s1, sizeof s1, "%s/surface.png", run);
+    snprintf(s2, sizeof s2, "%s/particles.png", run);
+    view_shot(run, 2, "", s1);
+    view_shot(run, 2, "--particles", s2);
+    img a = read_png(s1), b = read_png(s2);
+    unsigned char *ma = mask_of(&a), *mb = mask_of(&b);
+    size_t scene_px = 0, changed = 0;
+    for (size_t o = 0; o < (size_t)a.w * a.h; o++) {
+        if (!ma[o] && !mb[o]) continue;
+        scene_px++;
+        int ch = 0;
+        for (int c = 0; c < 3; c++) ch |= abs((int)a.rgb[3 * o + c] - (int)b.rgb[3 * o + c]) > 40;
+        changed += ch;
+    }
+    double share = (double)changed / (double)scene_px;
+    print_message("mesh toggle: %zu of %zu scene pixels change (%.3f; at least 0.10)\n", changed, scene_px, share);
+    assert_true(share >= 0.10);
+    free(ma);
+    free(mb);
+    free(a.rgb);
+    free(b.rgb);
 }
 
 /* Bad input: exit status 2 and a message naming the problem, before any window opens. */
@@ -300,6 +390,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_live_2d),
         cmocka_unit_test(test_replay_2d),
         cmocka_unit_test(test_replay_3d),
+        cmocka_unit_test(test_replay_meshes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
