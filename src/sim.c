@@ -1050,9 +1050,8 @@ int pfsph_sim_drag_body(pfsph_sim *sim, int body, const double target[3], pfsph_
     if (body < 0 || body >= nb)
         return pfsph_fail(err, PFSPH_EINPUT, "drag: no body %d (the scene has %d)", body, nb);
     if (!pfsph_bodies_draggable(sim->bodies, body))
-        return pfsph_fail(err, PFSPH_EINPUT, "drag: body \"%s\" is %s; only kinematic bodies without keyframes can be "
-                          "dragged", pfsph_bodies_name(sim->bodies, body),
-                          sim->scene.bodies[body].kinematic ? "moved by keyframes" : "dynamic");
+        return pfsph_fail(err, PFSPH_EINPUT, "drag: body \"%s\" is moved by keyframes; dynamic bodies and kinematic "
+                          "bodies without keyframes can be dragged", pfsph_bodies_name(sim->bodies, body));
     /* no faster than the flows the scene is set up for (a tenth of its sound speed, Mach 0.1),
      * and well inside the blow-up bound */
     double vmax = fmin(0.1 * sim->sound_speed, 0.2 * sim->solver->speed_bound(sim->solver_state, &sim->ctx));

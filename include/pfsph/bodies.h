@@ -59,9 +59,12 @@ uint32_t pfsph_bodies_particle_count(const pfsph_bodies *b);
 /* First boundary-particle id that belongs to a body (ids below are static solids). */
 uint32_t pfsph_bodies_first_id(const pfsph_bodies *b);
 
-/* Drag body i (kinematic, without keyframes: pfsph_bodies_draggable) towards target [m] from
- * the next step on, in a straight line at most vmax [m/s], without turning; it stays where the
- * drag leaves it. target NULL lets go. PFSPH_EINPUT for another body or a non-finite target. */
+/* Drag body i towards target [m] from the next step on (pfsph_bodies_draggable: any body but a
+ * keyframed one). Kinematic: in a straight line at most vmax [m/s], without turning; it stays
+ * where the drag leaves it. Dynamic: a critically damped spring (5 Hz) on its centre of mass
+ * pulls it, its pull capped so that it drives towards at most vmax; the fluid, gravity and
+ * contacts act as before; let go, it moves on freely. target NULL lets go. PFSPH_EINPUT for a
+ * keyframed body or a non-finite target. */
 int pfsph_bodies_drag(pfsph_bodies *b, int i, const double target[3], double vmax);
 bool pfsph_bodies_draggable(const pfsph_bodies *b, int i);
 /* Gravity of the body dynamics [m/s^2] (the live viewer changes it; 2D ignores g[2]). */

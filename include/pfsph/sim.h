@@ -114,10 +114,14 @@ int pfsph_sim_set_pair_coefficient(pfsph_sim *sim, int a, int b, double c, pfsph
 int pfsph_sim_set_pair_sigma(pfsph_sim *sim, int a, int b, double sigma, pfsph_error *err);
 /* Static contact-angle target [degrees, 0..180] of a fluid phase on a solid phase. */
 int pfsph_sim_set_pair_contact_angle(pfsph_sim *sim, int a, int b, double deg, pfsph_error *err);
-/* Drag rigid body `body` (kinematic, without keyframes) towards target [m]: it moves there in a
- * straight line from the next step on, at most a tenth of the sound speed (the flow speed the
- * scene is set up for) and a fifth of the blow-up speed bound, and stays where it is left;
- * target NULL lets go. */
+/* Drag rigid body `body` towards target [m] from the next step on. The speed limit vmax is a
+ * tenth of the sound speed (the flow speed the scene is set up for) or a fifth of the blow-up
+ * speed bound, the smaller. A kinematic body without keyframes moves there in a straight line
+ * at most vmax and stays where it is left. A dynamic body is pulled by a critically damped
+ * 5 Hz spring on its centre of mass, added to the fluid's force, gravity and contacts in each
+ * step; the pull drives it towards vmax at most, it hangs g / (2 pi 5 Hz)^2 = 1 cm below the
+ * target under gravity, and moves on freely when let go. Keyframed bodies are refused
+ * (PFSPH_EINPUT). target NULL lets go. */
 int pfsph_sim_drag_body(pfsph_sim *sim, int body, const double target[3], pfsph_error *err);
 
 #endif

@@ -32,7 +32,8 @@ typedef struct body {
     uint32_t n;
     double f[3], tq[3]; /* fluid force and torque of the last step */
     double vmax;       /* largest particle speed */
-    bool dragged;      /* kinematic, no keyframes: follows drag_to (pfsph_bodies_drag) */
+    bool dragged;      /* follows drag_to (pfsph_bodies_drag): kinematic, no keyframes, on a
+                        * straight line; dynamic, pulled by a damped spring */
     double drag_to[3], drag_vmax;
 } body;
 
@@ -948,6 +949,31 @@ static void drag_pose(const body *bd, double dt, double x0[3], double q0[4], dou
     for (int k = 0; k < 3; k++) x1[k] = x0[k] + s * d[k];
 }
 
+/* The spring that pulls a dragged dynamic body's centre of mass towards drag_to: critically
+ * damped at 5 Hz (omega = 31.4 1/s, the mouse joint's usual tuning in game physics: the body
+ * follows a cursor within about 0.2 s and sags g / omega^2 = 1 cm under gravity while held).
+ * Far from the target the pull is capped so that the speed it drives towards is drag_vmax:
+ * omega^2 |dx| at most 2 omega vmax, where the damping -2 omega v balances it. Acts at the
+ * centre of mass (no torque): the body turns only as the fluid and contacts turn it. */
+#define DRAG_OMEGA (2 * PI * 5.0)
+static void drag_spring(const body *bd)
+{
+    const dReal *x = dBodyGetPosition(bd->id), *v = dBodyGetLinearVel(bd->id);
+    dMass ms;
+    dBodyGetMass(bd->id, &ms);
+    double d[3], len = 0;
+    for (int k = 0; k < 3; k++) {
+        d[k] = bd->drag_to[k] - x[k];
+        len += d[k] * d[k];
+    }
+    len = sqrt(len);
+    const double w = DRAG_OMEGA, cap = 2 * bd->drag_vmax / w;
+    const double s = len > cap ? cap / len : 1;
+    double f[3];
+    for (int k = 0; k < 3; k++) f[k] = ms.mass * (w * w * s * d[k] - 2 * w * v[k]);
+    dBodyAddForce(bd->id, f[0], f[1], f[2]);
+}
+
 void pfsph_bodies_step(pfsph_bodies *B, pfsph_particles *bs, double t, double dt)
 {
     if (!B->nb) return;
@@ -974,6 +1000,7 @@ void pfsph_bodies_step(pfsph_bodies *B, pfsph_particles *bs, double t, double dt
         } else {
             dBodyAddForce(bd->id, bd->f[0], bd->f[1], bd->f[2]);
             dBodyAddTorque(bd->id, bd->tq[0], bd->tq[1], bd->tq[2]);
+            if (bd->dragged) drag_spring(bd);
         }
     }
     dSpaceCollide(B->space, B, near_cb);
@@ -1057,7 +1084,7 @@ int pfsph_bodies_drag(pfsph_bodies *b, int i, const double target[3], double vma
 {
     if (!b || i < 0 || i >= b->nb) return PFSPH_EINPUT;
     body *bd = &b->b[i];
-    if (!bd->def.kinematic || bd->def.nkeys > 0) return PFSPH_EINPUT;
+    if (bd->def.kinematic && bd->def.nkeys > 0) return PFSPH_EINPUT;
     if (!target) {
         bd->dragged = false;
         return PFSPH_OK;
@@ -1074,5 +1101,5 @@ int pfsph_bodies_drag(pfsph_bodies *b, int i, const double target[3], double vma
 
 bool pfsph_bodies_draggable(const pfsph_bodies *b, int i)
 {
-    return b && i >= 0 && i < b->nb && b->b[i].def.kinematic && b->b[i].def.nkeys == 0;
+    return b && i >= 0 && i < b->nb && !(b->b[i].def.kinematic && b->b[i].def.nkeys > 0);
 }

@@ -59,7 +59,8 @@ const char *const pfsph_view_help =
     "  --all-walls        3D: keep the walls that face the camera (default: cut away)\n"
     "\n"
     "Mouse: left drag orbits (2D: pans), right or middle drag (or shift + left) pans, wheel\n"
-    "zooms, ctrl + left drag moves a kinematic body (live, bodies without keyframes); replay:\n"
+    "zooms, ctrl + left drag pulls a rigid body (live; a dynamic one on a spring, a kinematic\n"
+    "one without keyframes along the cursor); replay:\n"
     "click or drag the slider. Keys: space pause/play, N single step (live) or\n"
     "next frame, P previous frame, Home/End first/last frame, R reset, C colour field,\n"
     "W walls, B bodies, D diffuse, X cut-away of the walls facing the camera (3D), M meshes /\n"
@@ -950,7 +951,8 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
         return;
     }
     if (button == GLFW_MOUSE_BUTTON_LEFT && down && (mods & GLFW_MOD_CONTROL) && A->is_live) {
-        /* the draggable body whose centre is nearest the cursor, within 80 pixels */
+        /* the draggable body (dynamic, or kinematic without keyframes) whose centre is nearest
+         * the cursor, within 80 pixels */
         const vframe *f = A->shown;
         double best = 80, bd = 0;
         int pick = -1;
@@ -965,7 +967,7 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
             A->grab_depth = bd;
         } else {
             pthread_mutex_lock(&A->L.mu);
-            snprintf(A->L.msg, sizeof A->L.msg, "ctrl + drag: no kinematic body without keyframes near the cursor");
+            snprintf(A->L.msg, sizeof A->L.msg, "ctrl + drag: no body near the cursor (bodies moved by keyframes cannot be dragged)");
             pthread_mutex_unlock(&A->L.mu);
             A->dirty = true;
         }

@@ -173,7 +173,7 @@ static void test_next_step(void **state)
 
 /* A kinematic paddle without keyframes and a floating dynamic block over a little water: the
  * paddle follows the drag target in a straight line at the capped speed, stops there, stays
- * after release; the dynamic block cannot be dragged. */
+ * after release. (The dynamic block's drag: test_drag_dynamic.) */
 static const char *BODIES =
     "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
     " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.5, 0.5]},"
@@ -196,8 +196,6 @@ static void test_drag(void **state)
     pfsph_sim *sim = NULL;
     if (pfsph_sim_create(&sim, sc, &err)) fail_msg("%s", err.msg);
     const struct pfsph_bodies *B = pfsph_sim_bodies(sim);
-    assert_int_equal(pfsph_sim_drag_body(sim, 1, (double[3]){0.2, 0.2, 0}, &err), PFSPH_EINPUT);
-    assert_non_null(strstr(err.msg, "dynamic"));
     assert_int_equal(pfsph_sim_drag_body(sim, 2, (double[3]){0.2, 0.2, 0}, &err), PFSPH_EINPUT);
     assert_int_equal(pfsph_sim_drag_body(sim, 0, (double[3]){NAN, 0.2, 0}, &err), PFSPH_EINPUT);
     pfsph_body_state bs;
@@ -241,6 +239,81 @@ static void test_drag(void **state)
     free(sc);
 }
 
+/* A dynamic block (500 kg/m^3, 6 x 4 cm) held above a little water by the drag spring, and a
+ * keyframed paddle. The spring acts from the next step: the block's state after the call is
+ * the one before. Held at a target 6 cm to the left and 5 cm down, clear of the water, it
+ * comes to rest where the spring balances gravity, g / omega^2 (omega = 2 pi 5 Hz: 9.9 mm)
+ * below the target, within 0.1 mm, with no speed left (critical damping: after 0.6 s the
+ * error of the start has decayed by (1 + 19) e^-19 ~ 1e-7), never faster than the cap (a tenth
+ * of the sound speed) plus what gravity adds against the damping, g / (2 omega); let go, it falls freely (its
+ * vertical speed grows by g t within 1 %). The keyframed paddle is refused. */
+static const char *DYNAMIC =
+    "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
+    " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.5, 0.5]},"
+    " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 2, \"dt_max\": 0.002},"
+    " \"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": 1e-3},"
+    "  {\"name\": \"wall\", \"kind\": \"solid\"}, {\"name\": \"wood\", \"kind\": \"solid\", \"rest_density\": 500}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.4, 0.04], \"phase\": \"water\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.4, 0.35], \"open_top\": true, \"layers\": 2,"
+    "   \"phase\": \"wall\"}],"
+    " \"bodies\": [{\"name\": \"block\", \"shape\": \"box\", \"half_extents\": [0.03, 0.02], \"position\": [0.3, 0.25],"
+    "   \"density\": 500, \"phase\": \"wood\"},"
+    "  {\"name\": \"paddle\", \"shape\": \"box\", \"half_extents\": [0.01, 0.02], \"position\": [0.05, 0.25],"
+    "   \"kinematic\": true, \"phase\": \"wood\", \"keyframes\": [{\"t\": 0, \"position\": [0.05, 0.25]},"
+    "   {\"t\": 2, \"position\": [0.05, 0.28]}]}]}";
+
+static void test_drag_dynamic(void **state)
+{
+    (void)state;
+    pfsph_scene *sc = malloc(sizeof *sc);
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(sc, DYNAMIC, "<drag dynamic>", &err), PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    if (pfsph_sim_create(&sim, sc, &err)) fail_msg("%s", err.msg);
+    const struct pfsph_bodies *B = pfsph_sim_bodies(sim);
+    assert_true(pfsph_bodies_draggable(B, 0));
+    assert_false(pfsph_bodies_draggable(B, 1));
+    assert_int_equal(pfsph_sim_drag_body(sim, 1, (double[3]){0.1, 0.2, 0}, &err), PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "keyframes"));
+    pfsph_body_state b0, bs;
+    pfsph_bodies_get_state(B, 0, &b0);
+    const double target[3] = {0.24, 0.2, 0.3}; /* z is dropped in 2D */
+    assert_int_equal(pfsph_sim_drag_body(sim, 0, target, &err), PFSPH_OK);
+    pfsph_bodies_get_state(B, 0, &bs);
+    assert_memory_equal(&bs, &b0, sizeof bs); /* nothing until the next step */
+    const double w = 2 * PI * 5, g = 9.81, vcap = 0.1 * pfsph_sim_sound_speed(sim);
+    double vtop = 0, t0 = pfsph_sim_time(sim);
+    while (pfsph_sim_time(sim) < t0 + 0.6) {
+        step(sim);
+        pfsph_bodies_get_state(B, 0, &bs);
+        double v = hypot(bs.v[0], bs.v[1]);
+        vtop = fmax(vtop, v);
+        /* the pull drives towards at most the cap; gravity, balanced by the damping 2 omega v,
+         * adds at most g / (2 omega) */
+        assert_true(v <= vcap + g / (2 * w) + 1e-9);
+        assert_true(bs.x[2] == 0);
+    }
+    const double sag = g / (w * w);
+    double ex = bs.x[0] - target[0], ey = bs.x[1] - (target[1] - sag);
+    print_message("dynamic block held at %.6f %.6f (target %.3f %.3f, predicted sag %.5f m): off by %.2e m, speed "
+                  "%.2e m/s; top speed %.3f m/s (cap %.3f)\n", bs.x[0], bs.x[1], target[0], target[1], sag,
+                  hypot(ex, ey), hypot(bs.v[0], bs.v[1]), vtop, vcap);
+    assert_true(hypot(ex, ey) < 1e-4);
+    assert_true(hypot(bs.v[0], bs.v[1]) < 1e-3);
+    assert_true(vtop > 0.3 * fmin(vcap, 0.37 * w * 0.078)); /* it did move at speed */
+    /* let go: free fall (well above the water) */
+    assert_int_equal(pfsph_sim_drag_body(sim, 0, NULL, &err), PFSPH_OK);
+    double t1 = pfsph_sim_time(sim), vy1 = bs.v[1];
+    while (pfsph_sim_time(sim) < t1 + 0.05) step(sim);
+    pfsph_bodies_get_state(B, 0, &bs);
+    double fall = -(bs.v[1] - vy1), want = g * (pfsph_sim_time(sim) - t1);
+    print_message("released: vertical speed grew by %.4f m/s in %.4f s (g t = %.4f)\n", fall,
+                  pfsph_sim_time(sim) - t1, want);
+    assert_true(fabs(fall - want) < 0.01 * want);
+    pfsph_sim_destroy(sim);
+    free(sc);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -248,6 +321,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_matrix),
         cmocka_unit_test(test_next_step),
         cmocka_unit_test(test_drag),
+        cmocka_unit_test(test_drag_dynamic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
