@@ -1,6 +1,8 @@
 /* PNG previews of a run directory: every particle is splatted as a shaded sphere (screen-space
  * disc with per-pixel depth, Lambert + ambient + a little specular), z-buffered, supersampled
- * 2x2, then written with libpng through the atomic writer; optionally an ffmpeg video. */
+ * 2x2, then written with libpng through the atomic writer; optionally an ffmpeg video. Where a
+ * frame has meshes, the liquid's (liquid_NNNNN.ply) is rasterised and shaded as water and the
+ * bodies' (surfaces_NNNNN.ply) as flat-shaded solids instead of their particles. */
 #include "pfsph/render.h"
 #include "pfsph/surface_mesh.h"
 

@@ -1,7 +1,8 @@
 /* OpenGL 3.3 core drawing for the viewer: particles as instanced point sprites (screen-facing
  * quads shaded as spheres in the fragment shader, with true sphere depth), two layers composited
  * as the PNG renderer does (fluid, bodies and diffuse in one, walls in the other: translucent
- * walls in 3D), and a 2D overlay of text and coloured quads in pixels. */
+ * walls in 3D), triangle meshes in vertex buffers (a replayed run's liquid, shaded as water,
+ * and rigid bodies), and a 2D overlay of text and coloured quads in pixels. */
 #ifndef PFSPH_VIEW_DRAW_H
 #define PFSPH_VIEW_DRAW_H
 
