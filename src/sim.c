@@ -17,6 +17,7 @@
 #include "pfsph/pairwise.h"
 #include "pfsph/thermostat.h"
 #include "physics/boundary.h"
+#include "core/nlist.h"
 #include "physics/density.h"
 #include "physics/eos.h"
 #include "physics/solver.h"
@@ -28,7 +29,7 @@ const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
 
 /* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
-#define SCR_MAX (SCR_COMMON + 13) /* + the solver's (at most 10) + the thermostat's 3 */
+#define SCR_MAX (SCR_COMMON + 17) /* + the solver's (at most 14) + the thermostat's 3 */
 
 /* What a stage that found a blow-up reports; the step turns it into the one message format. */
 typedef struct blowup_info {
@@ -49,6 +50,7 @@ struct pfsph_sim {
     pfsph_ctx ctx;
     pfsph_particles fluid, boundary;
     pfsph_grid grid, bgrid;
+    pfsph_nlist nlist;        /* built each step when the solver asks (neighbour_lists) */
     pfsph_real *scr[SCR_MAX]; /* per-step scratch: SCR_COMMON of ours, then the solver's */
     int nscr;
     int scr_noise;            /* first of the thermostat's 3 arrays (its accelerations), or -1 */
@@ -221,7 +223,14 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
     const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
-    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort + 2 * P;
+    /* neighbour lists: a full neighbourhood within h (pi q^2 in 2D, 4/3 pi q^3 in 3D, q = h / d)
+     * and a quarter more for compression near walls and in splashes */
+    const double q = s->support_factor;
+    const double nlist = ops && ops->neighbour_lists
+                             ? pfsph_nlist_bytes_per_particle(1.25 * (s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q))
+                             : 0;
+    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort +
+                             2 * P + nlist;
     const double per_boundary = 2 * P + sort;
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
     const double part_bytes = (double)nf * per_fluid + (double)nb * per_boundary;
@@ -457,6 +466,7 @@ void pfsph_sim_destroy(pfsph_sim *sim)
     pfsph_particles_free(&sim->boundary);
     pfsph_grid_free(&sim->grid);
     pfsph_grid_free(&sim->bgrid);
+    pfsph_nlist_free(&sim->nlist);
     for (int k = 0; k < SCR_MAX; k++) free(sim->scr[k]);
     free(sim);
 }
@@ -549,6 +559,7 @@ static int st_grid(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)bad;
     (void)err;
     sim->removed_before = sim->removed;
+    sim->ctx.nlist = NULL; /* the sort reorders the particles: lists are built again after it */
     pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed);
     return PFSPH_OK;
 }
@@ -562,13 +573,25 @@ static int st_shift(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* Number density; with neighbour lists (solvers that walk the neighbours many times a step)
+ * the density's walk also counts them and the lists are filled: positions stay put until the
+ * integration. */
 static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
-    (void)err;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = &sim->fluid;
     const size_t n = f->n;
-    pfsph__number_density(c, f->x, f->y, f->z, c->nd);
+    c->nlist = NULL;
+    if (sim->solver->neighbour_lists) {
+        uint32_t *cnt = pfsph_nlist_counts(&sim->nlist, n);
+        if (!cnt) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory building the neighbour lists");
+        pfsph__number_density_count(c, c->nd, cnt);
+        int rc = pfsph_nlist_fill(&sim->nlist, &sim->grid, f->x, f->y, f->z, n, c->kern.h * c->kern.h);
+        if (rc) return pfsph_fail(err, rc, "cannot build the neighbour lists");
+        c->nlist = &sim->nlist;
+    } else {
+        pfsph__number_density(c, f->x, f->y, f->z, c->nd);
+    }
     pfsph_real ndmax = 0;
 #pragma omp parallel for schedule(static) reduction(max : ndmax)
     for (size_t i = 0; i < n; i++) {
@@ -675,6 +698,7 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     const double dt = c->dt;
     const pfsph_real fdt = (pfsph_real)dt;
     double amax2 = 0, anp2 = 0;
+    c->nlist = NULL; /* the particles move: this step's lists no longer hold */
     pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
     int bad_ = 0;

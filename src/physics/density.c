@@ -1,8 +1,10 @@
 /* Number density delta_i (PF Eq. 23), fluid and boundary neighbours. */
 #include "physics/density.h"
 
-void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
-                           const pfsph_real *z, pfsph_real *nd)
+/* cnt: NULL, or where to count each particle's fluid neighbours j != i within h (the lists'
+ * counts, src/core/nlist.h): the walk is the density's own, so counting costs a compare. */
+static inline void number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
+                                  const pfsph_real *z, pfsph_real *nd, uint32_t *cnt)
 {
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_real h2 = k->h * k->h;
@@ -15,12 +17,17 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
         const pfsph_real xi = x[i], yi = y[i], zi = z[i];
         pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
         pfsph_real s = 0;
+        uint32_t c = 0;
         for (int q = 0; q < r.n; q++)
             for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
                 pfsph_real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
                 pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 < h2) s += pfsph_kernel_w(k, pfsph_sqrt(r2));
+                if (r2 < h2) {
+                    s += pfsph_kernel_w(k, pfsph_sqrt(r2));
+                    c++;
+                }
             }
+        if (cnt) cnt[i] = c - 1; /* less i itself */
         if (b->n) {
             pfsph_real sb = 0;
             pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
@@ -34,6 +41,18 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
         }
         nd[i] = s;
     }
+}
+
+void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
+                           const pfsph_real *z, pfsph_real *nd)
+{
+    number_density(ctx, x, y, z, nd, NULL);
+}
+
+void pfsph__number_density_count(const pfsph_ctx *ctx, pfsph_real *nd, uint32_t *cnt)
+{
+    const pfsph_particles *f = ctx->fluid;
+    number_density(ctx, f->x, f->y, f->z, nd, cnt);
 }
 
 void pfsph__number_density_rate(const pfsph_ctx *ctx, const pfsph_real *vx, const pfsph_real *vy,

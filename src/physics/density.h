@@ -9,6 +9,10 @@
 void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
                            const pfsph_real *z, pfsph_real *nd);
 
+/* The same at the fluid's positions, also counting into cnt[i] the fluid neighbours j != i
+ * within h of each particle (the counts of its neighbour list, src/core/nlist.h). */
+void pfsph__number_density_count(const pfsph_ctx *ctx, pfsph_real *nd, uint32_t *cnt);
+
 /* Rate of change of the number density, D delta_i / Dt = sum_j (v_i - v_j) . grad W_ij +
  * (1/V0) sum_b V_b (v_i - v_b) . grad W_ib (the continuity equation in number-density form),
  * for fluid velocities (vx, vy, vz) at the current positions; boundary particles move with

@@ -30,6 +30,9 @@ typedef struct pfsph_solve_stats {
 typedef struct pfsph_solver_ops {
     const char *name;      /* as in the scene's solver.type */
     int nscratch;          /* per-fluid-particle scratch arrays the solver needs */
+    /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
+     * solver that walks the neighbours many times per step (memory: src/core/nlist.h). */
+    int neighbour_lists;
     /* Solver state for the fluid of ctx; NULL state is allowed. */
     int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg,
                   pfsph_error *err);

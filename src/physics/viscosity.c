@@ -2,7 +2,55 @@
  * the fluid's or the solid's own viscosity, or free slip). */
 #include "physics/viscosity.h"
 
+#include "core/nlist.h"
 #include "pfsph/thermostat.h"
+
+/* particle i as its fluid pairs see it */
+typedef struct visc_i {
+    pfsph_real x, y, z, vx, vy, vz, nu;
+    double m, nd;
+    uint32_t id;
+    int phase;
+} visc_i;
+
+typedef struct visc_acc {
+    pfsph_real ax, ay, az; /* viscosity sum */
+    double fx, fy, fz;     /* thermostat */
+} visc_acc;
+
+/* Fluid neighbour j's Morris viscosity term (and with thermo its thermostat force) on i, added
+ * to acc; nothing when j == i or j lies beyond h. */
+static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, size_t i, uint32_t j, pfsph_real h2,
+                             pfsph_real eps, const int thermo, double amp,
+                             const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, visc_acc *acc)
+{
+    const pfsph_particles *f = ctx->fluid;
+    const pfsph_kernel *k = &ctx->kern;
+    pfsph_real dx = I->x - f->x[j], dy = I->y - f->y[j], dz = I->z - f->z[j];
+    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+    if (r2 >= h2 || j == i) return;
+    pfsph_real nu = (pfsph_real)0.5 * (I->nu + ctx->nu[f->phase[j]]);
+    pfsph_real vdx = (I->vx - f->vx[j]) * dx + (I->vy - f->vy[j]) * dy + (I->vz - f->vz[j]) * dz;
+    const pfsph_real rr = pfsph_sqrt(r2), dwr = pfsph_kernel_dw_r(k, rr);
+    pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
+    acc->ax += s * dx;
+    acc->ay += s * dy;
+    acc->az += s * dz;
+    if (thermo) {
+        const int pb = f->phase[j];
+        const double nud = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
+        if (nud > 0 && r2 > 0) {
+            const double rd = sqrt((double)r2);
+            const double t = pfsph__thermo_fluid(amp * ts[I->phase][pb], nud, I->m, (double)ctx->mass[pb], I->nd,
+                                                 (double)ctx->nd[j], (double)r2,
+                                                 (double)pfsph_kernel_dw_r(k, (pfsph_real)rd), (double)eps, rd,
+                                                 pfsph_thermo_theta(key, I->id, f->id[j]));
+            acc->fx += t * (double)dx;
+            acc->fy += t * (double)dy;
+            acc->fz += t * (double)dz;
+        }
+    }
+}
 
 /* thermo: also the thermostat's random forces (thermostat.h), fused into this pass so that the
  * neighbours within h are walked once; the same expressions as pfsph_thermostat_apply, so the
@@ -20,6 +68,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     const pfsph_real visc_c = (pfsph_real)(2 * (ctx->dim + 2));
     const size_t n = f->n;
     const int mixed = ctx->nwalls > 1;
+    const pfsph_nlist *nl = ctx->nlist; /* the step's lists, when the solver built them */
     const uint8_t *wall = b->wall;
     const pfsph_real *wall_scale = ctx->wall_scale, *wall_nu = ctx->wall_nu, wall_nu_max = ctx->wall_nu_max;
     double amp = 0, ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
@@ -43,34 +92,18 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
         double fx = 0, fy = 0, fz = 0; /* thermostat */
         pfsph_real ax = 0, ay = 0, az = 0;
         pfsph_ranges r;
-        pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
-        for (int q = 0; q < r.n; q++)
-            for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 >= h2 || j == i) continue;
-                pfsph_real nu = (pfsph_real)0.5 * (nui + ctx->nu[f->phase[j]]);
-                pfsph_real vdx = (vxi - f->vx[j]) * dx + (vyi - f->vy[j]) * dy + (vzi - f->vz[j]) * dz;
-                const pfsph_real rr = pfsph_sqrt(r2), dwr = pfsph_kernel_dw_r(k, rr);
-                pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
-                ax += s * dx;
-                ay += s * dy;
-                az += s * dz;
-                if (thermo) {
-                    const int pb = f->phase[j];
-                    const double nud = 0.5 * ((double)nui + (double)ctx->nu[pb]);
-                    if (nud > 0 && r2 > 0) {
-                        const double rd = sqrt((double)r2);
-                        const double t = pfsph__thermo_fluid(
-                            amp * ts[pa][pb], nud, mi, (double)ctx->mass[pb], ndi, (double)ctx->nd[j], (double)r2,
-                            (double)pfsph_kernel_dw_r(k, (pfsph_real)rd), (double)eps, rd,
-                            pfsph_thermo_theta(key, idi, f->id[j]));
-                        fx += t * (double)dx;
-                        fy += t * (double)dy;
-                        fz += t * (double)dz;
-                    }
-                }
-            }
+        /* the same terms in the same order from a list or a grid walk: the same bits */
+        const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
+        visc_acc acc = {0, 0, 0, 0, 0, 0};
+        if (nl) {
+            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++)
+                visc_pair(ctx, &vi, i, nl->idx[e], h2, eps, thermo, amp, ts, key, &acc);
+        } else {
+            pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+            for (int q = 0; q < r.n; q++)
+                for (uint32_t j = r.b[q]; j < r.e[q]; j++) visc_pair(ctx, &vi, i, j, h2, eps, thermo, amp, ts, key, &acc);
+        }
+        ax = acc.ax, ay = acc.ay, az = acc.az, fx = acc.fx, fy = acc.fy, fz = acc.fz;
         /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
          * says otherwise (ctx wall tables: free slip, its own viscosity); static walls rest,
          * body particles move. With only default walls the table is skipped and the sum is

@@ -1,0 +1,93 @@
+/* Neighbour lists built from the sorted grid (nlist.h). */
+#include "core/nlist.h"
+
+#include <stdlib.h>
+
+/* the neighbours of i within r2 (j != i), the first `room` of them written to out when out is
+ * not NULL; their count */
+static inline uint32_t walk(const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y, const pfsph_real *z,
+                            size_t i, pfsph_real r2max, uint32_t *out, uint32_t room)
+{
+    pfsph_ranges r;
+    const pfsph_real xi = x[i], yi = y[i], zi = z[i];
+    pfsph_grid_ranges(g, xi, yi, zi, &r);
+    uint32_t c = 0;
+    for (int q = 0; q < r.n; q++)
+        for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+            pfsph_real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
+            pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+            if (r2 < r2max && j != i) {
+                if (out && c < room) out[c] = j;
+                c++;
+            }
+        }
+    return c;
+}
+
+uint32_t *pfsph_nlist_counts(pfsph_nlist *l, size_t n)
+{
+    l->n = 0;
+    if (n > l->cap_n || !l->start) {
+        size_t cap = n + n / 8 + 16;
+        uint32_t *s = realloc(l->start, (cap + 1) * sizeof *s);
+        if (!s) return NULL;
+        l->start = s;
+        l->cap_n = cap;
+    }
+    return l->start + 1;
+}
+
+int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
+                     const pfsph_real *z, size_t n, pfsph_real r2)
+{
+    /* offsets, serially: a 64-bit total so that an overflow of the 32-bit offsets is caught */
+    const uint32_t *cnt = l->start + 1;
+    uint64_t total = 0;
+    l->n = 0;
+    l->start[0] = 0;
+    for (size_t i = 0; i < n; i++) {
+        total += cnt[i];
+        if (total > UINT32_MAX) return PFSPH_ENOMEM;
+        l->start[i + 1] = (uint32_t)total;
+    }
+    if (total > l->cap || !l->idx) {
+        size_t cap = (size_t)total + (size_t)total / 8 + 64;
+        uint32_t *p = realloc(l->idx, cap * sizeof *p);
+        if (!p) return PFSPH_ENOMEM;
+        l->idx = p;
+        l->cap = cap;
+    }
+    int bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : bad)
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t want = l->start[i + 1] - l->start[i];
+        if (walk(g, x, y, z, i, r2, l->idx + l->start[i], want) != want) bad = 1;
+    }
+    if (bad) return PFSPH_EINPUT; /* counts not those of this walk: a caller's bug */
+    l->n = n;
+    return PFSPH_OK;
+}
+
+int pfsph_nlist_build(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
+                      const pfsph_real *z, size_t n, pfsph_real r2)
+{
+    uint32_t *cnt = pfsph_nlist_counts(l, n);
+    if (!cnt) return PFSPH_ENOMEM;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) cnt[i] = walk(g, x, y, z, i, r2, NULL, 0);
+    return pfsph_nlist_fill(l, g, x, y, z, n, r2);
+}
+
+void pfsph_nlist_free(pfsph_nlist *l)
+{
+    if (!l) return;
+    free(l->start);
+    free(l->idx);
+    l->start = l->idx = NULL;
+    l->n = l->cap_n = l->cap = 0;
+}
+
+double pfsph_nlist_bytes_per_particle(double neighbours)
+{
+    return sizeof(uint32_t) * (1.0 + 1.125 * neighbours) + 0.5;
+}
