@@ -227,7 +227,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
      * and a quarter more for compression near walls and in splashes */
     const double q = s->support_factor;
     const double nlist = ops && ops->neighbour_lists
-                             ? pfsph_nlist_bytes_per_particle(1.25 * (s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q))
+                             ? pfsph_nlist_bytes_per_particle(1.25 * (s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q), 1)
                              : 0;
     const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort +
                              2 * P + nlist;
@@ -586,7 +586,7 @@ static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
         uint32_t *cnt = pfsph_nlist_counts(&sim->nlist, n);
         if (!cnt) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory building the neighbour lists");
         pfsph__number_density_count(c, c->nd, cnt);
-        int rc = pfsph_nlist_fill(&sim->nlist, &sim->grid, f->x, f->y, f->z, n, c->kern.h * c->kern.h);
+        int rc = pfsph_nlist_fill(&sim->nlist, &sim->grid, f->x, f->y, f->z, n, c->kern.h * c->kern.h, &c->kern);
         if (rc) return pfsph_fail(err, rc, "cannot build the neighbour lists");
         c->nlist = &sim->nlist;
     } else {

@@ -4,9 +4,10 @@
 #include <stdlib.h>
 
 /* the neighbours of i within r2 (j != i), the first `room` of them written to out when out is
- * not NULL; their count */
+ * not NULL (and their kernel derivatives to dw when it is not NULL); their count */
 static inline uint32_t walk(const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y, const pfsph_real *z,
-                            size_t i, pfsph_real r2max, uint32_t *out, uint32_t room)
+                            size_t i, pfsph_real r2max, uint32_t *out, pfsph_real *dw, const pfsph_kernel *k,
+                            uint32_t room)
 {
     pfsph_ranges r;
     const pfsph_real xi = x[i], yi = y[i], zi = z[i];
@@ -17,7 +18,10 @@ static inline uint32_t walk(const pfsph_grid *g, const pfsph_real *x, const pfsp
             pfsph_real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
             pfsph_real r2 = dx * dx + dy * dy + dz * dz;
             if (r2 < r2max && j != i) {
-                if (out && c < room) out[c] = j;
+                if (out && c < room) {
+                    out[c] = j;
+                    if (dw) dw[c] = pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                }
                 c++;
             }
         }
@@ -38,7 +42,7 @@ uint32_t *pfsph_nlist_counts(pfsph_nlist *l, size_t n)
 }
 
 int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
-                     const pfsph_real *z, size_t n, pfsph_real r2)
+                     const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k)
 {
     /* offsets, serially: a 64-bit total so that an overflow of the 32-bit offsets is caught */
     const uint32_t *cnt = l->start + 1;
@@ -50,18 +54,24 @@ int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, c
         if (total > UINT32_MAX) return PFSPH_ENOMEM;
         l->start[i + 1] = (uint32_t)total;
     }
-    if (total > l->cap || !l->idx) {
+    if (total > l->cap || !l->idx || (k && !l->dw)) {
         size_t cap = (size_t)total + (size_t)total / 8 + 64;
         uint32_t *p = realloc(l->idx, cap * sizeof *p);
         if (!p) return PFSPH_ENOMEM;
         l->idx = p;
+        if (k) {
+            pfsph_real *w = realloc(l->dw, cap * sizeof *w);
+            if (!w) return PFSPH_ENOMEM;
+            l->dw = w;
+        }
         l->cap = cap;
     }
+    pfsph_real *dw = k ? l->dw : NULL;
     int bad = 0;
 #pragma omp parallel for schedule(static) reduction(| : bad)
     for (size_t i = 0; i < n; i++) {
         const uint32_t want = l->start[i + 1] - l->start[i];
-        if (walk(g, x, y, z, i, r2, l->idx + l->start[i], want) != want) bad = 1;
+        if (walk(g, x, y, z, i, r2, l->idx + l->start[i], dw ? dw + l->start[i] : NULL, k, want) != want) bad = 1;
     }
     if (bad) return PFSPH_EINPUT; /* counts not those of this walk: a caller's bug */
     l->n = n;
@@ -69,13 +79,13 @@ int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, c
 }
 
 int pfsph_nlist_build(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
-                      const pfsph_real *z, size_t n, pfsph_real r2)
+                      const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k)
 {
     uint32_t *cnt = pfsph_nlist_counts(l, n);
     if (!cnt) return PFSPH_ENOMEM;
 #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) cnt[i] = walk(g, x, y, z, i, r2, NULL, 0);
-    return pfsph_nlist_fill(l, g, x, y, z, n, r2);
+    for (size_t i = 0; i < n; i++) cnt[i] = walk(g, x, y, z, i, r2, NULL, NULL, NULL, 0);
+    return pfsph_nlist_fill(l, g, x, y, z, n, r2, k);
 }
 
 void pfsph_nlist_free(pfsph_nlist *l)
@@ -83,11 +93,13 @@ void pfsph_nlist_free(pfsph_nlist *l)
     if (!l) return;
     free(l->start);
     free(l->idx);
+    free(l->dw);
     l->start = l->idx = NULL;
+    l->dw = NULL;
     l->n = l->cap_n = l->cap = 0;
 }
 
-double pfsph_nlist_bytes_per_particle(double neighbours)
+double pfsph_nlist_bytes_per_particle(double neighbours, int with_dw)
 {
-    return sizeof(uint32_t) * (1.0 + 1.125 * neighbours) + 0.5;
+    return sizeof(uint32_t) * (1.0 + 1.125 * neighbours) + (with_dw ? sizeof(pfsph_real) * 1.125 * neighbours : 0) + 0.5;
 }

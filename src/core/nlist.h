@@ -5,29 +5,37 @@
  * holds only the ~30. Each particle's list is in the order of the grid walk, so a pass over the
  * list adds the same terms in the same order as the grid walk did: the same bits.
  *
- * Memory: 4 bytes per particle for the offsets plus 4 bytes per neighbour (32-bit indices),
- * with 1/8 slack when the list grows: about 4 + 4.5 * 33 = 153 bytes per fluid particle in 3D
- * at h = 2 d, 4 + 4.5 * 13 = 62 in 2D. */
+ * Built with a kernel, each entry also keeps the kernel derivative of the pair, the same bits
+ * as the passes computed (pfsph_kernel_dw_r of sqrt(r2)): the passes then need no square root,
+ * division or branch of the kernel per pair.
+ *
+ * Memory: 4 bytes per particle for the offsets plus 4 bytes per neighbour (32-bit indices) and
+ * 4 (float) for the kernel derivative, with 1/8 slack when the list grows: about
+ * 4 + 9 * 33 = 301 bytes per fluid particle in 3D at h = 2 d, 4 + 9 * 13 = 121 in 2D. */
 #ifndef PFSPH_NLIST_H
 #define PFSPH_NLIST_H
 
 #include "pfsph/grid.h"
+#include "pfsph/kernel.h"
 
 typedef struct pfsph_nlist {
     size_t n;        /* particles listed */
     size_t cap_n;    /* entries allocated in start, minus one */
     uint32_t *start; /* n + 1: particle i's neighbours are idx[start[i] .. start[i + 1]) */
     uint32_t *idx;   /* neighbour indices into the sorted set */
+    pfsph_real *dw;  /* per entry: pfsph_kernel_dw_r(k, |x_ij|) (grad W_ij = dw x_ij), when built
+                      * with a kernel; else NULL */
     size_t cap;      /* entries allocated in idx */
 } pfsph_nlist;
 
 /* Builds the lists of the n particles at (x, y, z), sorted in grid g (this step), for the
- * radius g->reach * g->cell covers: j != i with |x_i - x_j|^2 < r2. Two grid walks (count,
+ * radius g->reach * g->cell covers: j != i with |x_i - x_j|^2 < r2; k: NULL, or the kernel
+ * whose derivative each entry keeps (dw). Two grid walks (count,
  * then fill) so that each list is contiguous and in grid-walk order for any thread count.
  * Grows its arrays only when a step needs more (by 1/8 over the need). Returns PFSPH_OK or
  * PFSPH_ENOMEM (the list is then empty). */
 int pfsph_nlist_build(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
-                      const pfsph_real *z, size_t n, pfsph_real r2);
+                      const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k);
 
 /* Two steps, for a caller whose own grid walk counts the neighbours (the density pass): the
  * array of n counts to fill (cnt[i]: neighbours j != i of i with |x_i - x_j|^2 < r2), NULL when
@@ -35,12 +43,13 @@ int pfsph_nlist_build(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, 
  * counts were not those of this walk; nothing is written out of bounds). */
 uint32_t *pfsph_nlist_counts(pfsph_nlist *l, size_t n);
 int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
-                     const pfsph_real *z, size_t n, pfsph_real r2);
+                     const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k);
 
 /* Frees the arrays; the struct may be built again. NULL is a no-op. */
 void pfsph_nlist_free(pfsph_nlist *l);
 
-/* Bytes per particle the lists of about `neighbours` neighbours each hold at most (estimate). */
-double pfsph_nlist_bytes_per_particle(double neighbours);
+/* Bytes per particle the lists of about `neighbours` neighbours each hold at most (estimate),
+ * with_dw: built with a kernel. */
+double pfsph_nlist_bytes_per_particle(double neighbours, int with_dw);
 
 #endif

@@ -74,8 +74,7 @@ static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph
         for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
             const uint32_t j = nl->idx[e];
             pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-            pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-            double w = pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+            double w = nl->dw[e];
             double ax = w * dx, ay = w * dy, az = w * dz;
             gx += ax;
             gy += ay;
@@ -125,7 +124,6 @@ static void corrected_velocity(const pfsph_ctx *c, const pfsph_real *p, const pf
 {
     const pfsph_particles *f = c->fluid;
     const pfsph_nlist *nl = c->nlist;
-    const pfsph_kernel *k = &c->kern;
     const size_t n = f->n;
     const pfsph_real dt = (pfsph_real)c->dt;
     const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
@@ -142,8 +140,7 @@ static void corrected_velocity(const pfsph_ctx *c, const pfsph_real *p, const pf
             for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
                 const uint32_t j = nl->idx[e];
                 pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                pfsph_real s = (pi + pq[j]) * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                pfsph_real s = (pi + pq[j]) * nl->dw[e];
                 ax += s * dx;
                 ay += s * dy;
                 az += s * dz;
@@ -172,7 +169,6 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_r
 {
     const pfsph_particles *f = c->fluid;
     const pfsph_nlist *nl = c->nlist;
-    const pfsph_kernel *k = &c->kern;
     const size_t n = f->n;
     const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
 #pragma omp parallel for schedule(static)
@@ -183,9 +179,8 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_r
         for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
             const uint32_t j = nl->idx[e];
             pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-            pfsph_real r2 = dx * dx + dy * dy + dz * dz;
             pfsph_real vd = (vxi - vx[j]) * dx + (vyi - vy[j]) * dy + (vzi - vz[j]) * dz;
-            s += vd * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+            s += vd * nl->dw[e];
         }
         const pfsph_real sb = vxi * bsum[0][i] + vyi * bsum[1][i] + vzi * bsum[2][i] - bsum[3][i];
         rate[i] = s + sb * inv_v0;

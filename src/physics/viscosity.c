@@ -19,19 +19,16 @@ typedef struct visc_acc {
 } visc_acc;
 
 /* Fluid neighbour j's Morris viscosity term (and with thermo its thermostat force) on i, added
- * to acc; nothing when j == i or j lies beyond h. */
-static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, size_t i, uint32_t j, pfsph_real h2,
-                             pfsph_real eps, const int thermo, double amp,
-                             const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, visc_acc *acc)
+ * to acc; x_ij = (dx, dy, dz), r2 = |x_ij|^2 < h^2, dwr = pfsph_kernel_dw_r(|x_ij|). */
+static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, pfsph_real dx, pfsph_real dy,
+                             pfsph_real dz, pfsph_real r2, pfsph_real dwr, pfsph_real eps, const int thermo,
+                             double amp, const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key,
+                             visc_acc *acc)
 {
     const pfsph_particles *f = ctx->fluid;
     const pfsph_kernel *k = &ctx->kern;
-    pfsph_real dx = I->x - f->x[j], dy = I->y - f->y[j], dz = I->z - f->z[j];
-    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-    if (r2 >= h2 || j == i) return;
     pfsph_real nu = (pfsph_real)0.5 * (I->nu + ctx->nu[f->phase[j]]);
     pfsph_real vdx = (I->vx - f->vx[j]) * dx + (I->vy - f->vy[j]) * dy + (I->vz - f->vz[j]) * dz;
-    const pfsph_real rr = pfsph_sqrt(r2), dwr = pfsph_kernel_dw_r(k, rr);
     pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
     acc->ax += s * dx;
     acc->ay += s * dy;
@@ -96,12 +93,22 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
         const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
         visc_acc acc = {0, 0, 0, 0, 0, 0};
         if (nl) {
-            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++)
-                visc_pair(ctx, &vi, i, nl->idx[e], h2, eps, thermo, amp, ts, key, &acc);
+            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
+                const uint32_t j = nl->idx[e];
+                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                visc_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, nl->dw[e], eps, thermo, amp, ts, key,
+                          &acc);
+            }
         } else {
             pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
             for (int q = 0; q < r.n; q++)
-                for (uint32_t j = r.b[q]; j < r.e[q]; j++) visc_pair(ctx, &vi, i, j, h2, eps, thermo, amp, ts, key, &acc);
+                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+                    pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+                    if (r2 >= h2 || j == i) continue;
+                    visc_pair(ctx, &vi, j, dx, dy, dz, r2, pfsph_kernel_dw_r(k, pfsph_sqrt(r2)), eps, thermo, amp, ts,
+                              key, &acc);
+                }
         }
         ax = acc.ax, ay = acc.ay, az = acc.az, fx = acc.fx, fy = acc.fy, fz = acc.fz;
         /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
