@@ -59,7 +59,9 @@ struct pfsph_sim {
     void *solver_state;
     double sound_speed;
     double amax;            /* largest acceleration of the last step */
-    double amax_np;         /* largest non-pressure acceleration of the last step */
+    double amax_np;         /* largest non-pressure acceleration of the last step (or the solver's
+                             * bound without viscosity: np_cap_without_viscosity) */
+    double gmag;            /* |gravity| */
     double vbound;          /* speeds above this are a blow-up */
     double t_limit;         /* the step in progress never passes this time */
     size_t removed_before;  /* removed count before this step's sort */
@@ -427,6 +429,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     sim->amax = g;
     sim->amax_np = g;
+    sim->gmag = g;
     size_t worst0;
     sim->stats.vmax = max_speed(&sim->fluid, &worst0);
     sim->vbound = sim->solver->speed_bound(sim->solver_state, c);
@@ -444,6 +447,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         for (size_t i = 0; i < sim->fluid.n; i++)
             a2 = fmax(a2, (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i]);
         sim->amax = sim->amax_np = fmax(g, sqrt(a2));
+        if (sim->solver->np_cap_without_viscosity) sim->amax_np = g + pfsph_pairwise_amax(sim->pw);
     }
     build_stages(sim);
     *out = sim;
@@ -583,11 +587,10 @@ static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     const size_t n = f->n;
     c->nlist = NULL;
     if (sim->solver->neighbour_lists) {
-        uint32_t *cnt = pfsph_nlist_counts(&sim->nlist, n);
-        if (!cnt) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory building the neighbour lists");
-        pfsph__number_density_count(c, c->nd, cnt);
-        int rc = pfsph_nlist_fill(&sim->nlist, &sim->grid, f->x, f->y, f->z, n, c->kern.h * c->kern.h, &c->kern);
-        if (rc) return pfsph_fail(err, rc, "cannot build the neighbour lists");
+        const double q = (double)c->h / (double)c->spacing; /* a full neighbourhood, and a quarter */
+        const double guess = 1.25 * (c->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q);
+        int rc = pfsph__number_density_list(c, c->nd, &sim->nlist, guess);
+        if (rc) return pfsph_fail(err, rc, "cannot build the neighbour lists (%s)", rc == PFSPH_ENOMEM ? "out of memory" : "internal error");
         c->nlist = &sim->nlist;
     } else {
         pfsph__number_density(c, f->x, f->y, f->z, c->nd);
@@ -736,7 +739,7 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
         else if (v2 > v2max) v2max = v2;
     }
     sim->amax = sqrt(amax2);
-    sim->amax_np = sqrt(anp2);
+    sim->amax_np = sim->solver->np_cap_without_viscosity ? sim->gmag + pfsph_pairwise_amax(sim->pw) : sqrt(anp2);
     sim->stats.ekin = pfsph__sum(ek, n);
     sim->stats.density_err_max = emax;
     sim->stats.dt = dt;

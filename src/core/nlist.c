@@ -2,6 +2,7 @@
 #include "core/nlist.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 /* the neighbours of i within r2 (j != i), the first `room` of them written to out when out is
  * not NULL (and their kernel derivatives to dw when it is not NULL); their count */
@@ -86,6 +87,68 @@ int pfsph_nlist_build(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, 
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) cnt[i] = walk(g, x, y, z, i, r2, NULL, NULL, NULL, 0);
     return pfsph_nlist_fill(l, g, x, y, z, n, r2, k);
+}
+
+int pfsph_nlist_plan(pfsph_nlist *l, size_t n, int nthreads, double guess)
+{
+    if (nthreads < 1 || nthreads > PFSPH_NLIST_MAX_THREADS) return PFSPH_EINPUT;
+    if (!pfsph_nlist_counts(l, n)) return PFSPH_ENOMEM;
+    const int same = l->nthreads == nthreads;
+    size_t off = 0;
+    for (int t = 0; t < nthreads; t++) {
+        const size_t i0 = n * (size_t)t / (size_t)nthreads, i1 = n * (size_t)(t + 1) / (size_t)nthreads;
+        /* this thread's particles lie where its particles lay last step (the grid order changes
+         * little from step to step), so its last need, per particle, predicts this one */
+        double per = same && l->n_t[t] ? (double)l->used[t] / (double)l->n_t[t] : guess;
+        l->rbeg[t] = off;
+        off += (size_t)(1.125 * per * (double)(i1 - i0)) + 256;
+        l->n_t[t] = i1 - i0;
+    }
+    l->rbeg[nthreads] = off;
+    l->nthreads = nthreads;
+    if (off > l->cap || !l->idx || !l->dw) {
+        uint32_t *p = realloc(l->idx, off * sizeof *p);
+        if (!p) return PFSPH_ENOMEM;
+        l->idx = p;
+        pfsph_real *w = realloc(l->dw, off * sizeof *w);
+        if (!w) return PFSPH_ENOMEM;
+        l->dw = w;
+        l->cap = off;
+    }
+    return PFSPH_OK;
+}
+
+int pfsph_nlist_finish(pfsph_nlist *l, int overflow, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
+                       const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k)
+{
+    if (overflow) {
+        int rc = pfsph_nlist_fill(l, g, x, y, z, n, r2, k);
+        for (int t = 0; t < l->nthreads && rc == PFSPH_OK; t++) { /* the next plan's sizes */
+            const size_t i0 = n * (size_t)t / (size_t)l->nthreads, i1 = n * (size_t)(t + 1) / (size_t)l->nthreads;
+            l->used[t] = l->start[i1] - l->start[i0];
+        }
+        return rc;
+    }
+    /* compact: each region moves left to follow the one before (in order, so a move never
+     * overwrites entries still to move) */
+    size_t to = l->used[0];
+    for (int t = 1; t < l->nthreads; t++) {
+        if (to != l->rbeg[t]) {
+            memmove(l->idx + to, l->idx + l->rbeg[t], l->used[t] * sizeof *l->idx);
+            memmove(l->dw + to, l->dw + l->rbeg[t], l->used[t] * sizeof *l->dw);
+        }
+        to += l->used[t];
+    }
+    const uint32_t *cnt = l->start + 1;
+    uint64_t total = 0;
+    l->start[0] = 0;
+    for (size_t i = 0; i < n; i++) {
+        total += cnt[i];
+        if (total > UINT32_MAX) return PFSPH_ENOMEM;
+        l->start[i + 1] = (uint32_t)total;
+    }
+    l->n = n;
+    return total == to ? PFSPH_OK : PFSPH_EINPUT;
 }
 
 void pfsph_nlist_free(pfsph_nlist *l)

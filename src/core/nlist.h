@@ -18,6 +18,8 @@
 #include "pfsph/grid.h"
 #include "pfsph/kernel.h"
 
+#define PFSPH_NLIST_MAX_THREADS 256 /* threads a one-walk build plans for (more: two walks) */
+
 typedef struct pfsph_nlist {
     size_t n;        /* particles listed */
     size_t cap_n;    /* entries allocated in start, minus one */
@@ -26,6 +28,10 @@ typedef struct pfsph_nlist {
     pfsph_real *dw;  /* per entry: pfsph_kernel_dw_r(k, |x_ij|) (grad W_ij = dw x_ij), when built
                       * with a kernel; else NULL */
     size_t cap;      /* entries allocated in idx */
+    /* One-walk builds (pfsph_nlist_plan / _finish): thread t of nthreads writes its particles'
+     * lists into idx[rbeg[t] .. rbeg[t + 1]); used[t] entries it needed, for n_t particles. */
+    int nthreads;
+    size_t rbeg[PFSPH_NLIST_MAX_THREADS + 1], used[PFSPH_NLIST_MAX_THREADS], n_t[PFSPH_NLIST_MAX_THREADS];
 } pfsph_nlist;
 
 /* Builds the lists of the n particles at (x, y, z), sorted in grid g (this step), for the
@@ -44,6 +50,18 @@ int pfsph_nlist_build(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, 
 uint32_t *pfsph_nlist_counts(pfsph_nlist *l, size_t n);
 int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
                      const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k);
+
+/* One walk, for a caller whose own grid walk finds the neighbours (the density pass): plan
+ * gives each of nthreads threads, taking particles [n t / nthreads, n (t + 1) / nthreads) in
+ * order, a region of idx and dw (rbeg) sized from the same thread's need last time (1/8 more,
+ * plus 256), or guess neighbours per particle the first time; returns PFSPH_ENOMEM, or
+ * PFSPH_EINPUT when it cannot plan (too many threads: count and fill instead). The caller then
+ * writes each particle's count to cnt = start + 1 and its entries at the thread's next free
+ * place while they fit, and sets used[t]. finish compacts the regions and sets the offsets,
+ * or, when a region overflowed, fills the lists by a second walk from the counts. */
+int pfsph_nlist_plan(pfsph_nlist *l, size_t n, int nthreads, double guess);
+int pfsph_nlist_finish(pfsph_nlist *l, int overflow, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
+                       const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k);
 
 /* Frees the arrays; the struct may be built again. NULL is a no-op. */
 void pfsph_nlist_free(pfsph_nlist *l);

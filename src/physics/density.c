@@ -1,6 +1,10 @@
 /* Number density delta_i (PF Eq. 23), fluid and boundary neighbours. */
 #include "physics/density.h"
 
+#include <omp.h>
+
+#include "core/nlist.h"
+
 /* cnt: NULL, or where to count each particle's fluid neighbours j != i within h (the lists'
  * counts, src/core/nlist.h): the walk is the density's own, so counting costs a compare. */
 static inline void number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
@@ -49,10 +53,78 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
     number_density(ctx, x, y, z, nd, NULL);
 }
 
-void pfsph__number_density_count(const pfsph_ctx *ctx, pfsph_real *nd, uint32_t *cnt)
+/* The boundary part (1/V0) sum_b V_b W_ib of particle i at (xi, yi, zi). */
+static inline pfsph_real boundary_density(const pfsph_ctx *ctx, pfsph_real xi, pfsph_real yi, pfsph_real zi)
+{
+    const pfsph_particles *b = ctx->boundary;
+    const pfsph_kernel *k = &ctx->kern;
+    const pfsph_real h2 = k->h * k->h;
+    pfsph_ranges r;
+    pfsph_real sb = 0;
+    pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
+    for (int q = 0; q < r.n; q++)
+        for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+            pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
+            pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+            if (r2 < h2) sb += b->aux[j] * pfsph_kernel_w(k, pfsph_sqrt(r2));
+        }
+    return sb * ((pfsph_real)1 / ctx->V0);
+}
+
+int pfsph__number_density_list(const pfsph_ctx *ctx, pfsph_real *nd, pfsph_nlist *l, double guess)
 {
     const pfsph_particles *f = ctx->fluid;
-    number_density(ctx, f->x, f->y, f->z, nd, cnt);
+    const pfsph_kernel *k = &ctx->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const size_t n = f->n;
+    const int T = omp_get_max_threads();
+    int rc = pfsph_nlist_plan(l, n, T, guess), over = 0;
+    if (rc == PFSPH_ENOMEM) return rc;
+    uint32_t *cnt = pfsph_nlist_counts(l, n);
+    if (!cnt) return PFSPH_ENOMEM;
+    if (rc) { /* no plan: count in the density walk, then fill by a second walk */
+        number_density(ctx, f->x, f->y, f->z, nd, cnt);
+        over = 1;
+    } else {
+#pragma omp parallel num_threads(T) reduction(| : over)
+        {
+            /* the particles of this thread as the plan has them: contiguous, in order */
+            const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+            const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
+            const size_t rb = l->rbeg[t], re = nt == T ? l->rbeg[t + 1] : rb; /* fewer threads: no room */
+            size_t pos = rb;
+            for (size_t i = i0; i < i1; i++) {
+                pfsph_ranges r;
+                const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+                pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+                pfsph_real s = 0;
+                const size_t p0 = pos;
+                /* the terms of number_density in its order (the same bits), and the list */
+                for (int q = 0; q < r.n; q++)
+                    for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+                        pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                        pfsph_real r2 = dx * dx + dy * dy + dz * dz;
+                        if (r2 < h2) {
+                            const pfsph_real rr = pfsph_sqrt(r2);
+                            s += pfsph_kernel_w(k, rr);
+                            if (j != i) {
+                                if (pos < re) {
+                                    l->idx[pos] = j;
+                                    l->dw[pos] = pfsph_kernel_dw_r(k, rr);
+                                }
+                                pos++;
+                            }
+                        }
+                    }
+                cnt[i] = (uint32_t)(pos - p0);
+                if (ctx->boundary->n) s += boundary_density(ctx, xi, yi, zi);
+                nd[i] = s;
+            }
+            if (nt != T || pos > re) over = 1;
+            else l->used[t] = pos - rb;
+        }
+    }
+    return pfsph_nlist_finish(l, over, ctx->grid, f->x, f->y, f->z, n, h2, k);
 }
 
 void pfsph__number_density_rate(const pfsph_ctx *ctx, const pfsph_real *vx, const pfsph_real *vy,

@@ -338,6 +338,7 @@ const pfsph_solver_ops pfsph_solver_dfsph = {
     .name = "dfsph",
     .nscratch = NSCR,
     .neighbour_lists = 1,
+    .np_cap_without_viscosity = 1,
     .create = create,
     .destroy = destroy,
     .pre_forces = pre_forces,
