@@ -10,6 +10,7 @@
 #include <cjson/cJSON.h>
 #include <omp.h>
 
+#include "pfsph/omp_env.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 
@@ -33,6 +34,7 @@ static void usage(void)
 
 int main(int argc, char **argv)
 {
+    pfsph_omp_wait_default(argv); /* as pfsph does */
     const char *scene = "bench/dam_break_7k.json", *solver = NULL;
     double end = 0;
     int threads = 0;
