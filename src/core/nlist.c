@@ -93,13 +93,18 @@ int pfsph_nlist_plan(pfsph_nlist *l, size_t n, int nthreads, double guess)
 {
     if (nthreads < 1 || nthreads > PFSPH_NLIST_MAX_THREADS) return PFSPH_EINPUT;
     if (!pfsph_nlist_counts(l, n)) return PFSPH_ENOMEM;
-    const int same = l->nthreads == nthreads;
+    if (l->nthreads != nthreads) {
+        /* no history for this many threads: the caller counts and fills by two walks, which
+         * sizes the arrays exactly (a guess would set the peak memory: 1.4x the need) */
+        l->nthreads = nthreads;
+        return PFSPH_EINPUT;
+    }
     size_t off = 0;
     for (int t = 0; t < nthreads; t++) {
         const size_t i0 = n * (size_t)t / (size_t)nthreads, i1 = n * (size_t)(t + 1) / (size_t)nthreads;
         /* this thread's particles lie where its particles lay last step (the grid order changes
          * little from step to step), so its last need, per particle, predicts this one */
-        double per = same && l->n_t[t] ? (double)l->used[t] / (double)l->n_t[t] : guess;
+        double per = l->n_t[t] ? (double)l->used[t] / (double)l->n_t[t] : guess;
         l->rbeg[t] = off;
         off += (size_t)(1.125 * per * (double)(i1 - i0)) + 256;
         l->n_t[t] = i1 - i0;
@@ -126,6 +131,7 @@ int pfsph_nlist_finish(pfsph_nlist *l, int overflow, const pfsph_grid *g, const 
         for (int t = 0; t < l->nthreads && rc == PFSPH_OK; t++) { /* the next plan's sizes */
             const size_t i0 = n * (size_t)t / (size_t)l->nthreads, i1 = n * (size_t)(t + 1) / (size_t)l->nthreads;
             l->used[t] = l->start[i1] - l->start[i0];
+            l->n_t[t] = i1 - i0;
         }
         return rc;
     }

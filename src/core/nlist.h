@@ -54,8 +54,9 @@ int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, c
 /* One walk, for a caller whose own grid walk finds the neighbours (the density pass): plan
  * gives each of nthreads threads, taking particles [n t / nthreads, n (t + 1) / nthreads) in
  * order, a region of idx and dw (rbeg) sized from the same thread's need last time (1/8 more,
- * plus 256), or guess neighbours per particle the first time; returns PFSPH_ENOMEM, or
- * PFSPH_EINPUT when it cannot plan (too many threads: count and fill instead). The caller then
+ * plus 256; guess neighbours per particle for a thread that had none); returns PFSPH_ENOMEM,
+ * or PFSPH_EINPUT when it cannot plan (the first build for this many threads, or too many
+ * threads: count and fill by two walks instead). The caller then
  * writes each particle's count to cnt = start + 1 and its entries at the thread's next free
  * place while they fit, and sets used[t]. finish compacts the regions and sets the offsets,
  * or, when a region overflowed, fills the lists by a second walk from the counts. */
