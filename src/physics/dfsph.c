@@ -114,10 +114,43 @@ static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph
     }
 }
 
-/* a = a_p(p) (PF Eq. 4 in the number-density form with the Akinci wall term, as
- * pfsph__pressure_accel computes it, over the lists, with p_j / delta_j^2 computed once per
- * particle into pq) and v_out = v + dt (a_extra + a). */
-static void corrected_velocity(const pfsph_ctx *c, const pfsph_real *p, const pfsph_real *ex,
+/* The residual of particle i: density mode (predicted delta - delta0) or divergence mode
+ * (dt D delta / Dt, none for a deficient neighbourhood), a compression over the step [1/m^d],
+ * and the factor that turns it into a pressure update. */
+static inline double residual_of(const pfsph_ctx *c, int divergence, const pfsph_real *rate,
+                                 const pfsph_real *fac, size_t i, double *fi)
+{
+    const double f = fac[i];
+    if (divergence) {
+        *fi = f > 0 ? f : 0;
+        return f > 0 ? c->dt * (double)rate[i] : 0;
+    }
+    *fi = fabs(f);
+    return (double)c->nd[i] + c->dt * (double)rate[i] - (double)c->nd0;
+}
+
+/* One Jacobi update of the clamped pressure p_i: p_i / delta_i^2 grows by omega res / (dt^2 A_i)
+ * (Bender & Koschier 2017, Eqs. 9, 12; the divergence residual already carries one dt). A_i
+ * counts only particle i's own pressure; in a Jacobi sweep the neighbours push too, and
+ * omega = 1 overshot: a 2D tank at rest diverged at step 3. omega = 0.5, as IISPH and our PCISPH
+ * relax. */
+static inline pfsph_real updated(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
+                                 const pfsph_real *p, size_t i)
+{
+    const double dt2 = c->dt * c->dt;
+    double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
+    double nd = c->nd[i];
+    double pn = (double)p[i] + OMEGA * nd * nd * res * fi / dt2;
+    return (pfsph_real)(pn > 0 ? pn : 0);
+}
+
+/* With upd, first the Jacobi update of p from the last residual (rate, fac); then a = a_p(p)
+ * (PF Eq. 4 in the number-density form with the Akinci wall term, as pfsph__pressure_accel
+ * computes it, over the lists, with p_j / delta_j^2 computed once per particle into pq) and
+ * v_out = v + dt (a_extra + a). One parallel region: a barrier fewer per iteration matters on
+ * a loaded machine. */
+static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, const pfsph_real *rate,
+                               const pfsph_real *fac, pfsph_real *p, const pfsph_real *ex,
                                const pfsph_real *ey, const pfsph_real *ez, pfsph_real *const bsum[4],
                                pfsph_real *pq, pfsph_real *const a[3], pfsph_real *vx, pfsph_real *vy,
                                pfsph_real *vz)
@@ -131,7 +164,10 @@ static void corrected_velocity(const pfsph_ctx *c, const pfsph_real *p, const pf
 #pragma omp parallel
     {
 #pragma omp for schedule(static)
-        for (size_t i = 0; i < n; i++) pq[i] = p[i] / (nd[i] * nd[i]);
+        for (size_t i = 0; i < n; i++) {
+            if (upd) p[i] = updated(c, divergence, rate, fac, p, i);
+            pq[i] = p[i] / (nd[i] * nd[i]);
+        }
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
@@ -163,10 +199,13 @@ static void corrected_velocity(const pfsph_ctx *c, const pfsph_real *p, const pf
 }
 
 /* D delta_i / Dt for the velocities v (PF Eq. 23 differentiated): sum_j (v_i - v_j) . grad
- * W_ij over the lists, plus the wall's (1/V0) (v_i . B_i - C_i) from the sums of factors(). */
+ * W_ij over the lists, plus the wall's (1/V0) (v_i . B_i - C_i) from the sums of factors();
+ * and err_i, the relative compression over the step that the residual stands for. */
 static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_real *vy, const pfsph_real *vz,
-                         pfsph_real *const bsum[4], pfsph_real *rate)
+                         pfsph_real *const bsum[4], pfsph_real *rate, int divergence, const pfsph_real *fac,
+                         pfsph_real *err)
 {
+    const double nd0 = c->nd0;
     const pfsph_particles *f = c->fluid;
     const pfsph_nlist *nl = c->nlist;
     const size_t n = f->n;
@@ -184,54 +223,9 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_r
         }
         const pfsph_real sb = vxi * bsum[0][i] + vyi * bsum[1][i] + vzi * bsum[2][i] - bsum[3][i];
         rate[i] = s + sb * inv_v0;
-    }
-}
-
-/* The residual of particle i: density mode (predicted delta - delta0) or divergence mode
- * (dt D delta / Dt, none for a deficient neighbourhood), a compression over the step [1/m^d],
- * and the factor that turns it into a pressure update. */
-static inline double residual_of(const pfsph_ctx *c, int divergence, const pfsph_real *rate,
-                                 const pfsph_real *fac, size_t i, double *fi)
-{
-    const double f = fac[i];
-    if (divergence) {
-        *fi = f > 0 ? f : 0;
-        return f > 0 ? c->dt * (double)rate[i] : 0;
-    }
-    *fi = fabs(f);
-    return (double)c->nd[i] + c->dt * (double)rate[i] - (double)c->nd0;
-}
-
-/* Mean compression over one step, relative to delta0, that the residuals stand for. */
-static double residual(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
-                       pfsph_real *err)
-{
-    const size_t n = c->fluid->n;
-    const double nd0 = c->nd0;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
+        /* the compression it stands for (residual()), in the same pass */
         double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
         err[i] = (pfsph_real)(res > 0 ? res / nd0 : 0);
-    }
-    return n ? pfsph__sum(err, n) / (double)n : 0;
-}
-
-/* One Jacobi update of the clamped pressure p: p_i / delta_i^2 grows by omega res / (dt^2 A_i)
- * (Bender & Koschier 2017, Eqs. 9, 12; the divergence residual already carries one dt). A_i
- * counts only particle i's own pressure; in a Jacobi sweep the neighbours push too, and
- * omega = 1 overshot: a 2D tank at rest diverged at step 3. omega = 0.5, as IISPH and our PCISPH
- * relax. */
-static void update(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
-                   pfsph_real *p)
-{
-    const size_t n = c->fluid->n;
-    const double dt2 = c->dt * c->dt;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
-        double nd = c->nd[i];
-        double pn = (double)p[i] + OMEGA * nd * nd * res * fi / dt2;
-        p[i] = (pfsph_real)(pn > 0 ? pn : 0);
     }
 }
 
@@ -244,15 +238,15 @@ static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real
 {
     const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay,
                      *ez = divergence ? NULL : c->az;
-    int it = 0;
-    for (;;) {
-        pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
-        corrected_velocity(c, p, ex, ey, ez, bsum, scr[PQ], ap, scr[VX], scr[VY], scr[VZ]);
-        density_rate(c, scr[VX], scr[VY], scr[VZ], bsum, scr[RATE]);
-        *avg = residual(c, divergence, scr[RATE], scr[FAC], scr[ERR]);
+    const size_t n = c->fluid->n;
+    pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
+    for (int it = 0;; it++) {
+        /* from the second pass on, the update of the last residual comes first */
+        corrected_velocity(c, it > 0, divergence, scr[RATE], scr[FAC], p, ex, ey, ez, bsum, scr[PQ], ap, scr[VX],
+                           scr[VY], scr[VZ]);
+        density_rate(c, scr[VX], scr[VY], scr[VZ], bsum, scr[RATE], divergence, scr[FAC], scr[ERR]);
+        *avg = n ? pfsph__sum(scr[ERR], n) / (double)n : 0;
         if (it >= max_it || (it >= min_it && *avg <= tol)) return it;
-        update(c, divergence, scr[RATE], scr[FAC], p);
-        it++;
     }
 }
 
