@@ -50,7 +50,8 @@ struct pfsph_sim {
     pfsph_ctx ctx;
     pfsph_particles fluid, boundary;
     pfsph_grid grid, bgrid;
-    pfsph_nlist nlist;        /* built each step when the solver asks (neighbour_lists) */
+    pfsph_nlist nlist, nlist_b; /* fluid and boundary neighbours, built each step when the
+                                 * solver asks (neighbour_lists) */
     pfsph_real *scr[SCR_MAX]; /* per-step scratch: SCR_COMMON of ours, then the solver's */
     int nscr;
     int scr_noise;            /* first of the thermostat's 3 arrays (its accelerations), or -1 */
@@ -226,11 +227,12 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
     const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
     /* neighbour lists: a full neighbourhood within h (pi q^2 in 2D, 4/3 pi q^3 in 3D, q = h / d)
-     * and a quarter more for compression near walls and in splashes */
-    const double q = s->support_factor;
-    const double nlist = ops && ops->neighbour_lists
-                             ? pfsph_nlist_bytes_per_particle(1.25 * (s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q), 1)
-                             : 0;
+     * and a quarter more for compression near walls and in splashes; boundary lists: half a
+     * neighbourhood for every fluid particle (a particle on a wall has about half) */
+    const double q = s->support_factor, full = s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q;
+    const double nlist = ops && ops->neighbour_lists ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) +
+                                                           pfsph_nlist_bytes_per_particle(0.5 * full, 1)
+                                                     : 0;
     const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort +
                              2 * P + nlist;
     const double per_boundary = 2 * P + sort;
@@ -471,6 +473,7 @@ void pfsph_sim_destroy(pfsph_sim *sim)
     pfsph_grid_free(&sim->grid);
     pfsph_grid_free(&sim->bgrid);
     pfsph_nlist_free(&sim->nlist);
+    pfsph_nlist_free(&sim->nlist_b);
     for (int k = 0; k < SCR_MAX; k++) free(sim->scr[k]);
     free(sim);
 }
@@ -563,7 +566,7 @@ static int st_grid(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)bad;
     (void)err;
     sim->removed_before = sim->removed;
-    sim->ctx.nlist = NULL; /* the sort reorders the particles: lists are built again after it */
+    sim->ctx.nlist = sim->ctx.nlist_b = NULL; /* the sort reorders the particles: lists are built again after it */
     pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed);
     return PFSPH_OK;
 }
@@ -585,13 +588,14 @@ static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = &sim->fluid;
     const size_t n = f->n;
-    c->nlist = NULL;
+    c->nlist = c->nlist_b = NULL;
     if (sim->solver->neighbour_lists) {
         const double q = (double)c->h / (double)c->spacing; /* a full neighbourhood, and a quarter */
         const double guess = 1.25 * (c->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q);
-        int rc = pfsph__number_density_list(c, c->nd, &sim->nlist, guess);
+        int rc = pfsph__number_density_list(c, c->nd, &sim->nlist, &sim->nlist_b, guess);
         if (rc) return pfsph_fail(err, rc, "cannot build the neighbour lists (%s)", rc == PFSPH_ENOMEM ? "out of memory" : "internal error");
         c->nlist = &sim->nlist;
+        c->nlist_b = &sim->nlist_b;
     } else {
         pfsph__number_density(c, f->x, f->y, f->z, c->nd);
     }
@@ -701,7 +705,7 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     const double dt = c->dt;
     const pfsph_real fdt = (pfsph_real)dt;
     double amax2 = 0, anp2 = 0;
-    c->nlist = NULL; /* the particles move: this step's lists no longer hold */
+    c->nlist = c->nlist_b = NULL; /* the particles move: this step's lists no longer hold */
     pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
     int bad_ = 0;

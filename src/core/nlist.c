@@ -4,24 +4,25 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* the neighbours of i within r2 (j != i), the first `room` of them written to out when out is
- * not NULL (and their kernel derivatives to dw when it is not NULL); their count */
-static inline uint32_t walk(const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y, const pfsph_real *z,
-                            size_t i, pfsph_real r2max, uint32_t *out, pfsph_real *dw, const pfsph_kernel *k,
-                            uint32_t room)
+/* the neighbours of query point i (targets within r2; j != i when the sets are one), the first
+ * `room` of them written to out when out is not NULL (and their kernel derivatives to dw when
+ * it is not NULL); their count */
+static inline uint32_t walk(const pfsph_nlist_sets *S, size_t i, uint32_t *out, pfsph_real *dw, uint32_t room)
 {
     pfsph_ranges r;
-    const pfsph_real xi = x[i], yi = y[i], zi = z[i];
-    pfsph_grid_ranges(g, xi, yi, zi, &r);
+    const pfsph_real xi = S->qx[i], yi = S->qy[i], zi = S->qz[i];
+    const pfsph_real *x = S->tx, *y = S->ty, *z = S->tz;
+    const size_t self = S->self ? i : SIZE_MAX;
+    pfsph_grid_ranges(S->g, xi, yi, zi, &r);
     uint32_t c = 0;
     for (int q = 0; q < r.n; q++)
         for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
             pfsph_real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
             pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-            if (r2 < r2max && j != i) {
+            if (r2 < S->r2 && j != self) {
                 if (out && c < room) {
                     out[c] = j;
-                    if (dw) dw[c] = pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                    if (dw) dw[c] = pfsph_kernel_dw_r(S->k, pfsph_sqrt(r2));
                 }
                 c++;
             }
@@ -42,9 +43,10 @@ uint32_t *pfsph_nlist_counts(pfsph_nlist *l, size_t n)
     return l->start + 1;
 }
 
-int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
-                     const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k)
+int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_nlist_sets *S)
 {
+    const size_t n = S->n;
+    const pfsph_kernel *k = S->k;
     /* offsets, serially: a 64-bit total so that an overflow of the 32-bit offsets is caught */
     const uint32_t *cnt = l->start + 1;
     uint64_t total = 0;
@@ -72,21 +74,21 @@ int pfsph_nlist_fill(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, c
 #pragma omp parallel for schedule(static) reduction(| : bad)
     for (size_t i = 0; i < n; i++) {
         const uint32_t want = l->start[i + 1] - l->start[i];
-        if (walk(g, x, y, z, i, r2, l->idx + l->start[i], dw ? dw + l->start[i] : NULL, k, want) != want) bad = 1;
+        if (walk(S, i, l->idx + l->start[i], dw ? dw + l->start[i] : NULL, want) != want) bad = 1;
     }
     if (bad) return PFSPH_EINPUT; /* counts not those of this walk: a caller's bug */
     l->n = n;
     return PFSPH_OK;
 }
 
-int pfsph_nlist_build(pfsph_nlist *l, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
-                      const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k)
+int pfsph_nlist_build(pfsph_nlist *l, const pfsph_nlist_sets *S)
 {
+    const size_t n = S->n;
     uint32_t *cnt = pfsph_nlist_counts(l, n);
     if (!cnt) return PFSPH_ENOMEM;
 #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) cnt[i] = walk(g, x, y, z, i, r2, NULL, NULL, NULL, 0);
-    return pfsph_nlist_fill(l, g, x, y, z, n, r2, k);
+    for (size_t i = 0; i < n; i++) cnt[i] = walk(S, i, NULL, NULL, 0);
+    return pfsph_nlist_fill(l, S);
 }
 
 int pfsph_nlist_plan(pfsph_nlist *l, size_t n, int nthreads, double guess)
@@ -94,8 +96,11 @@ int pfsph_nlist_plan(pfsph_nlist *l, size_t n, int nthreads, double guess)
     if (nthreads < 1 || nthreads > PFSPH_NLIST_MAX_THREADS) return PFSPH_EINPUT;
     if (!pfsph_nlist_counts(l, n)) return PFSPH_ENOMEM;
     if (l->nthreads != nthreads) {
-        /* no history for this many threads: the caller counts and fills by two walks, which
-         * sizes the arrays exactly (a guess would set the peak memory: 1.4x the need) */
+        /* no history for this many threads: regions of nothing, so that the caller's walk
+         * only counts and finish fills by a second walk, which sizes the arrays exactly (a
+         * guess would set the peak memory: 1.4x the need) */
+        for (int t = 0; t <= nthreads; t++) l->rbeg[t] = 0;
+        for (int t = 0; t < nthreads; t++) l->n_t[t] = 0;
         l->nthreads = nthreads;
         return PFSPH_EINPUT;
     }
@@ -123,11 +128,11 @@ int pfsph_nlist_plan(pfsph_nlist *l, size_t n, int nthreads, double guess)
     return PFSPH_OK;
 }
 
-int pfsph_nlist_finish(pfsph_nlist *l, int overflow, const pfsph_grid *g, const pfsph_real *x, const pfsph_real *y,
-                       const pfsph_real *z, size_t n, pfsph_real r2, const pfsph_kernel *k)
+int pfsph_nlist_finish(pfsph_nlist *l, int overflow, const pfsph_nlist_sets *S)
 {
+    const size_t n = S->n;
     if (overflow) {
-        int rc = pfsph_nlist_fill(l, g, x, y, z, n, r2, k);
+        int rc = pfsph_nlist_fill(l, S);
         for (int t = 0; t < l->nthreads && rc == PFSPH_OK; t++) { /* the next plan's sizes */
             const size_t i0 = n * (size_t)t / (size_t)l->nthreads, i1 = n * (size_t)(t + 1) / (size_t)l->nthreads;
             l->used[t] = l->start[i1] - l->start[i0];

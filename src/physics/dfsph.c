@@ -59,10 +59,8 @@ static void destroy(void *state) { free(state); }
  * B_i = sum_b V_b grad W_ib (bx, by, bz) and C_i = sum_b V_b v_b . grad W_ib (bc). */
 static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph_real *const bsum[4])
 {
-    const pfsph_kernel *k = &ctx->kern;
-    const pfsph_real h2 = k->h * k->h;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
-    const pfsph_nlist *nl = ctx->nlist;
+    const pfsph_nlist *nl = ctx->nlist, *bl = ctx->nlist_b;
     const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
     const double few = 0.6 * D->full;
     const size_t n = f->n;
@@ -82,27 +80,21 @@ static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph
             s2 += (ax * ax + ay * ay + az * az) / (double)ctx->mass[f->phase[j]];
         }
         pfsph_real bx = 0, by = 0, bz = 0, bc = 0;
-        if (b->n) {
-            pfsph_ranges r;
-            pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-            for (int q = 0; q < r.n; q++)
-                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                    pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                    if (r2 >= h2) continue;
-                    const pfsph_real dw = pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
-                    double w = (double)(b->aux[j] * inv_v0) * dw;
-                    gx += w * dx;
-                    gy += w * dy;
-                    gz += w * dz;
-                    nn++;
-                    /* the order and rounding of pressure.c's wall term, so that a_p keeps its bits */
-                    pfsph_real sb = b->aux[j] * dw;
-                    bx += sb * dx;
-                    by += sb * dy;
-                    bz += sb * dz;
-                    bc += sb * (b->vx[j] * dx + b->vy[j] * dy + b->vz[j] * dz);
-                }
+        for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
+            const uint32_t j = bl->idx[e];
+            pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
+            const pfsph_real dw = bl->dw[e];
+            double w = (double)(b->aux[j] * inv_v0) * dw;
+            gx += w * dx;
+            gy += w * dy;
+            gz += w * dz;
+            nn++;
+            /* the order and rounding of pressure.c's wall term, so that a_p keeps its bits */
+            pfsph_real sb = b->aux[j] * dw;
+            bx += sb * dx;
+            by += sb * dy;
+            bz += sb * dz;
+            bc += sb * (b->vx[j] * dx + b->vy[j] * dy + b->vz[j] * dz);
         }
         bsum[0][i] = bx;
         bsum[1][i] = by;
