@@ -1,8 +1,9 @@
 /* Divergence-free SPH (Bender & Koschier 2015, 2017) in the number-density form of PF Eq. 23:
  * a divergence solve on the velocities at the start of the step and a density solve on the
  * predicted velocities, both Jacobi iterations on a clamped pressure (p >= 0) with the DFSPH
- * factor of each particle; time steps limited by the CFL condition only (no sound speed).
- * Derivation and choices: docs/solvers.md, "DFSPH". */
+ * factor of each particle; time steps limited by the CFL condition and the non-pressure
+ * forces other than viscosity (no sound speed). The passes walk the step's neighbour lists
+ * (src/core/nlist.h). Derivation and choices: docs/solvers.md, "DFSPH". */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -294,8 +295,11 @@ static const pfsph_real *wall_pressure(void *state, const pfsph_ctx *c, pfsph_re
 }
 
 /* CFL on the flow speed, and the displacement the non-pressure forces cause in one step held
- * at a_np dt^2 <= EPS_STEP d: the Jacobi solve has to undo it within the step. No acoustic
- * limit. (This replaces the force criterion 0.25 sqrt(d / a), which it always undercuts.) */
+ * at a_np dt^2 <= EPS_STEP d: the Jacobi solve has to undo it within the step. a_np is |g| +
+ * the largest pair-force acceleration (np_cap_without_viscosity): viscosity compresses nothing
+ * systematically, and with it the 7k dam break took 1,294 steps to 3 s instead of 701
+ * (docs/solvers.md). No acoustic limit. (This replaces the force criterion 0.25 sqrt(d / a),
+ * which it always undercuts.) */
 static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, double amax, double amax_np)
 {
     (void)amax;
