@@ -11,6 +11,7 @@
 
 #include <omp.h>
 
+#include "pfsph/omp_env.h"
 #include "pfsph/grid.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
@@ -120,6 +121,7 @@ static int seed_diffuse(pfsph_sim *sim, long n, double top, pfsph_error *err)
 
 int main(int argc, char **argv)
 {
+    pfsph_omp_wait_default(argv); /* as pfsph does */
     long target = 50000, steps = 20, warmup = 3;
     int pcisph = 0, pairwise = 0, threads = 0, emit_all = 0, no_thermo = 0;
     long ndiffuse = -1;

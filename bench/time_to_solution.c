@@ -5,12 +5,23 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include <cjson/cJSON.h>
 #include <omp.h>
 
+#include "pfsph/omp_env.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
+
+/* CPU time of the process (all threads): on a shared machine it moves less than wall time */
+static double cpu_seconds(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+           1e-6 * (double)ru.ru_stime.tv_usec;
+}
 
 static void usage(void)
 {
@@ -23,6 +34,7 @@ static void usage(void)
 
 int main(int argc, char **argv)
 {
+    pfsph_omp_wait_default(argv); /* as pfsph does */
     const char *scene = "bench/dam_break_7k.json", *solver = NULL;
     double end = 0;
     int threads = 0;
@@ -70,14 +82,24 @@ int main(int argc, char **argv)
         return 2;
     }
     const double t0 = omp_get_wtime();
-    int rc = pfsph_sim_advance(sim, end, &err);
-    const double wall = omp_get_wtime() - t0;
+    const double c0 = cpu_seconds();
+    /* pfsph_sim_advance's loop, stepped here so that the solver iterations can be summed */
+    int rc = PFSPH_OK;
+    unsigned long long its = 0, div_its = 0;
+    while (rc == PFSPH_OK && pfsph_sim_time(sim) < end - 1e-12 * (end > 1 ? end : 1)) {
+        rc = pfsph_sim_step(sim, end, &err);
+        its += (unsigned long long)pfsph_sim_stats(sim)->iterations;
+        div_its += (unsigned long long)pfsph_sim_stats(sim)->div_iterations;
+    }
+    const double wall = omp_get_wtime() - t0, cpu = cpu_seconds() - c0;
     if (rc) fprintf(stderr, "%s\n", err.msg);
     const unsigned long long steps = (unsigned long long)pfsph_sim_steps(sim);
     printf("%s, %s, %zu fluid particles, %d threads: %.3f s simulated in %.2f s wall, %llu steps "
            "(mean dt %.3g s, %.2f ms per step)\n", s.name, pfsph_scene_solver_name(&s),
            pfsph_sim_ctx(sim)->fluid->n, omp_get_max_threads(), pfsph_sim_time(sim), wall, steps,
            steps ? pfsph_sim_time(sim) / (double)steps : 0, steps ? 1e3 * wall / (double)steps : 0);
+    printf("  cpu (user + sys) %.2f s; solver iterations per step: %.2f (divergence %.2f)\n", cpu,
+           steps ? (double)its / (double)steps : 0, steps ? (double)div_its / (double)steps : 0);
     const double *st = pfsph_sim_stage_seconds(sim);
     printf("  per stage [s]:");
     for (int k = 0; k < PFSPH_NSTAGES; k++)

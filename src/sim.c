@@ -17,6 +17,7 @@
 #include "pfsph/pairwise.h"
 #include "pfsph/thermostat.h"
 #include "physics/boundary.h"
+#include "core/nlist.h"
 #include "physics/density.h"
 #include "physics/eos.h"
 #include "physics/solver.h"
@@ -28,7 +29,7 @@ const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
 
 /* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
-#define SCR_MAX (SCR_COMMON + 13) /* + the solver's (at most 10) + the thermostat's 3 */
+#define SCR_MAX (SCR_COMMON + 17) /* + the solver's (at most 14) + the thermostat's 3 */
 
 /* What a stage that found a blow-up reports; the step turns it into the one message format. */
 typedef struct blowup_info {
@@ -49,6 +50,8 @@ struct pfsph_sim {
     pfsph_ctx ctx;
     pfsph_particles fluid, boundary;
     pfsph_grid grid, bgrid;
+    pfsph_nlist nlist, nlist_b; /* fluid and boundary neighbours, built each step when the
+                                 * solver asks (neighbour_lists) */
     pfsph_real *scr[SCR_MAX]; /* per-step scratch: SCR_COMMON of ours, then the solver's */
     int nscr;
     int scr_noise;            /* first of the thermostat's 3 arrays (its accelerations), or -1 */
@@ -57,7 +60,9 @@ struct pfsph_sim {
     void *solver_state;
     double sound_speed;
     double amax;            /* largest acceleration of the last step */
-    double amax_np;         /* largest non-pressure acceleration of the last step */
+    double amax_np;         /* largest non-pressure acceleration of the last step (or the solver's
+                             * bound without viscosity: np_cap_without_viscosity) */
+    double gmag;            /* |gravity| */
     double vbound;          /* speeds above this are a blow-up */
     double t_limit;         /* the step in progress never passes this time */
     size_t removed_before;  /* removed count before this step's sort */
@@ -221,7 +226,15 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
     const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
-    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort + 2 * P;
+    /* neighbour lists: a full neighbourhood within h (pi q^2 in 2D, 4/3 pi q^3 in 3D, q = h / d)
+     * and a quarter more for compression near walls and in splashes; boundary lists: half a
+     * neighbourhood for every fluid particle (a particle on a wall has about half) */
+    const double q = s->support_factor, full = s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q;
+    const double nlist = ops && ops->neighbour_lists ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) +
+                                                           pfsph_nlist_bytes_per_particle(0.5 * full, 1)
+                                                     : 0;
+    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort +
+                             2 * P + nlist;
     const double per_boundary = 2 * P + sort;
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
     const double part_bytes = (double)nf * per_fluid + (double)nb * per_boundary;
@@ -418,6 +431,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     sim->amax = g;
     sim->amax_np = g;
+    sim->gmag = g;
     size_t worst0;
     sim->stats.vmax = max_speed(&sim->fluid, &worst0);
     sim->vbound = sim->solver->speed_bound(sim->solver_state, c);
@@ -435,6 +449,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         for (size_t i = 0; i < sim->fluid.n; i++)
             a2 = fmax(a2, (double)c->ax[i] * c->ax[i] + (double)c->ay[i] * c->ay[i] + (double)c->az[i] * c->az[i]);
         sim->amax = sim->amax_np = fmax(g, sqrt(a2));
+        if (sim->solver->np_cap_without_viscosity) sim->amax_np = g + pfsph_pairwise_amax(sim->pw);
     }
     build_stages(sim);
     *out = sim;
@@ -457,6 +472,8 @@ void pfsph_sim_destroy(pfsph_sim *sim)
     pfsph_particles_free(&sim->boundary);
     pfsph_grid_free(&sim->grid);
     pfsph_grid_free(&sim->bgrid);
+    pfsph_nlist_free(&sim->nlist);
+    pfsph_nlist_free(&sim->nlist_b);
     for (int k = 0; k < SCR_MAX; k++) free(sim->scr[k]);
     free(sim);
 }
@@ -549,6 +566,7 @@ static int st_grid(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)bad;
     (void)err;
     sim->removed_before = sim->removed;
+    sim->ctx.nlist = sim->ctx.nlist_b = NULL; /* the sort reorders the particles: lists are built again after it */
     pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed);
     return PFSPH_OK;
 }
@@ -562,13 +580,25 @@ static int st_shift(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* Number density; with neighbour lists (solvers that walk the neighbours many times a step)
+ * the density's walk also counts them and the lists are filled: positions stay put until the
+ * integration. */
 static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
-    (void)err;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = &sim->fluid;
     const size_t n = f->n;
-    pfsph__number_density(c, f->x, f->y, f->z, c->nd);
+    c->nlist = c->nlist_b = NULL;
+    if (sim->solver->neighbour_lists) {
+        const double q = (double)c->h / (double)c->spacing; /* a full neighbourhood, and a quarter */
+        const double guess = 1.25 * (c->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q);
+        int rc = pfsph__number_density_list(c, c->nd, &sim->nlist, &sim->nlist_b, guess);
+        if (rc) return pfsph_fail(err, rc, "cannot build the neighbour lists (%s)", rc == PFSPH_ENOMEM ? "out of memory" : "internal error");
+        c->nlist = &sim->nlist;
+        c->nlist_b = &sim->nlist_b;
+    } else {
+        pfsph__number_density(c, f->x, f->y, f->z, c->nd);
+    }
     pfsph_real ndmax = 0;
 #pragma omp parallel for schedule(static) reduction(max : ndmax)
     for (size_t i = 0; i < n; i++) {
@@ -675,6 +705,7 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     const double dt = c->dt;
     const pfsph_real fdt = (pfsph_real)dt;
     double amax2 = 0, anp2 = 0;
+    c->nlist = c->nlist_b = NULL; /* the particles move: this step's lists no longer hold */
     pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
     int bad_ = 0;
@@ -712,7 +743,7 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
         else if (v2 > v2max) v2max = v2;
     }
     sim->amax = sqrt(amax2);
-    sim->amax_np = sqrt(anp2);
+    sim->amax_np = sim->solver->np_cap_without_viscosity ? sim->gmag + pfsph_pairwise_amax(sim->pw) : sqrt(anp2);
     sim->stats.ekin = pfsph__sum(ek, n);
     sim->stats.density_err_max = emax;
     sim->stats.dt = dt;

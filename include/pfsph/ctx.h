@@ -23,6 +23,10 @@ typedef struct pfsph_ctx {
     pfsph_particles *boundary; /* static solid particles; aux = Akinci volume [m^d] */
     pfsph_grid *grid;          /* fluid grid; cell >= max radius in use */
     pfsph_grid *bgrid;         /* boundary grid, same geometry */
+    /* Fluid neighbours within h of each fluid particle (src/core/nlist.h), built this step after
+     * the density stage when the solver asks for lists; NULL otherwise. */
+    const struct pfsph_nlist *nlist;
+    const struct pfsph_nlist *nlist_b; /* the same step's boundary neighbours within h */
     pfsph_real mass[PFSPH_MAX_PHASES];         /* particle mass per phase: rho0 * V0 */
     pfsph_real rest_density[PFSPH_MAX_PHASES];
     pfsph_real nu[PFSPH_MAX_PHASES];           /* kinematic viscosity per phase */

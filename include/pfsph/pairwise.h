@@ -38,6 +38,8 @@ void pfsph_pairwise_destroy(pfsph_pairwise *pw); /* NULL is a no-op */
  * when the filter is on and eta > 0. Grid cells must be >= k*h; fluid arrays in grid order.
  * Deterministic for any thread count. This is also the function the benchmark times. */
 void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx);
+/* The largest pair-force acceleration |F_i^int / m_i| of the last apply [m/s^2] (0 for NULL). */
+double pfsph_pairwise_amax(const pfsph_pairwise *pw);
 
 /* Particle shifting (include/pfsph/shifting.h) with the scene's "shifting" parameters, for a
  * step of ctx->dt: called right after the grid sort, before the density. No-op when off. The

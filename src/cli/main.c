@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "pfsph/omp_env.h"
 #include "pfsph/bodies.h"
 #include "pfsph/houdini.h"
 #include "pfsph/meshing.h"
@@ -645,6 +646,7 @@ static int cmd_view(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
+    pfsph_omp_wait_default(argv); /* a spin count that does not collapse under load */
     if (argc < 2) {
         fputs(USAGE, stderr);
         return 2;

@@ -1,6 +1,19 @@
 /* Number density delta_i (PF Eq. 23), fluid and boundary neighbours. */
 #include "physics/density.h"
 
+#include <omp.h>
+
+/* SSE (every x86-64 has it; the build targets x86-64-v2) for the candidate test of the one
+ * grid walk a step makes with lists; single precision only. Elsewhere: the scalar loop. */
+#if defined(__SSE2__) && !defined(PFSPH_DOUBLE) && defined(__GNUC__)
+#include <immintrin.h>
+#define PFSPH__SSE 1
+#else
+#define PFSPH__SSE 0
+#endif
+
+#include "core/nlist.h"
+
 void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
                            const pfsph_real *z, pfsph_real *nd)
 {
@@ -36,29 +49,69 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
     }
 }
 
-void pfsph__number_density_rate(const pfsph_ctx *ctx, const pfsph_real *vx, const pfsph_real *vy,
-                                const pfsph_real *vz, pfsph_real *rate)
+/* One thread's particles [i0, i1) of the one-walk build: densities (the terms of
+ * pfsph__number_density in its order: the same bits), counts, and the entries while they fit in
+ * [*pos, re) / [*bpos, bre) (fluid, boundary). */
+static void density_list_block(const pfsph_ctx *ctx, pfsph_real *nd, pfsph_nlist *l, pfsph_nlist *lb, size_t i0,
+                               size_t i1, size_t *pos_io, size_t re, size_t *bpos_io, size_t bre)
 {
-    const pfsph_kernel *k = &ctx->kern;
-    const pfsph_real h2 = k->h * k->h;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
-    const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
-    const size_t n = f->n;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
+    const pfsph_kernel *k = &ctx->kern;
+    const pfsph_real h2 = k->h * k->h, inv_v0 = (pfsph_real)1 / ctx->V0;
+    uint32_t *cnt = l->start + 1, *bcnt = lb->start + 1;
+    size_t pos = *pos_io, bpos = *bpos_io;
+    for (size_t i = i0; i < i1; i++) {
         pfsph_ranges r;
         const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-        const pfsph_real vxi = vx[i], vyi = vy[i], vzi = vz[i];
         pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+#if PFSPH__SSE
+        const __m128 X = _mm_set1_ps(xi), Y = _mm_set1_ps(yi), Z = _mm_set1_ps(zi), H2 = _mm_set1_ps(h2);
+#endif
         pfsph_real s = 0;
-        for (int q = 0; q < r.n; q++)
-            for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+        const size_t p0 = pos;
+#define PFSPH__HIT(j_, r2_)                                                                    \
+    do {                                                                                       \
+        const uint32_t jh = (j_);                                                              \
+        const pfsph_real rr = pfsph_sqrt(r2_);                                                 \
+        s += pfsph_kernel_w(k, rr);                                                            \
+        if (jh != i) {                                                                         \
+            if (pos < re) {                                                                    \
+                l->idx[pos] = jh;                                                              \
+                l->dw[pos] = pfsph_kernel_dw_r(k, rr);                                         \
+            }                                                                                  \
+            pos++;                                                                             \
+        }                                                                                      \
+    } while (0)
+        for (int q = 0; q < r.n; q++) {
+            uint32_t j = r.b[q];
+#if PFSPH__SSE
+            /* four candidates at a time: ~85 % of them lie beyond h (docs/benchmarks.md), and
+             * the scalar loop's branch on r2 < h2 mispredicts often. r2 is rounded as the
+             * scalar expression rounds it, so the hits are the same. */
+            for (; j + 4 <= r.e[q]; j += 4) {
+                const __m128 dx = _mm_sub_ps(X, _mm_loadu_ps(f->x + j));
+                const __m128 dy = _mm_sub_ps(Y, _mm_loadu_ps(f->y + j));
+                const __m128 dz = _mm_sub_ps(Z, _mm_loadu_ps(f->z + j));
+                const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+                unsigned m = (unsigned)_mm_movemask_ps(_mm_cmplt_ps(r2, H2));
+                if (!m) continue;
+                float r2s[4];
+                _mm_storeu_ps(r2s, r2);
+                for (; m; m &= m - 1) {
+                    const unsigned bit = (unsigned)__builtin_ctz(m);
+                    PFSPH__HIT(j + bit, r2s[bit]);
+                }
+            }
+#endif
+            for (; j < r.e[q]; j++) {
                 pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
                 pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 >= h2 || j == i) continue;
-                pfsph_real vd = (vxi - vx[j]) * dx + (vyi - vy[j]) * dy + (vzi - vz[j]) * dz;
-                s += vd * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                if (r2 < h2) PFSPH__HIT(j, r2);
             }
+        }
+#undef PFSPH__HIT
+        cnt[i] = (uint32_t)(pos - p0);
+        const size_t b0 = bpos;
         if (b->n) {
             pfsph_real sb = 0;
             pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
@@ -66,12 +119,54 @@ void pfsph__number_density_rate(const pfsph_ctx *ctx, const pfsph_real *vx, cons
                 for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
                     pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
                     pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                    if (r2 >= h2) continue;
-                    pfsph_real vd = (vxi - b->vx[j]) * dx + (vyi - b->vy[j]) * dy + (vzi - b->vz[j]) * dz;
-                    sb += b->aux[j] * vd * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                    if (r2 < h2) {
+                        const pfsph_real rr = pfsph_sqrt(r2);
+                        sb += b->aux[j] * pfsph_kernel_w(k, rr);
+                        if (bpos < bre) {
+                            lb->idx[bpos] = j;
+                            lb->dw[bpos] = pfsph_kernel_dw_r(k, rr);
+                        }
+                        bpos++;
+                    }
                 }
             s += sb * inv_v0;
         }
-        rate[i] = s;
+        bcnt[i] = (uint32_t)(bpos - b0);
+        nd[i] = s;
     }
+    *pos_io = pos;
+    *bpos_io = bpos;
+}
+
+int pfsph__number_density_list(const pfsph_ctx *ctx, pfsph_real *nd, pfsph_nlist *l, pfsph_nlist *lb, double guess)
+{
+    const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
+    const pfsph_real h2 = ctx->kern.h * ctx->kern.h;
+    const size_t n = f->n;
+    int T = omp_get_max_threads();
+    if (T > PFSPH_NLIST_MAX_THREADS) T = PFSPH_NLIST_MAX_THREADS;
+    /* a plan that cannot be made (the first build for T threads) leaves empty regions: the
+     * walk then only counts, and finish fills by a second walk */
+    int rc = pfsph_nlist_plan(l, n, T, guess), rcb = pfsph_nlist_plan(lb, n, T, guess / 4);
+    if (rc == PFSPH_ENOMEM || rcb == PFSPH_ENOMEM) return PFSPH_ENOMEM;
+    int over = rc != PFSPH_OK, bover = rcb != PFSPH_OK;
+#pragma omp parallel num_threads(T) reduction(| : over, bover)
+    {
+        /* the particles of this thread as the plan has them: contiguous, in order */
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
+        /* fewer threads than planned: no room (count only) */
+        const size_t rb = l->rbeg[t], re = nt == T ? l->rbeg[t + 1] : rb;
+        const size_t brb = lb->rbeg[t], bre = nt == T ? lb->rbeg[t + 1] : brb;
+        size_t pos = rb, bpos = brb;
+        density_list_block(ctx, nd, l, lb, i0, i1, &pos, re, &bpos, bre);
+        if (nt != T || pos > re) over = 1;
+        else l->used[t] = pos - rb;
+        if (nt != T || bpos > bre) bover = 1;
+        else lb->used[t] = bpos - brb;
+    }
+    const pfsph_nlist_sets S = {ctx->grid, f->x, f->y, f->z, f->x, f->y, f->z, n, 1, h2, &ctx->kern};
+    const pfsph_nlist_sets SB = {ctx->bgrid, b->x, b->y, b->z, f->x, f->y, f->z, n, 0, h2, &ctx->kern};
+    rc = pfsph_nlist_finish(l, over, &S);
+    return rc ? rc : pfsph_nlist_finish(lb, bover, &SB);
 }

@@ -9,11 +9,13 @@
 void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
                            const pfsph_real *z, pfsph_real *nd);
 
-/* Rate of change of the number density, D delta_i / Dt = sum_j (v_i - v_j) . grad W_ij +
- * (1/V0) sum_b V_b (v_i - v_b) . grad W_ib (the continuity equation in number-density form),
- * for fluid velocities (vx, vy, vz) at the current positions; boundary particles move with
- * their own velocity (bodies) or rest. [1/(m^d s)] */
-void pfsph__number_density_rate(const pfsph_ctx *ctx, const pfsph_real *vx, const pfsph_real *vy,
-                                const pfsph_real *vz, pfsph_real *rate);
+/* The same at the fluid's positions, and in the same walk each fluid particle's lists of
+ * fluid neighbours (l: j != i within h) and boundary neighbours (lb: within h), with the
+ * kernel derivatives (src/core/nlist.h, one-walk build; guess: fluid neighbours per particle
+ * for a thread that had none). Returns PFSPH_OK, PFSPH_ENOMEM, or PFSPH_EINPUT when the lists
+ * disagree with the walk (a bug). */
+struct pfsph_nlist;
+int pfsph__number_density_list(const pfsph_ctx *ctx, pfsph_real *nd, struct pfsph_nlist *l, struct pfsph_nlist *lb,
+                               double guess);
 
 #endif

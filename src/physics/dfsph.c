@@ -1,15 +1,15 @@
 /* Divergence-free SPH (Bender & Koschier 2015, 2017) in the number-density form of PF Eq. 23:
  * a divergence solve on the velocities at the start of the step and a density solve on the
  * predicted velocities, both Jacobi iterations on a clamped pressure (p >= 0) with the DFSPH
- * factor of each particle; time steps limited by the CFL condition only (no sound speed).
- * Derivation and choices: docs/solvers.md, "DFSPH". */
+ * factor of each particle; time steps limited by the CFL condition and the non-pressure
+ * forces other than viscosity (no sound speed). The passes walk the step's neighbour lists
+ * (src/core/nlist.h). Derivation and choices: docs/solvers.md, "DFSPH". */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/nlist.h"
 #include "core/reduce.h"
-#include "physics/density.h"
-#include "physics/pressure.h"
 #include "physics/solver.h"
 
 #define OMEGA 0.5
@@ -19,7 +19,10 @@
  * unsteadily (0.246 then 0.304 m/s, gas compressed 4.4 %); at 0.004: 0.309, 0.307 m/s, 1.4 %. */
 #define EPS_STEP 0.004
 
-enum { FAC, VX, VY, VZ, RATE, ERR, PV, AX, AY, AZ, NSCR };
+/* scratch: PV (the wall pressure for bodies, after the solve) doubles as PQ (p / delta^2,
+ * during the solves) */
+enum { FAC, VX, VY, VZ, RATE, ERR, PV, AX, AY, AZ, BX, BY, BZ, BC, NSCR };
+#define PQ PV
 
 typedef struct dfsph {
     double tol, div_tol, cfl, c;
@@ -51,69 +54,56 @@ static void destroy(void *state) { free(state); }
  * reaction on the neighbours) changes delta_i per dt^2 (Bender & Koschier 2017, Eq. 9 for
  * number densities). A particle with fewer than 60 % of a full neighbourhood gets factor 0 in
  * the divergence solve only, through the sign of fac (SPlisHSPlasH's 20 of 33 in 3D): its
- * velocity divergence at a free surface is not a compression. */
-static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac)
+ * velocity divergence at a free surface is not a compression.
+ * The same walk stores the boundary sums that stay fixed during the step (walls and bodies do
+ * not move until the integration), so that the solver's passes need no boundary walk:
+ * B_i = sum_b V_b grad W_ib (bx, by, bz) and C_i = sum_b V_b v_b . grad W_ib (bc). */
+static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph_real *const bsum[4])
 {
-    const pfsph_kernel *k = &ctx->kern;
-    const pfsph_real h2 = k->h * k->h;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
+    const pfsph_nlist *nl = ctx->nlist, *bl = ctx->nlist_b;
     const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
     const double few = 0.6 * D->full;
     const size_t n = f->n;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
-        pfsph_ranges r;
         const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-        pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
         double gx = 0, gy = 0, gz = 0, s2 = 0;
-        int nn = 0;
-        for (int q = 0; q < r.n; q++)
-            for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 >= h2 || j == i) continue;
-                double w = pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
-                double ax = w * dx, ay = w * dy, az = w * dz;
-                gx += ax;
-                gy += ay;
-                gz += az;
-                s2 += (ax * ax + ay * ay + az * az) / (double)ctx->mass[f->phase[j]];
-                nn++;
-            }
-        if (b->n) {
-            pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-            for (int q = 0; q < r.n; q++)
-                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                    pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                    if (r2 >= h2) continue;
-                    double w = (double)(b->aux[j] * inv_v0) * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
-                    gx += w * dx;
-                    gy += w * dy;
-                    gz += w * dz;
-                    nn++;
-                }
+        int nn = (int)(nl->start[i + 1] - nl->start[i]);
+        for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
+            const uint32_t j = nl->idx[e];
+            pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+            double w = nl->dw[e];
+            double ax = w * dx, ay = w * dy, az = w * dz;
+            gx += ax;
+            gy += ay;
+            gz += az;
+            s2 += (ax * ax + ay * ay + az * az) / (double)ctx->mass[f->phase[j]];
         }
+        pfsph_real bx = 0, by = 0, bz = 0, bc = 0;
+        for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
+            const uint32_t j = bl->idx[e];
+            pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
+            const pfsph_real dw = bl->dw[e];
+            double w = (double)(b->aux[j] * inv_v0) * dw;
+            gx += w * dx;
+            gy += w * dy;
+            gz += w * dz;
+            nn++;
+            /* the order and rounding of pressure.c's wall term, so that a_p keeps its bits */
+            pfsph_real sb = b->aux[j] * dw;
+            bx += sb * dx;
+            by += sb * dy;
+            bz += sb * dz;
+            bc += sb * (b->vx[j] * dx + b->vy[j] * dy + b->vz[j] * dz);
+        }
+        bsum[0][i] = bx;
+        bsum[1][i] = by;
+        bsum[2][i] = bz;
+        bsum[3][i] = bc;
         double A = (gx * gx + gy * gy + gz * gz) / (double)ctx->mass[f->phase[i]] + s2;
         double fi = A > 1e-30 * s2 && A > 0 ? 1.0 / A : 0.0;
         fac[i] = (pfsph_real)(nn + 1 < few ? -fi : fi);
-    }
-}
-
-/* v_out = v + dt (a_extra + a_p(p)) for the pressure-like field p (PF Eq. 4 form). */
-static void corrected_velocity(const pfsph_ctx *c, const pfsph_real *p, const pfsph_real *ex,
-                               const pfsph_real *ey, const pfsph_real *ez, pfsph_real *const a[3],
-                               pfsph_real *vx, pfsph_real *vy, pfsph_real *vz)
-{
-    const pfsph_particles *f = c->fluid;
-    const size_t n = f->n;
-    const pfsph_real dt = (pfsph_real)c->dt;
-    pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, p, a[0], a[1], a[2]);
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        vx[i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a[0][i]);
-        vy[i] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a[1][i]);
-        vz[i] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a[2][i]);
     }
 }
 
@@ -132,36 +122,103 @@ static inline double residual_of(const pfsph_ctx *c, int divergence, const pfsph
     return (double)c->nd[i] + c->dt * (double)rate[i] - (double)c->nd0;
 }
 
-/* Mean compression over one step, relative to delta0, that the residuals stand for. */
-static double residual(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
-                       pfsph_real *err)
-{
-    const size_t n = c->fluid->n;
-    const double nd0 = c->nd0;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
-        err[i] = (pfsph_real)(res > 0 ? res / nd0 : 0);
-    }
-    return n ? pfsph__sum(err, n) / (double)n : 0;
-}
-
-/* One Jacobi update of the clamped pressure p: p_i / delta_i^2 grows by omega res / (dt^2 A_i)
+/* One Jacobi update of the clamped pressure p_i: p_i / delta_i^2 grows by omega res / (dt^2 A_i)
  * (Bender & Koschier 2017, Eqs. 9, 12; the divergence residual already carries one dt). A_i
  * counts only particle i's own pressure; in a Jacobi sweep the neighbours push too, and
  * omega = 1 overshot: a 2D tank at rest diverged at step 3. omega = 0.5, as IISPH and our PCISPH
  * relax. */
-static void update(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
-                   pfsph_real *p)
+static inline pfsph_real updated(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
+                                 const pfsph_real *p, size_t i)
 {
-    const size_t n = c->fluid->n;
     const double dt2 = c->dt * c->dt;
+    double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
+    double nd = c->nd[i];
+    double pn = (double)p[i] + OMEGA * nd * nd * res * fi / dt2;
+    return (pfsph_real)(pn > 0 ? pn : 0);
+}
+
+/* With upd, first the Jacobi update of p from the last residual (rate, fac); then a = a_p(p)
+ * (PF Eq. 4 in the number-density form with the Akinci wall term, as pfsph__pressure_accel
+ * computes it, over the lists, with p_j / delta_j^2 computed once per particle into pq) and
+ * v_out = v + dt (a_extra + a). One parallel region: a barrier fewer per iteration matters on
+ * a loaded machine. */
+static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, const pfsph_real *rate,
+                               const pfsph_real *fac, pfsph_real *p, const pfsph_real *ex,
+                               const pfsph_real *ey, const pfsph_real *ez, pfsph_real *const bsum[4],
+                               pfsph_real *pq, pfsph_real *const a[3], pfsph_real *vx, pfsph_real *vy,
+                               pfsph_real *vz)
+{
+    const pfsph_particles *f = c->fluid;
+    const pfsph_nlist *nl = c->nlist;
+    const size_t n = f->n;
+    const pfsph_real dt = (pfsph_real)c->dt;
+    const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
+    const pfsph_real *nd = c->nd;
+#pragma omp parallel
+    {
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (upd) p[i] = updated(c, divergence, rate, fac, p, i);
+            pq[i] = p[i] / (nd[i] * nd[i]);
+        }
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+            const pfsph_real pi = pq[i];
+            pfsph_real ax = 0, ay = 0, az = 0;
+            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
+                const uint32_t j = nl->idx[e];
+                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                pfsph_real s = (pi + pq[j]) * nl->dw[e];
+                ax += s * dx;
+                ay += s * dy;
+                az += s * dz;
+            }
+            if (pi > 0) { /* Akinci 2012: the wall pushes with p_i alone (pressure.c) */
+                const pfsph_real wb = pi * inv_v0;
+                ax += wb * bsum[0][i];
+                ay += wb * bsum[1][i];
+                az += wb * bsum[2][i];
+            }
+            const pfsph_real inv_m = -(pfsph_real)1 / c->mass[f->phase[i]];
+            a[0][i] = inv_m * ax;
+            a[1][i] = inv_m * ay;
+            a[2][i] = inv_m * az;
+            vx[i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a[0][i]);
+            vy[i] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a[1][i]);
+            vz[i] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a[2][i]);
+        }
+    }
+}
+
+/* D delta_i / Dt for the velocities v (PF Eq. 23 differentiated): sum_j (v_i - v_j) . grad
+ * W_ij over the lists, plus the wall's (1/V0) (v_i . B_i - C_i) from the sums of factors();
+ * and err_i, the relative compression over the step that the residual stands for. */
+static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_real *vy, const pfsph_real *vz,
+                         pfsph_real *const bsum[4], pfsph_real *rate, int divergence, const pfsph_real *fac,
+                         pfsph_real *err)
+{
+    const double nd0 = c->nd0;
+    const pfsph_particles *f = c->fluid;
+    const pfsph_nlist *nl = c->nlist;
+    const size_t n = f->n;
+    const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
+        const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+        const pfsph_real vxi = vx[i], vyi = vy[i], vzi = vz[i];
+        pfsph_real s = 0;
+        for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
+            const uint32_t j = nl->idx[e];
+            pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+            pfsph_real vd = (vxi - vx[j]) * dx + (vyi - vy[j]) * dy + (vzi - vz[j]) * dz;
+            s += vd * nl->dw[e];
+        }
+        const pfsph_real sb = vxi * bsum[0][i] + vyi * bsum[1][i] + vzi * bsum[2][i] - bsum[3][i];
+        rate[i] = s + sb * inv_v0;
+        /* the compression it stands for (residual()), in the same pass */
         double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
-        double nd = c->nd[i];
-        double pn = (double)p[i] + OMEGA * nd * nd * res * fi / dt2;
-        p[i] = (pfsph_real)(pn > 0 ? pn : 0);
+        err[i] = (pfsph_real)(res > 0 ? res / nd0 : 0);
     }
 }
 
@@ -174,14 +231,15 @@ static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real
 {
     const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay,
                      *ez = divergence ? NULL : c->az;
-    int it = 0;
-    for (;;) {
-        corrected_velocity(c, p, ex, ey, ez, ap, scr[VX], scr[VY], scr[VZ]);
-        pfsph__number_density_rate(c, scr[VX], scr[VY], scr[VZ], scr[RATE]);
-        *avg = residual(c, divergence, scr[RATE], scr[FAC], scr[ERR]);
+    const size_t n = c->fluid->n;
+    pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
+    for (int it = 0;; it++) {
+        /* from the second pass on, the update of the last residual comes first */
+        corrected_velocity(c, it > 0, divergence, scr[RATE], scr[FAC], p, ex, ey, ez, bsum, scr[PQ], ap, scr[VX],
+                           scr[VY], scr[VZ]);
+        density_rate(c, scr[VX], scr[VY], scr[VZ], bsum, scr[RATE], divergence, scr[FAC], scr[ERR]);
+        *avg = n ? pfsph__sum(scr[ERR], n) / (double)n : 0;
         if (it >= max_it || (it >= min_it && *avg <= tol)) return it;
-        update(c, divergence, scr[RATE], scr[FAC], p);
-        it++;
     }
 }
 
@@ -193,7 +251,8 @@ static void pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const *scr, 
     const dfsph *D = state;
     pfsph_particles *f = c->fluid;
     const size_t n = f->n;
-    factors(D, c, scr[FAC]);
+    pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
+    factors(D, c, scr[FAC], bsum);
     out->div_iterations = 0;
     if (D->div_max_iter <= 0 || !n) return;
     pfsph_real *pv = f->aux;
@@ -236,8 +295,11 @@ static const pfsph_real *wall_pressure(void *state, const pfsph_ctx *c, pfsph_re
 }
 
 /* CFL on the flow speed, and the displacement the non-pressure forces cause in one step held
- * at a_np dt^2 <= EPS_STEP d: the Jacobi solve has to undo it within the step. No acoustic
- * limit. (This replaces the force criterion 0.25 sqrt(d / a), which it always undercuts.) */
+ * at a_np dt^2 <= EPS_STEP d: the Jacobi solve has to undo it within the step. a_np is |g| +
+ * the largest pair-force acceleration (np_cap_without_viscosity): viscosity compresses nothing
+ * systematically, and with it the 7k dam break took 1,294 steps to 3 s instead of 701
+ * (docs/solvers.md). No acoustic limit. (This replaces the force criterion 0.25 sqrt(d / a),
+ * which it always undercuts.) */
 static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, double amax, double amax_np)
 {
     (void)amax;
@@ -265,6 +327,8 @@ static const char *hint(const void *state, const pfsph_ctx *ctx)
 const pfsph_solver_ops pfsph_solver_dfsph = {
     .name = "dfsph",
     .nscratch = NSCR,
+    .neighbour_lists = 1,
+    .np_cap_without_viscosity = 1,
     .create = create,
     .destroy = destroy,
     .pre_forces = pre_forces,

@@ -18,6 +18,7 @@ struct pfsph_pairwise {
     pfsph_real *sx, *sy, *sz; /* shifting scratch */
     size_t cap;
     double shift_max; /* largest shift of the last step [m] */
+    double amax;      /* largest pair-force acceleration of the last apply [m/s^2] */
 };
 
 void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, double eps_min,
@@ -250,21 +251,27 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
 
 void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 {
-    (void)pw;
+    pw->amax = 0;
     if (!ctx->pairwise->enabled) return;
     pw_job J;
     job_init(&J, ctx);
     const size_t n = ctx->fluid->n;
     pfsph_real *ax = ctx->ax, *ay = ctx->ay, *az = ctx->az;
-#pragma omp parallel for schedule(dynamic, 256)
+    double a2max = 0; /* a max is the same for any thread count and order */
+#pragma omp parallel for schedule(dynamic, 256) reduction(max : a2max)
     for (size_t i = 0; i < n; i++) {
         double acc[3];
         particle(&J, i, acc, false, NULL, NULL, NULL);
         ax[i] += (pfsph_real)acc[0];
         ay[i] += (pfsph_real)acc[1];
         az[i] += (pfsph_real)acc[2];
+        const double a2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+        if (a2 > a2max) a2max = a2;
     }
+    pw->amax = sqrt(a2max);
 }
+
+double pfsph_pairwise_amax(const pfsph_pairwise *pw) { return pw ? pw->amax : 0; }
 
 void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T)
 {

@@ -30,6 +30,13 @@ typedef struct pfsph_solve_stats {
 typedef struct pfsph_solver_ops {
     const char *name;      /* as in the scene's solver.type */
     int nscratch;          /* per-fluid-particle scratch arrays the solver needs */
+    /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
+     * solver that walks the neighbours many times per step (memory: src/core/nlist.h). */
+    int neighbour_lists;
+    /* Non-zero: amax_np, the non-pressure acceleration dt_limit receives, leaves viscosity out:
+     * |g| + the largest pair-force acceleration (an upper bound of |g + a_pair|). Viscosity
+     * smooths velocities; it compresses nothing that the solve must undo (DFSPH, docs/solvers.md). */
+    int np_cap_without_viscosity;
     /* Solver state for the fluid of ctx; NULL state is allowed. */
     int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg,
                   pfsph_error *err);
