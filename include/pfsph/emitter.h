@@ -4,7 +4,9 @@
  * Particles enter layer by layer: the volume owed grows by rate x dt, and each whole layer owed
  * enters at the sites, already moved along the jet by the fraction of a layer still owed, so
  * that consecutive layers are one spacing apart and the emitted volume is rate x time to within
- * one layer. A site with a particle closer than 0.8 d is skipped for that layer (refused). */
+ * one layer. A site with a particle closer than 0.8 d is skipped for that layer (refused). The
+ * nozzle is a velocity inlet: particles in the slab one spacing deep in front of the opening
+ * that move out slower than the jet get the jet's velocity, so that nothing blocks it for good. */
 #ifndef PFSPH_EMITTER_H
 #define PFSPH_EMITTER_H
 
@@ -15,6 +17,7 @@ typedef struct pfsph_emitter_state {
     double debt;       /* layers owed, in [0, 1) between steps (volume owed / layer volume) */
     uint64_t emitted;  /* particles created (each took a fluid id) */
     uint64_t refused;  /* sites skipped because a particle was closer than 0.8 d */
+    uint64_t pushed;   /* particles in front of the opening given the jet's velocity (inlet) */
 } pfsph_emitter_state;
 
 /* What an emitter resolved to on the lattice (for `pfsph check` and the docs). */

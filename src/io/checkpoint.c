@@ -288,7 +288,7 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
     const int nbod = pfsph_bodies_count(B);
     const pfsph_emitters *E = pfsph_sim_emitters(sim);
     const int nem = pfsph_emitters_count(E);
-    if (nem) payload += 4 + (size_t)nem * 24; /* only with emitters: the format of other scenes is unchanged */
+    if (nem) payload += 4 + (size_t)nem * 32; /* only with emitters: the format of other scenes is unchanged */
     payload += 4;
     if (nbod) payload += 4 + (size_t)nbod * 13 * 8 + 8 + 4 * c->boundary->n;
     size_t total = HEADER_LEN + payload;
@@ -344,6 +344,7 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
             w_f64(&w, es.debt);
             w_u64(&w, es.emitted);
             w_u64(&w, es.refused);
+            w_u64(&w, es.pushed);
         }
     }
     if (w.len != total) {
@@ -632,6 +633,7 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
             est[i].debt = r_f64(&r);
             est[i].emitted = r_u64(&r);
             est[i].refused = r_u64(&r);
+            est[i].pushed = r_u64(&r);
             emitted += est[i].emitted;
         }
     }

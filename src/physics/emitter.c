@@ -204,6 +204,41 @@ static size_t gather(pfsph_emitters *em, const pfsph_particles *f, int dim, cons
     return m;
 }
 
+/* The nozzle is a velocity inlet: a particle in the slab one spacing deep in front of the
+ * opening that moves out slower than the jet is given the jet's velocity. Without it a
+ * particle standing in front of the nozzle (a pool risen to it, gas in a tube that a bubble is
+ * blown from) would block its sites for good; with it the inlet pushes the way clear, as the
+ * pressure behind a real nozzle does. Returns the particles set. */
+static size_t push_inlet(const nozzle *z, pfsph_particles *f, int dim, double d, const pfsph_real *v)
+{
+    const int a = z->p.axis;
+    const double sgn = z->p.direction[a] > 0 ? 1 : -1, vn = (double)v[a] * sgn;
+    int t[2] = {-1, -1}, nt = 0;
+    for (int k = 0; k < dim; k++)
+        if (k != a) t[nt++] = k;
+    const double half0 = z->p.shape == PFSPH_NOZZLE_DISC ? z->p.radius : 0.5 * z->p.size[0];
+    const double half1 = z->p.shape == PFSPH_NOZZLE_DISC ? z->p.radius : 0.5 * z->p.size[1];
+    const double m = 0.5 * d;
+    size_t set = 0;
+    for (size_t j = 0; j < f->n; j++) {
+        const double x[3] = {f->x[j], f->y[j], f->z[j]};
+        double along = (x[a] - z->p.center[a]) * sgn;
+        if (!(along >= 0 && along < d)) continue;
+        /* back to the exit plane along the jet, then inside the opening (half a spacing more) */
+        double u = x[t[0]] - z->p.center[t[0]] - along * z->step[t[0]] / d;
+        double w = nt == 2 ? x[t[1]] - z->p.center[t[1]] - along * z->step[t[1]] / d : 0;
+        bool in = z->p.shape == PFSPH_NOZZLE_DISC ? u * u + w * w <= (half0 + m) * (half0 + m)
+                                                  : fabs(u) <= half0 + m && (nt < 2 || fabs(w) <= half1 + m);
+        const pfsph_real *fv[3] = {f->vx, f->vy, f->vz};
+        if (!in || (double)fv[a][j] * sgn >= vn) continue;
+        f->vx[j] = v[0];
+        f->vy[j] = v[1];
+        f->vz[j] = v[2];
+        set++;
+    }
+    return set;
+}
+
 size_t pfsph_emitters_step(pfsph_emitters *em, pfsph_particles *f, const pfsph_ctx *ctx, double t0, double dt,
                            double *vmax_in)
 {
@@ -214,6 +249,10 @@ size_t pfsph_emitters_step(pfsph_emitters *em, pfsph_particles *f, const pfsph_c
     size_t added = 0;
     for (int i = 0; i < em->n; i++) {
         nozzle *z = &em->z[i];
+        const pfsph_real v[3] = {(pfsph_real)(z->info.speed * z->p.direction[0]),
+                                 (pfsph_real)(z->info.speed * z->p.direction[1]),
+                                 (pfsph_real)(z->info.speed * z->p.direction[2])};
+        if (open_for(z, t0, t0 + dt) > 0) z->st.pushed += push_inlet(z, f, dim, d, v);
         double debt = owed(z, t0, dt);
         if (debt < 1) {
             z->st.debt = debt;
@@ -229,9 +268,6 @@ size_t pfsph_emitters_step(pfsph_emitters *em, pfsph_particles *f, const pfsph_c
         }
         size_t m = gather(em, f, dim, lo, hi, EMIT_MIN_GAP * d);
         if (m == SIZE_MAX) m = 0; /* out of memory for the list: nothing blocks (rare) */
-        const pfsph_real v[3] = {(pfsph_real)(z->info.speed * z->p.direction[0]),
-                                 (pfsph_real)(z->info.speed * z->p.direction[1]),
-                                 (pfsph_real)(z->info.speed * z->p.direction[2])};
         const pfsph_real rho0 = ctx->rest_density[z->p.phase];
         for (long l = 0; l < layers; l++) {
             debt -= 1;
