@@ -221,6 +221,30 @@ int pfsph_scene_emitters_info(const pfsph_scene *s, pfsph_emitter_info *info, pf
     return PFSPH_OK;
 }
 
+double pfsph_scene_emitter_speed(const pfsph_scene *s)
+{
+    pfsph_emitter_info info[PFSPH_MAX_EMITTERS];
+    pfsph_error err;
+    if (!s->nemitters || pfsph_scene_emitters_info(s, info, &err)) return 0;
+    const double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
+    double v = 0;
+    for (int i = 0; i < s->nemitters; i++) {
+        const double *c = s->emitters[i].center;
+        double drop = 0;
+        if (g > 0)
+            for (int k = 0; k < (1 << s->dim); k++) { /* the domain's corners */
+                double dh = 0;
+                for (int a = 0; a < s->dim; a++) {
+                    double corner = (k >> a) & 1 ? s->domain_max[a] : s->domain_min[a];
+                    dh += (corner - c[a]) * s->gravity[a] / g;
+                }
+                drop = fmax(drop, dh);
+            }
+        v = fmax(v, sqrt(info[i].speed * info[i].speed + 2 * g * drop));
+    }
+    return v;
+}
+
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
                          size_t *bytes, pfsph_error *err)
 {
@@ -327,22 +351,7 @@ static void auto_sound_speed(pfsph_sim *sim)
     double H = f->n ? hi - lo + sim->ctx.spacing : 0;
     double vref = fmax(sqrt(2 * g * H), sqrt(v2));
     /* emitted fluid: its entry speed plus a fall from the nozzle to the domain's lowest corner */
-    for (int i = 0; i < pfsph_emitters_count(sim->em); i++) {
-        pfsph_emitter_info in;
-        pfsph_emitters_info(sim->em, i, &in);
-        const double *c = s->emitters[i].center;
-        double drop = 0;
-        if (g > 0)
-            for (int k = 0; k < (1 << s->dim); k++) { /* domain corners */
-                double dh = 0;
-                for (int a = 0; a < s->dim; a++) {
-                    double corner = (k >> a) & 1 ? s->domain_max[a] : s->domain_min[a];
-                    dh += (corner - c[a]) * s->gravity[a] / g;
-                }
-                drop = fmax(drop, dh);
-            }
-        vref = fmax(vref, sqrt(in.speed * in.speed + 2 * g * drop));
-    }
+    if (s->nemitters) vref = fmax(vref, pfsph_scene_emitter_speed(s));
     if (vref <= 0) vref = 1; /* no gravity, no motion: assume flows of order 1 m/s */
     sim->sound_speed = s->sound_speed > 0 ? s->sound_speed : 10 * vref;
 }

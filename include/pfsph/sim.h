@@ -111,6 +111,10 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
 /* The most particles the scene's emitters can have added by time t [s] (0 without emitters);
  * PFSPH_EINPUT (message with the JSON path) for a nozzle the lattice cannot feed. */
 int pfsph_scene_emitted_max(const pfsph_scene *s, double t, size_t *n, pfsph_error *err);
+/* The fastest emitted fluid can get: its entry speed plus a fall from the nozzle to the domain's
+ * lowest corner [m/s]; 0 without emitters. Sets the automatic sound speed and the renderer's
+ * fixed speed scale of scenes that start (nearly) empty. */
+double pfsph_scene_emitter_speed(const pfsph_scene *s);
 /* What each emitter resolves to on the lattice (s->nemitters entries: sites, speed, rate). */
 int pfsph_scene_emitters_info(const pfsph_scene *s, struct pfsph_emitter_info *info, pfsph_error *err);
 
