@@ -182,6 +182,27 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
     return PFSPH_OK;
 }
 
+/* Nozzle exit points closer than 0.4 d to a static solid are left out, as fluid block sites are
+ * (build_particles): a particle there would start half a spacing into the wall's particles. */
+typedef struct site_filter {
+    const pfsph_scene *s;
+    double d;
+} site_filter;
+
+static bool keep_site(const double x[3], void *user)
+{
+    const site_filter *f = user;
+    for (int k = 0; k < f->s->nsolids; k++)
+        if (pfsph__solid_distance(&f->s->solids[k], f->s->dim, f->d, x) < 0.4 * f->d) return false;
+    return true;
+}
+
+static int emitters_create(pfsph_emitters **em, const pfsph_scene *s, const pfsph_ctx *c, pfsph_error *err)
+{
+    site_filter sf = {s, 2 * s->particle_radius};
+    return pfsph_emitters_create(em, s->emitters, s->nemitters, c, keep_site, &sf, s->source, err);
+}
+
 /* A context with what emitters read (lattice, domain, phases), for the estimate. */
 static void emitter_ctx(const pfsph_scene *s, pfsph_ctx *c)
 {
@@ -201,7 +222,7 @@ int pfsph_scene_emitted_max(const pfsph_scene *s, double t, size_t *n, pfsph_err
     pfsph_ctx c;
     emitter_ctx(s, &c);
     pfsph_emitters *em = NULL;
-    int rc = pfsph_emitters_create(&em, s->emitters, s->nemitters, &c, s->source, err);
+    int rc = emitters_create(&em, s, &c, err);
     if (rc) return rc;
     *n = pfsph_emitters_max(em, t);
     pfsph_emitters_destroy(em);
@@ -214,7 +235,7 @@ int pfsph_scene_emitters_info(const pfsph_scene *s, pfsph_emitter_info *info, pf
     pfsph_ctx c;
     emitter_ctx(s, &c);
     pfsph_emitters *em = NULL;
-    int rc = pfsph_emitters_create(&em, s->emitters, s->nemitters, &c, s->source, err);
+    int rc = emitters_create(&em, s, &c, err);
     if (rc) return rc;
     for (int i = 0; i < s->nemitters; i++) pfsph_emitters_info(em, i, &info[i]);
     pfsph_emitters_destroy(em);
@@ -433,7 +454,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
      * can add by the scene's end, so that a step never allocates; a longer run (--end) grows
      * them geometrically (st_emit). */
     if (s->nemitters) {
-        if ((rc = pfsph_emitters_create(&sim->em, s->emitters, s->nemitters, c, s->source, err))) goto fail;
+        if ((rc = emitters_create(&sim->em, s, c, err))) goto fail;
         if ((rc = pfsph_particles_reserve(&sim->fluid, sim->fluid.n + pfsph_emitters_max(sim->em, s->end_time))))
             goto nomem;
     }

@@ -10,6 +10,8 @@
 #ifndef PFSPH_EMITTER_H
 #define PFSPH_EMITTER_H
 
+#include <stdbool.h>
+
 #include "pfsph/ctx.h"
 
 /* What a checkpoint stores of one emitter: all a resumed run needs to continue bit for bit. */
@@ -30,11 +32,16 @@ typedef struct pfsph_emitter_info {
 
 typedef struct pfsph_emitters pfsph_emitters;
 
-/* Resolve n nozzles on the lattice of ctx (dim, spacing, domain); `source` names the scene in
- * messages ("<source>: $.emitters[i]: ..."). PFSPH_EINPUT for a nozzle without a site inside the
- * domain or a rate that needs an entry speed above 1000 m/s. n = 0 gives *out = NULL. */
+/* Which exit points a nozzle may use (the simulation leaves out those within 0.4 d of a solid,
+ * as it does for fluid blocks); NULL: all. */
+typedef bool (*pfsph_site_filter)(const double x[3], void *user);
+
+/* Resolve n nozzles on the lattice of ctx (dim, spacing, domain), keeping the sites `keep`
+ * accepts; `source` names the scene in messages ("<source>: $.emitters[i]: ..."). PFSPH_EINPUT
+ * for a nozzle without a site inside the domain or a rate that needs an entry speed above
+ * 1000 m/s. n = 0 gives *out = NULL. */
 int pfsph_emitters_create(pfsph_emitters **out, const pfsph_emitter_params *p, int n, const pfsph_ctx *ctx,
-                          const char *source, pfsph_error *err);
+                          pfsph_site_filter keep, void *user, const char *source, pfsph_error *err);
 void pfsph_emitters_destroy(pfsph_emitters *em);
 int pfsph_emitters_count(const pfsph_emitters *em);
 void pfsph_emitters_info(const pfsph_emitters *em, int i, pfsph_emitter_info *info);

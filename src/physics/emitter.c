@@ -33,7 +33,7 @@ static double lat(double d, long k) { return ((double)k + 0.5) * d; }
 
 /* Sites of the opening, in lattice order (first transverse axis fastest); NULL ps: count only. */
 static size_t sample(const pfsph_emitter_params *p, int dim, double d, const double *dmin, const double *dmax,
-                     const double *stepv, double *out)
+                     const double *stepv, pfsph_site_filter keep, void *user, double *out)
 {
     int t[2] = {-1, -1}, nt = 0;
     for (int a = 0; a < dim; a++)
@@ -63,7 +63,7 @@ static size_t sample(const pfsph_emitter_params *p, int dim, double d, const dou
              * leaves it) */
             for (int c = 0; c < dim && in; c++)
                 in = x[c] >= dmin[c] && x[c] <= dmax[c] && x[c] + stepv[c] >= dmin[c] && x[c] + stepv[c] <= dmax[c];
-            if (!in) continue;
+            if (!in || (keep && !keep(x, user))) continue;
             if (out) memcpy(out + 3 * n, x, sizeof x);
             n++;
         }
@@ -71,7 +71,7 @@ static size_t sample(const pfsph_emitter_params *p, int dim, double d, const dou
 }
 
 int pfsph_emitters_create(pfsph_emitters **out, const pfsph_emitter_params *p, int n, const pfsph_ctx *ctx,
-                          const char *source, pfsph_error *err)
+                          pfsph_site_filter keep, void *user, const char *source, pfsph_error *err)
 {
     *out = NULL;
     if (n <= 0) return PFSPH_OK;
@@ -87,11 +87,12 @@ int pfsph_emitters_create(pfsph_emitters **out, const pfsph_emitter_params *p, i
         z->p = p[i];
         const double dn = fabs(z->p.direction[z->p.axis]);
         for (int a = 0; a < 3; a++) z->step[a] = d * z->p.direction[a] / dn;
-        size_t ns = sample(&z->p, ctx->dim, d, ctx->domain_min, ctx->domain_max, z->step, NULL);
+        size_t ns = sample(&z->p, ctx->dim, d, ctx->domain_min, ctx->domain_max, z->step, keep, user, NULL);
         if (!ns) {
             pfsph_emitters_destroy(em);
             return pfsph_fail(err, PFSPH_EINPUT, "%s: $.emitters[%d]: the nozzle holds no lattice site inside the "
-                              "domain (sites lie at (k + 1/2) d, d = %g m; widen the opening or move it)", source, i,
+                              "domain and at least 0.4 d from the solids (sites lie at (k + 1/2) d, d = %g m; widen "
+                              "the opening or move it)", source, i,
                               d);
         }
         z->site = malloc(3 * ns * sizeof(double));
@@ -99,7 +100,7 @@ int pfsph_emitters_create(pfsph_emitters **out, const pfsph_emitter_params *p, i
             pfsph_emitters_destroy(em);
             return pfsph_fail(err, PFSPH_ENOMEM, "emitters: out of memory");
         }
-        sample(&z->p, ctx->dim, d, ctx->domain_min, ctx->domain_max, z->step, z->site);
+        sample(&z->p, ctx->dim, d, ctx->domain_min, ctx->domain_max, z->step, keep, user, z->site);
         z->info.sites = ns;
         const double layer_v = (double)ns * V0;
         /* the rate is exact on the lattice: a layer of ns sites every d of normal travel */
@@ -204,8 +205,9 @@ static size_t gather(pfsph_emitters *em, const pfsph_particles *f, int dim, cons
     return m;
 }
 
-/* The nozzle is a velocity inlet: a particle in the slab one spacing deep in front of the
- * opening that moves out slower than the jet is given the jet's velocity. Without it a
+/* The nozzle is a velocity inlet: a particle in the slab from half a spacing behind the exit
+ * plane to one spacing in front of it, over the opening, that moves out slower than the jet is
+ * given the jet's velocity. Without it a
  * particle standing in front of the nozzle (a pool risen to it, gas in a tube that a bubble is
  * blown from) would block its sites for good; with it the inlet pushes the way clear, as the
  * pressure behind a real nozzle does. Returns the particles set. */
@@ -223,7 +225,7 @@ static size_t push_inlet(const nozzle *z, pfsph_particles *f, int dim, double d,
     for (size_t j = 0; j < f->n; j++) {
         const double x[3] = {f->x[j], f->y[j], f->z[j]};
         double along = (x[a] - z->p.center[a]) * sgn;
-        if (!(along >= 0 && along < d)) continue;
+        if (!(along >= -0.5 * d && along < d)) continue;
         /* back to the exit plane along the jet, then inside the opening (half a spacing more) */
         double u = x[t[0]] - z->p.center[t[0]] - along * z->step[t[0]] / d;
         double w = nt == 2 ? x[t[1]] - z->p.center[t[1]] - along * z->step[t[1]] / d : 0;

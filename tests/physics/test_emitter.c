@@ -196,6 +196,54 @@ static void test_entry_spacing(void **st)
     pfsph_sim_destroy(sim);
 }
 
+/* Gas blown into water through a nozzle in the floor of a tank (the way a bubble is blown):
+ * the inlet pushes the water in front of the nozzle away, so that the gas (a phase with pair
+ * forces) gets in; the run stays stable and the gas stays in the tank. */
+static const char *BLOW_2D =
+    "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
+    " \"domain\": {\"min\": [-0.05, -0.05], \"max\": [0.25, 0.35]},"
+    " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 0.4, \"fps\": 25, \"dt_max\": 0.002},"
+    " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": 0.002},"
+    "              {\"name\": \"gas\", \"kind\": \"gas\", \"rest_density\": 100, \"viscosity\": 0.002},"
+    "              {\"name\": \"wall\", \"kind\": \"solid\"}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.2, 0.16], \"phase\": \"water\"}],"
+    " \"emitters\": [{\"phase\": \"gas\", \"center\": [0.1, 0.0045], \"width\": 0.04, \"direction\": [0, 1],"
+    "                 \"speed\": 0.3, \"stop\": 0.2}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.2, 0.3], \"layers\": 3,"
+    "              \"open_top\": true, \"phase\": \"wall\"}],"
+    " \"pairwise\": {\"k\": 1.7, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 2},"
+    "   {\"phases\": [\"gas\", \"gas\"], \"c\": 20}, {\"phases\": [\"water\", \"wall\"], \"contact_angle\": 90}]}}";
+
+static void test_blow_gas(void **st)
+{
+    (void)st;
+    pfsph_sim *sim = make(BLOW_2D, "blow-2d");
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    advance(sim, 0.4);
+    pfsph_emitter_state es;
+    pfsph_emitter_info in;
+    pfsph_emitters_get_state(pfsph_sim_emitters(sim), 0, &es);
+    pfsph_emitters_info(pfsph_sim_emitters(sim), 0, &in);
+    const pfsph_particles *f = c->fluid;
+    size_t gas = 0;
+    double gy = 0;
+    for (size_t i = 0; i < f->n; i++)
+        if (f->phase[i] == 1) {
+            gas++;
+            gy += f->y[i];
+        }
+    const double owed = in.layer_rate * 0.2 * (double)in.sites;
+    printf("blow: %zu sites, %llu gas particles emitted of %.0f owed, %llu refused, %llu pushes by the inlet; "
+           "%zu gas in the tank, their mean height %.4f m; %zu removed\n", in.sites, (unsigned long long)es.emitted,
+           owed, (unsigned long long)es.refused, (unsigned long long)es.pushed, gas, gas ? gy / gas : 0,
+           pfsph_sim_removed(sim));
+    assert_int_equal(gas, es.emitted);
+    assert_true((double)es.emitted >= 0.75 * owed);
+    assert_true(es.pushed > 0);
+    assert_int_equal(pfsph_sim_removed(sim), 0);
+    pfsph_sim_destroy(sim);
+}
+
 static void test_threads_identical(void **st)
 {
     (void)st;
@@ -286,7 +334,8 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mass_2d),          cmocka_unit_test(test_mass_3d),
-        cmocka_unit_test(test_entry_spacing),    cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_entry_spacing),    cmocka_unit_test(test_blow_gas),
+        cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_resume),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
