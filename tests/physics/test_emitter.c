@@ -268,7 +268,8 @@ static void test_threads_identical(void **st)
 }
 
 /* Resume while the nozzle pours: frames 0..5 with a checkpoint at 5, resumed to 10, against
- * 0..10 in one go. Two emitters, one of them opening after the checkpoint. */
+ * 0..10 in one go. Two emitters, one of them opening after the checkpoint; diffuse material on
+ * (its stage sees the fluid grow). */
 static const char *RESUME_2D =
     "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
     " \"domain\": {\"min\": [-0.05, -0.05], \"max\": [0.35, 0.4]},"
@@ -280,6 +281,9 @@ static const char *RESUME_2D =
     "                 \"start\": 0.27, \"stop\": 0.35}],"
     " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.3, 0.2], \"open_top\": true,"
     "              \"layers\": 2, \"phase\": \"wall\"}],"
+    " \"diffuse\": {\"enabled\": true, \"sampling_rate\": 400, \"phi_v_min\": 0.05, \"phi_v_max\": 1,"
+    "               \"phi_e_min\": 0.1, \"phi_e_max\": 2, \"energy_mass\": 1.0,"
+    "               \"lifetime_min\": 0.5, \"lifetime_max\": 2},"
     " \"output\": {\"formats\": [\"vtp\"], \"fields\": [\"id\", \"speed\"], \"checkpoint_interval\": 5}}";
 
 static void run_dir(const pfsph_scene *s, const char *dir, double end, bool resume)
@@ -306,13 +310,14 @@ static void test_resume(void **st)
     tu_assert_same_file(full, part, "frames/fluid_00006.vtp");
     tu_assert_same_file(full, part, "frames/fluid_00008.vtp");
     tu_assert_same_file(full, part, "frames/fluid_00010.vtp");
+    tu_assert_same_file(full, part, "frames/diffuse_00010.vtp");
     tu_assert_same_file(full, part, "stats.csv");
     /* the fluid grew across the resume (stats.csv's n_fluid at frames 5 and 10) */
     char p[1100];
     snprintf(p, sizeof p, "%s/stats.csv", full);
     size_t len;
     char *csv = (char *)tu_slurp(p, &len);
-    long n5 = -1, n10 = -1;
+    long n5 = -1, n10 = -1, dif10 = -1;
     for (char *line = strtok(csv, "\n"); line; line = strtok(NULL, "\n")) {
         int fr;
         double t, dt;
@@ -320,13 +325,20 @@ static void test_resume(void **st)
         long nf;
         if (sscanf(line, "%d,%lf,%lf,%llu,%ld", &fr, &t, &dt, &steps, &nf) == 5) {
             if (fr == 5) n5 = nf;
-            if (fr == 10) n10 = nf;
+            if (fr == 10) {
+                n10 = nf;
+                long a, b, c3;
+                const char *q = line;
+                for (int k = 0; k < 11 && q; k++) q = strchr(q, ',') ? strchr(q, ',') + 1 : NULL;
+                if (q && sscanf(q, "%ld,%ld,%ld", &a, &b, &c3) == 3) dif10 = a + b + c3;
+            }
         }
     }
     free(csv);
-    printf("resume: fluid %ld at the checkpoint (frame 5), %ld at frame 10; frames 6, 8, 10 and stats.csv "
-           "identical\n", n5, n10);
+    printf("resume: fluid %ld at the checkpoint (frame 5), %ld at frame 10, %ld diffuse particles; frames 6, 8, 10 "
+           "(fluid and diffuse) and stats.csv identical\n", n5, n10, dif10);
     assert_true(n5 > 0 && n10 > n5);
+    assert_true(dif10 > 0);
 }
 
 int main(int argc, char **argv)
