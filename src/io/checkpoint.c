@@ -649,7 +649,8 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: fluid next id %u, the scene makes %u fluid "
                         "particles and its emitters made %llu", name, fluid.next_id, c->fluid->next_id,
                         (unsigned long long)emitted);
-    } else if (nem && (rc = check_emitters(pfsph_sim_emitters(sim), nem, est, st.time, name, err))) {
+    } else if (nem && check_emitters(pfsph_sim_emitters(sim), nem, est, st.time, name, err)) {
+        rc = PFSPH_EINPUT;
     } else if ((has_d != 0) != (pfsph_sim_diffuse(sim) != NULL)) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint %s diffuse particles but the scene has them %s", name,
                         has_d ? "has" : "has no", has_d ? "off" : "on");

@@ -31,7 +31,8 @@ struct pfsph_emitters {
 
 static double lat(double d, long k) { return ((double)k + 0.5) * d; }
 
-/* Sites of the opening, in lattice order (first transverse axis fastest); NULL ps: count only. */
+/* Sites of the opening, in lattice order (first transverse axis fastest), into out (3 per site;
+ * NULL: count only). */
 static size_t sample(const pfsph_emitter_params *p, int dim, double d, const double *dmin, const double *dmax,
                      const double *stepv, pfsph_site_filter keep, void *user, double *out)
 {

@@ -15,14 +15,6 @@
 
 static const char *const shape_names[] = {"disc", "rectangle", "segment", NULL}; /* enum pfsph_nozzle */
 
-static int fail_key(pfsph_jctx *ctx, const char *P, const char *key, const char *fmt, const char *what,
-                    double v)
-{
-    char kp[192];
-    snprintf(kp, sizeof kp, "%s.%s", P, key);
-    return pfsph__json_fail(ctx, kp, fmt, what, v);
-}
-
 static bool has(const cJSON *e, const char *key) { return cJSON_GetObjectItemCaseSensitive(e, key) != NULL; }
 
 static int require(const cJSON *e, const char *P, const char *key, pfsph_jctx *ctx)
@@ -39,7 +31,11 @@ static int positive(const cJSON *e, const char *P, const char *key, double hi, d
     double v = *out;
     int rc = pfsph__json_number(e, P, key, -HUGE_VAL, hi, &v, ctx);
     if (rc) return rc;
-    if (!(v > 0)) return fail_key(ctx, P, key, "%svalue %g is out of range: must be > 0", "", v);
+    if (!(v > 0)) {
+        char kp[192];
+        snprintf(kp, sizeof kp, "%s.%s", P, key);
+        return pfsph__json_fail(ctx, kp, "value %g is out of range: must be > 0", v);
+    }
     *out = v;
     return PFSPH_OK;
 }
