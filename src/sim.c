@@ -14,6 +14,7 @@
 #include "core/reduce.h"
 #include "pfsph/bodies.h"
 #include "pfsph/diffuse.h"
+#include "pfsph/emitter.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/thermostat.h"
 #include "physics/boundary.h"
@@ -69,6 +70,7 @@ struct pfsph_sim {
     pfsph_pairwise *pw;
     pfsph_diffuse *df;
     pfsph_bodies *bodies;
+    pfsph_emitters *em;     /* NULL: the scene has no emitter */
     stage stages[MAX_STAGES];
     int nstages;
     double time;
@@ -185,6 +187,90 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
     return PFSPH_OK;
 }
 
+/* Nozzle exit points closer than 0.4 d to a static solid are left out, as fluid block sites are
+ * (build_particles): a particle there would start half a spacing into the wall's particles. */
+typedef struct site_filter {
+    const pfsph_scene *s;
+    double d;
+} site_filter;
+
+static bool keep_site(const double x[3], void *user)
+{
+    const site_filter *f = user;
+    for (int k = 0; k < f->s->nsolids; k++)
+        if (pfsph__solid_distance(&f->s->solids[k], f->s->dim, f->d, x) < 0.4 * f->d) return false;
+    return true;
+}
+
+static int emitters_create(pfsph_emitters **em, const pfsph_scene *s, const pfsph_ctx *c, pfsph_error *err)
+{
+    site_filter sf = {s, 2 * s->particle_radius};
+    return pfsph_emitters_create(em, s->emitters, s->nemitters, c, keep_site, &sf, s->source, err);
+}
+
+/* A context with what emitters read (lattice, domain, phases), for the estimate. */
+static void emitter_ctx(const pfsph_scene *s, pfsph_ctx *c)
+{
+    memset(c, 0, sizeof *c);
+    double d = 2 * s->particle_radius;
+    c->dim = s->dim;
+    c->spacing = (pfsph_real)d;
+    c->V0 = (pfsph_real)(s->dim == 2 ? d * d : d * d * d);
+    pfsph_ctx_set_model(c, s);
+    for (int p = 0; p < s->nphases; p++) c->rest_density[p] = (pfsph_real)s->phases[p].rest_density;
+}
+
+int pfsph_scene_emitted_max(const pfsph_scene *s, double t, size_t *n, pfsph_error *err)
+{
+    *n = 0;
+    if (!s->nemitters) return PFSPH_OK;
+    pfsph_ctx c;
+    emitter_ctx(s, &c);
+    pfsph_emitters *em = NULL;
+    int rc = emitters_create(&em, s, &c, err);
+    if (rc) return rc;
+    *n = pfsph_emitters_max(em, t);
+    pfsph_emitters_destroy(em);
+    return PFSPH_OK;
+}
+
+int pfsph_scene_emitters_info(const pfsph_scene *s, pfsph_emitter_info *info, pfsph_error *err)
+{
+    if (!s->nemitters) return PFSPH_OK;
+    pfsph_ctx c;
+    emitter_ctx(s, &c);
+    pfsph_emitters *em = NULL;
+    int rc = emitters_create(&em, s, &c, err);
+    if (rc) return rc;
+    for (int i = 0; i < s->nemitters; i++) pfsph_emitters_info(em, i, &info[i]);
+    pfsph_emitters_destroy(em);
+    return PFSPH_OK;
+}
+
+double pfsph_scene_emitter_speed(const pfsph_scene *s)
+{
+    pfsph_emitter_info info[PFSPH_MAX_EMITTERS];
+    pfsph_error err;
+    if (!s->nemitters || pfsph_scene_emitters_info(s, info, &err)) return 0;
+    const double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
+    double v = 0;
+    for (int i = 0; i < s->nemitters; i++) {
+        const double *c = s->emitters[i].center;
+        double drop = 0;
+        if (g > 0)
+            for (int k = 0; k < (1 << s->dim); k++) { /* the domain's corners */
+                double dh = 0;
+                for (int a = 0; a < s->dim; a++) {
+                    double corner = (k >> a) & 1 ? s->domain_max[a] : s->domain_min[a];
+                    dh += (corner - c[a]) * s->gravity[a] / g;
+                }
+                drop = fmax(drop, dh);
+            }
+        v = fmax(v, sqrt(info[i].speed * info[i].speed + 2 * g * drop));
+    }
+    return v;
+}
+
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
                          size_t *bytes, pfsph_error *err)
 {
@@ -195,6 +281,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
         if (c < 0) return pfsph_fail(err, PFSPH_EINPUT, "cannot sample block %d", i);
         nf += c;
     }
+    long nf_max = nf;
     for (int i = 0; i < s->nsolids; i++) {
         long c = pfsph__sample_solid(s, &s->solids[i], d, NULL);
         if (c < 0) return pfsph_fail(err, PFSPH_EINPUT, "cannot sample solid %d", i);
@@ -211,6 +298,13 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
         pfsph_bodies_destroy(B);
         pfsph_particles_free(&tmp);
         if (rc) return rc;
+    }
+    /* emitters: the most they can have added by the scene's end (the arrays are reserved for it) */
+    if (s->nemitters) {
+        size_t ne = 0;
+        int rc = pfsph_scene_emitted_max(s, s->end_time, &ne, err);
+        if (rc) return rc;
+        nf_max += (long)ne;
     }
     pfsph_real h = (pfsph_real)(s->support_factor * d);
     int r1, r2;
@@ -237,13 +331,14 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
                              2 * P + nlist;
     const double per_boundary = 2 * P + sort;
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
-    const double part_bytes = (double)nf * per_fluid + (double)nb * per_boundary;
+    const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary;
     if (n_fluid) *n_fluid = (size_t)nf;
     if (n_boundary) *n_boundary = (size_t)nb;
     if (bytes) *bytes = part_bytes + grid_bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)(part_bytes + grid_bytes);
-    if (nf + nb > (long)UINT32_MAX)
+    if (nf_max + nb > (long)UINT32_MAX)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: the scene makes %ld particles (%ld fluid), more than the %u one run "
-                          "can index; enlarge particle_radius or shrink the fluid", s->source, nf + nb, nf, UINT32_MAX);
+                          "can index; enlarge particle_radius or shrink the fluid", s->source, nf_max + nb, nf_max,
+                          UINT32_MAX);
     /* a grid the program cannot index, or one that dwarfs the particles: the domain is to blame */
     if (cells > (double)((size_t)1 << 31) || (grid_bytes > (double)(1u << 30) && grid_bytes > 16 * part_bytes))
         return pfsph_fail(err, PFSPH_EINPUT, "%s: $.domain: the neighbour grids over the domain need %.3g cells of "
@@ -289,6 +384,8 @@ static void auto_sound_speed(pfsph_sim *sim)
     }
     double H = f->n ? hi - lo + sim->ctx.spacing : 0;
     double vref = fmax(sqrt(2 * g * H), sqrt(v2));
+    /* emitted fluid: its entry speed plus a fall from the nozzle to the domain's lowest corner */
+    if (s->nemitters) vref = fmax(vref, pfsph_scene_emitter_speed(s));
     if (vref <= 0) vref = 1; /* no gravity, no motion: assume flows of order 1 m/s */
     sim->sound_speed = s->sound_speed > 0 ? s->sound_speed : 10 * vref;
 }
@@ -366,6 +463,14 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     uint8_t solid_wall[PFSPH_MAX_SOLIDS];
     wall_models(c, s, solid_wall);
     if ((rc = build_particles(s, d, solid_wall, &sim->fluid, &sim->boundary, &sim->bodies, err))) goto fail;
+    /* Emitters: the fluid arrays (and below, the step's scratch) are reserved for the most they
+     * can add by the scene's end, so that a step never allocates; a longer run (--end) grows
+     * them geometrically (st_emit). */
+    if (s->nemitters) {
+        if ((rc = emitters_create(&sim->em, s, c, err))) goto fail;
+        if ((rc = pfsph_particles_reserve(&sim->fluid, sim->fluid.n + pfsph_emitters_max(sim->em, s->end_time))))
+            goto nomem;
+    }
     c->fluid = &sim->fluid;
     c->boundary = &sim->boundary;
 
@@ -407,7 +512,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     pfsph__boundary_volumes(&sim->boundary, &sim->bgrid, &c->kern);
     for (size_t i = 0; i < sim->boundary.n; i++)
         sim->boundary.rho[i] = (pfsph_real)s->phases[sim->boundary.phase[i]].rest_density;
-    if ((rc = alloc_scratch(sim, sim->fluid.n))) goto nomem;
+    if ((rc = alloc_scratch(sim, sim->em ? sim->fluid.cap : sim->fluid.n))) goto nomem;
 
     auto_sound_speed(sim);
     pfsph_solver_config cfg_, *cfg = &cfg_; /* the solver keeps what it needs */
@@ -468,6 +573,7 @@ void pfsph_sim_destroy(pfsph_sim *sim)
     if (sim->pw) pfsph_pairwise_destroy(sim->pw);
     if (sim->df) pfsph_diffuse_destroy(sim->df);
     pfsph_bodies_destroy(sim->bodies);
+    pfsph_emitters_destroy(sim->em);
     pfsph_particles_free(&sim->fluid);
     pfsph_particles_free(&sim->boundary);
     pfsph_grid_free(&sim->grid);
@@ -766,6 +872,31 @@ static int st_diffuse(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* New particles at the nozzles, after everything moved (emitter.c). Their entry speed counts in
+ * the next step's CFL condition through stats.vmax. */
+static int st_emit(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    pfsph_particles *f = &sim->fluid;
+    size_t due = pfsph_emitters_due(sim->em, sim->time, sim->ctx.dt);
+    if (!due) {
+        pfsph_emitters_step(sim->em, f, &sim->ctx, sim->time, sim->ctx.dt, &(double){0}); /* keeps the debt */
+        return PFSPH_OK;
+    }
+    if (f->n + due > f->cap) { /* past the reserved end time: grow by half at least */
+        size_t cap = f->cap + f->cap / 2;
+        if (cap < f->n + due) cap = f->n + due;
+        if (pfsph_particles_reserve(f, cap))
+            return pfsph_fail(err, PFSPH_ENOMEM, "out of memory growing the fluid to %zu particles", cap);
+    }
+    if (f->cap > sim->scr_cap && alloc_scratch(sim, f->cap))
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory growing the step's scratch to %zu particles", f->cap);
+    double vin = 0;
+    pfsph_emitters_step(sim->em, f, &sim->ctx, sim->time, sim->ctx.dt, &vin);
+    if (vin > sim->stats.vmax) sim->stats.vmax = vin;
+    return PFSPH_OK;
+}
+
 static int st_bodies(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     pfsph_bodies_step(sim->bodies, &sim->boundary, sim->time, sim->ctx.dt);
@@ -803,6 +934,7 @@ static void build_stages(pfsph_sim *sim)
     ADD("integrate", PFSPH_STAGE_INTEGRATE, st_integrate);
     if (sim->df) ADD("diffuse", PFSPH_STAGE_DIFFUSE, st_diffuse);
     if (sim->bodies) ADD("bodies", PFSPH_STAGE_BODIES, st_bodies);
+    if (sim->em) ADD("emit", PFSPH_STAGE_INTEGRATE, st_emit);
 #undef ADD
     sim->nstages = n;
 }
@@ -855,6 +987,19 @@ const pfsph_particles *pfsph_sim_diffuse(const pfsph_sim *sim)
     return sim->df ? pfsph_diffuse_particles(sim->df) : NULL;
 }
 double pfsph_sim_sound_speed(const pfsph_sim *sim) { return sim->sound_speed; }
+const pfsph_emitters *pfsph_sim_emitters(const pfsph_sim *sim) { return sim->em; }
+
+int pfsph_sim_restore_emitters(pfsph_sim *sim, int n, const pfsph_emitter_state *st, double t, pfsph_error *err)
+{
+    if (n != pfsph_emitters_count(sim->em))
+        return pfsph_fail(err, PFSPH_EINPUT, "restore: %d emitters, the scene has %d", n,
+                          pfsph_emitters_count(sim->em));
+    for (int i = 0; i < n; i++) {
+        int rc = pfsph_emitters_set_state(sim->em, i, &st[i], t, err);
+        if (rc) return rc;
+    }
+    return PFSPH_OK;
+}
 const pfsph_bodies *pfsph_sim_bodies(const pfsph_sim *sim) { return sim->bodies; }
 
 int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const pfsph_body_state *st,

@@ -142,4 +142,28 @@ void pfsph_diffuse_defaults(pfsph_diffuse_params *p);
 void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing,
                               int *foam_min, int *foam_max);
 
+/* ---- emitters (physics/emitter.c, include/pfsph/emitter.h; docs/emitters.md) ---- */
+
+#define PFSPH_MAX_EMITTERS 16
+
+/* Nozzle shapes: a disc or a rectangle in 3D, a segment in 2D. */
+enum pfsph_nozzle { PFSPH_NOZZLE_DISC = 0, PFSPH_NOZZLE_RECTANGLE = 1, PFSPH_NOZZLE_SEGMENT = 2 };
+
+/* A nozzle that feeds particles of one phase into the scene. Its exit plane is normal to `axis`
+ * (the largest component of `direction`) and passes through `center`; particles enter on the
+ * scene lattice's sites of that plane, layer after layer. */
+typedef struct pfsph_emitter_params {
+    int shape;           /* enum pfsph_nozzle */
+    int phase;           /* a fluid or gas phase */
+    double center[3];    /* centre of the exit plane [m] */
+    double direction[3]; /* unit vector of the entry velocity */
+    int axis;            /* 0 x, 1 y, 2 z: the exit plane's normal (from direction) */
+    double radius;       /* DISC [m] */
+    double size[2];      /* RECTANGLE: extents along the other two axes in x, y, z order [m];
+                          * SEGMENT: size[0], its length along the other axis [m] */
+    double speed;        /* entry speed along direction [m/s]; 0: from rate */
+    double rate;         /* volume rate [m^3/s, m^2/s in 2D]; 0: from speed */
+    double start, stop;  /* emits while start <= t < stop [s]; stop = INFINITY: to the end */
+} pfsph_emitter_params;
+
 #endif

@@ -166,6 +166,8 @@ typedef struct pfsph_scene {
     pfsph_solid solids[PFSPH_MAX_SOLIDS];
     int nbodies;
     pfsph_body_def bodies[PFSPH_MAX_BODIES];
+    int nemitters;                  /* nozzles that add fluid while running (docs/emitters.md) */
+    pfsph_emitter_params emitters[PFSPH_MAX_EMITTERS];
     pfsph_pairwise_params pairwise; /* see pairwise.h */
     pfsph_diffuse_params diffuse;   /* see diffuse.h */
     pfsph_output output;

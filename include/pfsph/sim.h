@@ -95,9 +95,28 @@ const struct pfsph_bodies *pfsph_sim_bodies(const pfsph_sim *sim);
 int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const struct pfsph_body_state *st,
                              const uint32_t *boundary_ids, size_t n, pfsph_error *err);
 
-/* Number of particles and bytes a scene would need, without allocating them. */
+/* Emitters (NULL when the scene has none); see emitter.h. */
+struct pfsph_emitters;
+struct pfsph_emitter_state;
+struct pfsph_emitter_info;
+const struct pfsph_emitters *pfsph_sim_emitters(const pfsph_sim *sim);
+/* Restore the emitters' states (a checkpoint's, at time t [s]), checked against the scene's. */
+int pfsph_sim_restore_emitters(pfsph_sim *sim, int n, const struct pfsph_emitter_state *st, double t,
+                               pfsph_error *err);
+
+/* Number of particles and bytes a scene would need, without allocating them. n_fluid: the
+ * fluid it starts with; bytes: with the most its emitters can add by the scene's end. */
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
                          size_t *bytes, pfsph_error *err);
+/* The most particles the scene's emitters can have added by time t [s] (0 without emitters);
+ * PFSPH_EINPUT (message with the JSON path) for a nozzle the lattice cannot feed. */
+int pfsph_scene_emitted_max(const pfsph_scene *s, double t, size_t *n, pfsph_error *err);
+/* The fastest emitted fluid can get: its entry speed plus a fall from the nozzle to the domain's
+ * lowest corner [m/s]; 0 without emitters. Sets the automatic sound speed and the renderer's
+ * fixed speed scale of scenes that start (nearly) empty. */
+double pfsph_scene_emitter_speed(const pfsph_scene *s);
+/* What each emitter resolves to on the lattice (s->nemitters entries: sites, speed, rate). */
+int pfsph_scene_emitters_info(const pfsph_scene *s, struct pfsph_emitter_info *info, pfsph_error *err);
 
 /* ---- changing the model while it runs (the live viewer's interface; docs/viewer.md) ----
  * Each takes effect at the next pfsph_sim_step, as if the scene had said so from the start;

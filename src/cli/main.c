@@ -11,6 +11,7 @@
 
 #include "pfsph/omp_env.h"
 #include "pfsph/bodies.h"
+#include "pfsph/emitter.h"
 #include "pfsph/houdini.h"
 #include "pfsph/meshing.h"
 #include "pfsph/pairwise.h"
@@ -266,10 +267,17 @@ static int check_memory(const pfsph_scene *s, int verbose)
         return exit_code(rc);
     }
     long mem = physical_memory();
+    size_t ne = 0;
+    if (s->nemitters && (rc = pfsph_scene_emitted_max(s, s->end_time, &ne, &err))) { /* estimate checked it */
+        print_error(NULL, err.msg);
+        return exit_code(rc);
+    }
     if (verbose) {
-        printf("particles: %zu fluid, %zu boundary\n", nf, nb);
+        if (ne) printf("particles: %zu fluid at the start, up to %zu with the emitters' by t = %g s, %zu boundary\n",
+                       nf, nf + ne, s->end_time, nb);
+        else printf("particles: %zu fluid, %zu boundary\n", nf, nb);
         printf("memory estimate: %.1f MiB (%.0f bytes per fluid particle)%s\n", (double)bytes / 1048576.0,
-               nf ? (double)bytes / (double)nf : 0.0, "");
+               nf + ne ? (double)bytes / (double)(nf + ne) : 0.0, ne ? ", for the most fluid" : "");
     }
     if (mem > 0 && (double)bytes > 0.8 * (double)mem) {
         fprintf(stderr, "pfsph: %s: the scene needs about %.1f GiB, more than 80%% of this machine's %.1f GiB; "
@@ -493,6 +501,23 @@ static int cmd_check(int argc, char **argv)
         pfsph_bodies_destroy(B);
         pfsph_particles_free(&tmp);
     }
+    if (s.nemitters) {
+        pfsph_error err = {0};
+        pfsph_emitter_info info[PFSPH_MAX_EMITTERS];
+        if (pfsph_scene_emitters_info(&s, info, &err) == PFSPH_OK) {
+            static const char *const shapes[] = {"disc", "rectangle", "segment"};
+            printf("emitters: %d\n", s.nemitters);
+            for (int i = 0; i < s.nemitters; i++) {
+                const pfsph_emitter_params *e = &s.emitters[i];
+                double m = info[i].rate * s.phases[e->phase].rest_density;
+                printf("  [%d] %s of %zu sites, phase \"%s\", %.4g m/s, %.4g m^%d/s (%.4g kg/s%s, %.4g layers/s), "
+                       "from %g s to ", i, shapes[e->shape], info[i].sites, s.phases[e->phase].name, info[i].speed,
+                       info[i].rate, s.dim, m, s.dim == 2 ? " per metre" : "", info[i].layer_rate, e->start);
+                if (isfinite(e->stop)) printf("%g s\n", e->stop);
+                else printf("the end\n");
+            }
+        }
+    }
     if (s.pairwise.enabled) {
         pfsph_error err = {0};
         double d = 2 * s.particle_radius;
@@ -504,8 +529,10 @@ static int cmd_check(int argc, char **argv)
         pfsph_pairwise_report(&s, stdout);
     }
     /* the verdict last, once every check has passed */
-    printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids\n", s.source, s.dim,
+    printf("%s: valid %dD scene, solver %s, %d phases, %d fluid blocks, %d solids", s.source, s.dim,
            pfsph_scene_solver_name(&s), s.nphases, s.nblocks, s.nsolids);
+    if (s.nemitters) printf(", %d emitter%s", s.nemitters, s.nemitters > 1 ? "s" : "");
+    printf("\n");
     return 0;
 }
 

@@ -4,6 +4,7 @@
 #include "pfsph/checkpoint.h"
 
 #include "pfsph/bodies.h"
+#include "pfsph/emitter.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -209,6 +210,24 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
             }
         }
     }
+    /* emitters: only when there are some, so scenes without them keep their hash */
+    if (s->nemitters) {
+        h_int(h, s->nemitters);
+        for (int i = 0; i < s->nemitters && i < PFSPH_MAX_EMITTERS; i++) {
+            const pfsph_emitter_params *e = &s->emitters[i];
+            h_int(h, e->shape);
+            h_int(h, e->phase);
+            h_vec(h, e->center, 3);
+            h_vec(h, e->direction, 3);
+            h_int(h, e->axis);
+            h_f64(h, e->radius);
+            h_vec(h, e->size, 2);
+            h_f64(h, e->speed);
+            h_f64(h, e->rate);
+            h_f64(h, e->start);
+            h_f64(h, isfinite(e->stop) ? e->stop : -1);
+        }
+    }
     return H.h;
 }
 
@@ -267,6 +286,9 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
      * the bodies' poses, but the order decides summation order: bit-exact resume) */
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     const int nbod = pfsph_bodies_count(B);
+    const pfsph_emitters *E = pfsph_sim_emitters(sim);
+    const int nem = pfsph_emitters_count(E);
+    if (nem) payload += 4 + (size_t)nem * 32; /* only with emitters: the format of other scenes is unchanged */
     payload += 4;
     if (nbod) payload += 4 + (size_t)nbod * 13 * 8 + 8 + 4 * c->boundary->n;
     size_t total = HEADER_LEN + payload;
@@ -313,6 +335,17 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
         }
         w_u64(&w, c->boundary->n);
         for (size_t j = 0; j < c->boundary->n; j++) w_u32(&w, c->boundary->id[j]);
+    }
+    if (nem) {
+        w_u32(&w, (uint32_t)nem);
+        for (int i = 0; i < nem; i++) {
+            pfsph_emitter_state es;
+            pfsph_emitters_get_state(E, i, &es);
+            w_f64(&w, es.debt);
+            w_u64(&w, es.emitted);
+            w_u64(&w, es.refused);
+            w_u64(&w, es.pushed);
+        }
     }
     if (w.len != total) {
         free(buf);
@@ -462,6 +495,19 @@ static int check_clock(const pfsph_scene *s, int32_t fr, long expect_frame, int3
     return PFSPH_OK;
 }
 
+/* The emitters' states against the scene's nozzles, before the simulation is touched. */
+static int check_emitters(const pfsph_emitters *E, int n, const pfsph_emitter_state *st, double t, const char *name,
+                          pfsph_error *err)
+{
+    for (int i = 0; i < n; i++)
+        if (pfsph_emitters_check_state(E, i, &st[i], t, err)) {
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg);
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s", name, msg);
+        }
+    return PFSPH_OK;
+}
+
 static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name, long expect_frame,
                   pfsph_checkpoint_info *info, pfsph_error *err)
 {
@@ -536,8 +582,11 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
     memset(&diff, 0, sizeof diff);
     rc = r_set(&r, &fluid, name, "fluid", err);
     if (rc) return rc;
-    /* fluid particles are never added: the ids are those the scene made */
-    if (fluid.next_id != c->fluid->next_id || st.removed > fluid.next_id) {
+    /* fluid particles are added only by emitters: the ids are those the scene made, then one per
+     * emitted particle (checked below, once the emitters' counts are read) */
+    const int nem = pfsph_emitters_count(pfsph_sim_emitters(sim));
+    if ((nem ? fluid.next_id < c->fluid->next_id : fluid.next_id != c->fluid->next_id) ||
+        st.removed > fluid.next_id) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: fluid next id %u and %zu removed, the scene "
                         "makes %u fluid particles", name, fluid.next_id, st.removed, c->fluid->next_id);
         pfsph_particles_free(&fluid);
@@ -576,6 +625,18 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
         if (!bst || !bids) r.bad = 1;
     } else if (nbod > PFSPH_MAX_BODIES)
         r.bad = 1;
+    pfsph_emitter_state est[PFSPH_MAX_EMITTERS];
+    uint64_t emitted = 0;
+    if (nem && !r.bad) {
+        if (r_u32(&r) != (uint32_t)nem) r.bad = 1;
+        for (int i = 0; i < nem && !r.bad; i++) {
+            est[i].debt = r_f64(&r);
+            est[i].emitted = r_u64(&r);
+            est[i].refused = r_u64(&r);
+            est[i].pushed = r_u64(&r);
+            emitted += est[i].emitted;
+        }
+    }
     if (r.bad || r.pos != r.len) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: payload length does not match its contents", name);
     } else if ((int)nbod != pfsph_bodies_count(pfsph_sim_bodies(sim))) {
@@ -584,12 +645,19 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
     } else if (nbod && nbp != pfsph_bodies_particle_count(pfsph_sim_bodies(sim))) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint has %u body particles, the scene makes %u (a mesh file "
                         "changed?)", name, nbp, pfsph_bodies_particle_count(pfsph_sim_bodies(sim)));
+    } else if (nem && (uint64_t)fluid.next_id != (uint64_t)c->fluid->next_id + emitted) {
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: fluid next id %u, the scene makes %u fluid "
+                        "particles and its emitters made %llu", name, fluid.next_id, c->fluid->next_id,
+                        (unsigned long long)emitted);
+    } else if (nem && check_emitters(pfsph_sim_emitters(sim), nem, est, st.time, name, err)) {
+        rc = PFSPH_EINPUT;
     } else if ((has_d != 0) != (pfsph_sim_diffuse(sim) != NULL)) {
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint %s diffuse particles but the scene has them %s", name,
                         has_d ? "has" : "has no", has_d ? "off" : "on");
     } else {
         rc = pfsph_sim_restore(sim, &st, &fluid, has_d ? &diff : NULL, created, refused, err);
         if (!rc && nbod) rc = pfsph_sim_restore_bodies(sim, (int)nbod, bst, bids, (size_t)nbid, err);
+        if (!rc && nem) rc = pfsph_sim_restore_emitters(sim, nem, est, st.time, err);
         if (rc) {
             char msg[sizeof err->msg];
             snprintf(msg, sizeof msg, "%s", err->msg);

@@ -4,6 +4,7 @@
  * frame has meshes, the liquid's (liquid_NNNNN.ply) is rasterised and shaded as water and the
  * bodies' (surfaces_NNNNN.ply) as flat-shaded solids instead of their particles. */
 #include "pfsph/render.h"
+#include "pfsph/sim.h"
 #include "pfsph/surface_mesh.h"
 
 #include <dirent.h>
@@ -994,12 +995,13 @@ static int make_video(const char *run_dir, int first, double fps, const pfsph_re
 
 /* A fixed colour scale for speed over the whole run (per-frame ranges flicker): the free-fall
  * speed sqrt(2 g H) over the fluid's height H in the first frame, the largest speed a
- * gravity-driven flow such as a dam break reaches. 0 (per-frame range) without gravity. */
+ * gravity-driven flow such as a dam break reaches, or what emitted fluid reaches when more.
+ * 0 (per-frame range) without gravity or fluid. */
 static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
 {
-    double g2 = 0;
+    double g2 = 0, ve = pfsph_scene_emitter_speed(sc);
     for (int k = 0; k < 3; k++) g2 += sc->gravity[k] * sc->gravity[k];
-    if (!(g2 > 0) || fluid->n == 0) return 0;
+    if (!(g2 > 0) || fluid->n == 0) return ve;
     double g = sqrt(g2), lo = DBL_MAX, hi = -DBL_MAX;
     for (size_t i = 0; i < fluid->n; i++) {
         double h = -(fluid->x[i] * sc->gravity[0] + fluid->y[i] * sc->gravity[1] +
@@ -1008,7 +1010,7 @@ static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
         if (h < lo) lo = h;
         if (h > hi) hi = h;
     }
-    return hi > lo ? sqrt(2 * g * (hi - lo)) : 0;
+    return fmax(ve, hi > lo ? sqrt(2 * g * (hi - lo)) : 0);
 }
 
 static int color_code(const char *s)

@@ -45,5 +45,8 @@ int pfsph__scene_parse_diffuse(const cJSON *node, const char *path, pfsph_scene 
 /* The "bodies" array (src/scene/scene_bodies.c), after solids and fluid. */
 int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s,
                               pfsph_jctx *ctx);
+/* The "emitters" array (src/scene/scene_emitters.c), after the fluid blocks and solids. */
+int pfsph__scene_parse_emitters(const cJSON *arr, const char *path, pfsph_scene *s,
+                                pfsph_jctx *ctx);
 
 #endif

@@ -612,9 +612,13 @@ static int parse_fluid(parser *p, const cJSON *root)
     pfsph_scene *s = p->s;
     const cJSON *arr;
     TRY(array_of(p, root, "$", "fluid", PFSPH_MAX_BLOCKS, &arr));
-    if (!arr || cJSON_GetArraySize(arr) == 0)
+    /* a scene that starts empty is fine when an emitter fills it */
+    const cJSON *em = get(root, "emitters");
+    if ((!arr || cJSON_GetArraySize(arr) == 0) && !(cJSON_IsArray(em) && cJSON_GetArraySize(em) > 0))
         return pfsph__json_fail(&p->ctx, "$.fluid",
-                                "a scene needs at least one fluid block (\"fluid\": [ {...} ])");
+                                "a scene needs at least one fluid block (\"fluid\": [ {...} ]) or an emitter "
+                                "(\"emitters\": [ {...} ])");
+    if (!arr) return PFSPH_OK;
     int def = -1;
     for (int i = 0; i < s->nphases; i++)
         if (s->phases[i].kind != PFSPH_PHASE_SOLID) { def = i; break; }
@@ -1009,7 +1013,7 @@ static int parse_root(parser *p, const cJSON *root)
     pfsph_scene *s = p->s;
     static const char *const keys[] = {"name", "dimension", "particle_radius", "support_factor",
                                        "gravity", "domain", "solver", "time", "seed", "threads",
-                                       "phases", "fluid", "solids", "bodies", "pairwise", "diffuse",
+                                       "phases", "fluid", "solids", "bodies", "emitters", "pairwise", "diffuse",
                                        "output", "camera", "comment", NULL};
     if (!cJSON_IsObject(root))
         return pfsph__json_fail(&p->ctx, "$", "a scene must be a JSON object { ... }");
@@ -1042,6 +1046,7 @@ static int parse_root(parser *p, const cJSON *root)
     TRY(check_blocks(p));
     const cJSON *bd = get(root, "bodies");
     if (bd) TRY(pfsph__scene_parse_bodies(bd, "$.bodies", s, &p->ctx));
+    TRY(pfsph__scene_parse_emitters(get(root, "emitters"), "$.emitters", s, &p->ctx));
     /* Sub-parsers of other modules see every phase, the default solid phase included. */
     const cJSON *pw = get(root, "pairwise");
     if (pw) {

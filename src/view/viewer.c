@@ -460,12 +460,13 @@ static void field_range(const app *A, const pfsph_particles *ps, int by, double 
     if (!(*hi > *lo)) *hi = *lo + (fabs(*lo) > 0 ? 1e-3 * fabs(*lo) : 1.0);
 }
 
-/* The renderer's fixed speed scale: free fall over the first frame's fluid height. */
+/* The renderer's fixed speed scale: free fall over the first frame's fluid height, or what
+ * emitted fluid reaches when more. */
 static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
 {
-    double g2 = 0;
+    double g2 = 0, ve = pfsph_scene_emitter_speed(sc);
     for (int k = 0; k < 3; k++) g2 += sc->gravity[k] * sc->gravity[k];
-    if (!(g2 > 0) || fluid->n == 0) return 0;
+    if (!(g2 > 0) || fluid->n == 0) return ve;
     double g = sqrt(g2), lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < fluid->n; i++) {
         double h = -(fluid->x[i] * sc->gravity[0] + fluid->y[i] * sc->gravity[1] +
@@ -474,7 +475,7 @@ static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
         lo = fmin(lo, h);
         hi = fmax(hi, h);
     }
-    return hi > lo ? sqrt(2 * g * (hi - lo)) : 0;
+    return fmax(ve, hi > lo ? sqrt(2 * g * (hi - lo)) : 0);
 }
 
 static const float DIFFUSE_COL[3][3] = {{0.98f, 0.98f, 0.98f}, {0.80f, 0.82f, 0.85f}, {0.55f, 0.78f, 0.98f}};

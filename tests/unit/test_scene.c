@@ -353,7 +353,7 @@ static void test_shipped_scenes(void **state)
             globfree(&g);
             fail_msg("%s", err.msg);
         }
-        assert_true(g_scene.nblocks >= 1);
+        assert_true(g_scene.nblocks >= 1 || g_scene.nemitters >= 1); /* a poured scene may start empty */
     }
     globfree(&g);
 }
