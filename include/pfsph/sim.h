@@ -11,7 +11,7 @@
 enum pfsph_stage {
     PFSPH_STAGE_GRID, PFSPH_STAGE_DENSITY, PFSPH_STAGE_FORCES, PFSPH_STAGE_PAIRWISE,
     PFSPH_STAGE_PRESSURE, PFSPH_STAGE_INTEGRATE, PFSPH_STAGE_DIFFUSE, PFSPH_STAGE_BODIES,
-    PFSPH_STAGE_OUTPUT,
+    PFSPH_STAGE_FILM, PFSPH_STAGE_OUTPUT,
     PFSPH_NSTAGES
 };
 extern const char *const pfsph_stage_names[PFSPH_NSTAGES];
@@ -38,6 +38,11 @@ int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err);
 /* Before the first frame of a fresh run: sort, sum densities and set the Tait (equation of state)
  * pressures, so frame 0 carries real values. */
 void pfsph_sim_prime_output(pfsph_sim *sim);
+
+/* Surface layers of the fluid as it is now (include/pfsph/surface_detect.h): out[i] in 0
+ * (interior) .. layers, fluid order; boundary particles cover; with bubbles each bubble on its
+ * own. For the frames' `surface_layer` field. Returns PFSPH_OK or PFSPH_ENOMEM. */
+int pfsph_sim_surface_layers(const pfsph_sim *sim, int layers, uint8_t *out);
 
 double pfsph_sim_time(const pfsph_sim *sim);
 uint64_t pfsph_sim_steps(const pfsph_sim *sim);

@@ -232,7 +232,7 @@ static void w_f64(wbuf *w, double v) { w_raw(w, &v, 8); }
 
 static size_t set_bytes(size_t n)
 {
-    return 8 + 4 + n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 1 + 4);
+    return 8 + 4 + n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 2 + 4);
 }
 
 static void w_set(wbuf *w, const pfsph_particles *ps)
@@ -248,6 +248,8 @@ static void w_set(wbuf *w, const pfsph_particles *ps)
         }
     }
     if (ps->n) memcpy(w->p + w->len, ps->phase, ps->n);
+    w->len += ps->n;
+    if (ps->n) memcpy(w->p + w->len, ps->bubble, ps->n);
     w->len += ps->n;
     for (size_t i = 0; i < ps->n; i++) w_u32(w, ps->id[i]);
 }
@@ -382,7 +384,7 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
     memset(ps, 0, sizeof(*ps));
     uint64_t n = r_u64(r);
     uint32_t next_id = r_u32(r);
-    const size_t per = PFSPH_NFIELDS * sizeof(pfsph_real) + 1 + 4;
+    const size_t per = PFSPH_NFIELDS * sizeof(pfsph_real) + 2 + 4;
     if (r->bad || n > (r->len - r->pos) / per)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle count %llu exceeds the file",
                           name, what, (unsigned long long)n);
@@ -398,6 +400,8 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
         }
     }
     memcpy(ps->phase, r->p + r->pos, (size_t)n);
+    r->pos += (size_t)n;
+    memcpy(ps->bubble, r->p + r->pos, (size_t)n);
     r->pos += (size_t)n;
     for (size_t i = 0; i < n; i++) ps->id[i] = r_u32(r);
     ps->n = (size_t)n;
