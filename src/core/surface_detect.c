@@ -67,26 +67,48 @@ static void peel(const pfsph_ctx *ctx, const pfsph_surface_opts *o, double radiu
             out[i] = 0;
             continue;
         }
-        /* the test point on i's sphere, where the neighbours are fewest */
-        const double px = xi + rc * s[0] / sn, py = yi + rc * s[1] / sn, pz = zi + rc * s[2] / sn;
-        bool covered = false;
-        for (int q = 0; q < rg.n && !covered; q++)
-            for (uint32_t j = rg.b[q]; j < rg.e[q]; j++) {
-                if (j == i || (grp && grp[j] != gi) || (!first && layer[j])) continue;
-                const double dx = px - f->x[j], dy = py - f->y[j], dz = pz - f->z[j];
-                if (dx * dx + dy * dy + dz * dz < rc2) {
-                    covered = true;
-                    break;
+        /* the test points on i's sphere: where the neighbours are fewest (Barecasco et al.),
+         * then a ring 30 degrees off it (ours: a particle in a one-site notch of a lattice
+         * surface has an uncovered arc of 30 degrees that the sum's direction can miss) */
+        const double u[3] = {s[0] / sn, s[1] / sn, s[2] / sn};
+        double e1[3], e2[3] = {0, 0, 0};
+        if (ctx->dim == 2) {
+            e1[0] = -u[1], e1[1] = u[0], e1[2] = 0;
+        } else { /* an orthonormal pair perpendicular to u */
+            const double t[3] = {fabs(u[0]) < 0.9 ? 1.0 : 0.0, fabs(u[0]) < 0.9 ? 0.0 : 1.0, 0};
+            e1[0] = u[1] * t[2] - u[2] * t[1], e1[1] = u[2] * t[0] - u[0] * t[2], e1[2] = u[0] * t[1] - u[1] * t[0];
+            const double l = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+            for (int a = 0; a < 3; a++) e1[a] /= l;
+            e2[0] = u[1] * e1[2] - u[2] * e1[1], e2[1] = u[2] * e1[0] - u[0] * e1[2], e2[2] = u[0] * e1[1] - u[1] * e1[0];
+        }
+        const double C = 0.86602540378443865, Sn = 0.5; /* cos, sin of 30 degrees */
+        const int npts = ctx->dim == 2 ? 3 : 5;
+        const double ring[5][2] = {{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+        bool covered = true;
+        for (int t = 0; t < npts && covered; t++) {
+            const double cu = t ? C : 1.0, se = t ? Sn : 0.0;
+            double dir[3];
+            for (int a = 0; a < 3; a++) dir[a] = cu * u[a] + se * (ring[t][0] * e1[a] + ring[t][1] * e2[a]);
+            const double px = xi + rc * dir[0], py = yi + rc * dir[1], pz = zi + rc * dir[2];
+            covered = false;
+            for (int q = 0; q < rg.n && !covered; q++)
+                for (uint32_t j = rg.b[q]; j < rg.e[q]; j++) {
+                    if (j == i || (grp && grp[j] != gi) || (!first && layer[j])) continue;
+                    const double dx = px - f->x[j], dy = py - f->y[j], dz = pz - f->z[j];
+                    if (dx * dx + dy * dy + dz * dz < rc2) {
+                        covered = true;
+                        break;
+                    }
                 }
-            }
-        for (int q = 0; q < rb.n && !covered; q++)
-            for (uint32_t j = rb.b[q]; j < rb.e[q]; j++) {
-                const double dx = px - b->x[j], dy = py - b->y[j], dz = pz - b->z[j];
-                if (dx * dx + dy * dy + dz * dz < rc2) {
-                    covered = true;
-                    break;
+            for (int q = 0; q < rb.n && !covered; q++)
+                for (uint32_t j = rb.b[q]; j < rb.e[q]; j++) {
+                    const double dx = px - b->x[j], dy = py - b->y[j], dz = pz - b->z[j];
+                    if (dx * dx + dy * dy + dz * dz < rc2) {
+                        covered = true;
+                        break;
+                    }
                 }
-            }
+        }
         out[i] = covered ? 0 : 1;
     }
 }
