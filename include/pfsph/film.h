@@ -8,6 +8,7 @@
 #ifndef PFSPH_FILM_H
 #define PFSPH_FILM_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "pfsph/ctx.h"
@@ -19,14 +20,16 @@
  * With one film phase alpha and one gas beta it is the paper's
  *   a b c_aa + (a (1 - b) + (1 - a) b) c_ab + (1 - a)(1 - b) c_bb;
  * with a = b = 0 it is c[pi][pj]: solids and ordinary fluids use the same matrix. Symmetric
- * in (i, j) when c is. */
+ * in (i, j) when c is. apart: i and j belong to two different bubbles; their gases are kept
+ * apart by the films between them, so the gas-gas term is left out (docs/film.md: without
+ * this two touching bubbles of one gas coalesce into one drop within 0.25 s). */
 static inline double pfsph_film_pair_c(const double (*c)[PFSPH_MAX_PHASES], const int *film,
-                                       int pi, double a, int pj, double b)
+                                       int pi, double a, int pj, double b, bool apart)
 {
     const int fi = a > 0 && film[pi] >= 0 ? film[pi] : pi;
     const int fj = b > 0 && film[pj] >= 0 ? film[pj] : pj;
     return a * b * c[fi][fj] + a * (1 - b) * c[fi][pj] + (1 - a) * b * c[pi][fj] +
-           (1 - a) * (1 - b) * c[pi][pj]; /* Eq. 24 */
+           (apart ? 0.0 : (1 - a) * (1 - b) * c[pi][pj]); /* Eq. 24 */
 }
 
 typedef struct pfsph_film pfsph_film;

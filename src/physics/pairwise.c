@@ -153,7 +153,7 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx)
  * d = x_j - x_i (Eq. 7). */
 static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g,
                            size_t self, pfsph_real xi, pfsph_real yi, pfsph_real zi, int pa,
-                           double ai, double acc[3], bool want_vir, double S[6], double *sw, double sx[3],
+                           double ai, int bi, double acc[3], bool want_vir, double S[6], double *sw, double sx[3],
                            double sxx[6])
 {
     pfsph_ranges rg;
@@ -170,8 +170,10 @@ static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfs
             if (J->two_phase) { /* Eq. 24 where a film particle takes part */
                 const int pb = ps->phase[j];
                 const double aj = (double)ps->film[j];
-                cf = ai > 0 || aj > 0 ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj) * J->mass[pb]
-                                      : coef[pb];
+                const int bj = ps->bubble[j];
+                const bool apart = bi && bj && bi != bj;
+                cf = ai > 0 || aj > 0 || apart ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
+                                               : coef[pb];
             } else {
                 cf = coef[ps->phase[j]];
             }
@@ -223,9 +225,10 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
     double sx[3] = {0, 0, 0}, sxx[6] = {0, 0, 0, 0, 0, 0};
     acc[0] = acc[1] = acc[2] = 0;
     const double ai = J->two_phase ? (double)f->film[i] : 0.0;
-    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, acc, want_vir, S, &sw, sx, sxx);
+    const int bi = J->two_phase ? f->bubble[i] : 0;
+    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, acc, want_vir, S, &sw, sx, sxx);
     if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0)
-        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)-1, xi, yi, zi, pa, ai, acc, want_vir, S, &sw,
+        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)-1, xi, yi, zi, pa, ai, bi, acc, want_vir, S, &sw,
                 sx, sxx);
     double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     if (J->filter) {

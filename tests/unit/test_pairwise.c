@@ -556,9 +556,9 @@ static void test_film_eq24(void **state)
                     const size_t jj = other == 2 ? 0 : j;
                     /* the formula in the header, both orders */
                     const double c_ij = pfsph_film_pair_c((const double (*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film, 1, a,
-                                                          pj, other == 0 ? b : 0);
+                                                          pj, other == 0 ? b : 0, false);
                     const double c_ji = pfsph_film_pair_c((const double (*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film, pj,
-                                                          other == 0 ? b : 0, 1, a);
+                                                          other == 0 ? b : 0, 1, a, false);
                     assert_true(fabs(c_ij - expect_c) <= 1e-12 * expect_c);
                     assert_true(c_ij == c_ji);
                     const double rr = sqrt(pow(sj->x[jj] - w.fluid.x[i], 2) + pow(sj->y[jj] - w.fluid.y[i], 2) +
