@@ -58,6 +58,9 @@ const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim);
  * (fluid->n entries). PFSPH_EINPUT without pair forces, PFSPH_ENOMEM. */
 int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out);
 /* Seconds spent per stage so far. */
+/* Process CPU time per stage slot since creation [s] (not checkpointed; for benchmarks: with
+ * one thread it is the stage's own CPU time, whatever else loads the machine). */
+const double *pfsph_sim_stage_cpu_seconds(const pfsph_sim *sim);
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);
 size_t pfsph_sim_removed(const pfsph_sim *sim);
 /* Account time spent outside the step (output) to a stage. */
