@@ -107,6 +107,13 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
         h_f64(h, b->height);
         h_int(h, b->axis);
         h_vec(h, b->velocity, 3);
+        if (b->bubble >= 0) { /* a bubble's film (docs/film.md); only then: older hashes stay */
+            const int k = b->bubble;
+            h_int(h, s->film.gas[k]);
+            h_int(h, s->film.film[s->film.gas[k]]);
+            h_f64(h, s->film.thickness[k]);
+            h_f64(h, s->film.thickness[k] > 0 ? 0.0 : s->film.volume[k]);
+        }
     }
     h_int(h, s->nsolids);
     for (int i = 0; i < s->nsolids && i < PFSPH_MAX_SOLIDS; i++) {

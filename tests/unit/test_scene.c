@@ -545,6 +545,30 @@ static const bad_case bad_cases[] = {
      "unknown key"},
     {"seed_fraction", SCENE3(",\"seed\":1.5"), "$.seed", "expected an integer"},
     {"huge_number", SCENE3(",\"support_factor\":1e999"), "$.support_factor", "not a finite number"},
+    /* bubbles in air (docs/film.md) */
+#define BUB(b) "{\"particle_radius\":0.01," DOM3 ",\"phases\":[{\"name\":\"soap\"},{\"name\":\"air\",\"kind\":\"gas\"}]," \
+               "\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"radius\":0.1,\"phase\":\"air\",\"bubble\":" b "}]}"
+    {"bubble_not_object", BUB("1"), "$.fluid[0].bubble", "expected an object"},
+    {"bubble_no_film", BUB("{\"thickness\":0.01}"), "$.fluid[0].bubble.film", "missing required key"},
+    {"bubble_film_unknown", BUB("{\"film\":\"soup\",\"thickness\":0.01}"), "$.fluid[0].bubble.film",
+     "unknown phase \"soup\""},
+    {"bubble_film_gas", BUB("{\"film\":\"air\",\"thickness\":0.01}"), "$.fluid[0].bubble.film", "a film is a liquid"},
+    {"bubble_thickness_big", BUB("{\"film\":\"soap\",\"thickness\":0.03}"), "$.fluid[0].bubble.thickness",
+     "value 0.03 is out of range [0, 0.02]"},
+    {"bubble_thickness_zero", BUB("{\"film\":\"soap\",\"thickness\":0}"), "$.fluid[0].bubble.thickness",
+     "must be above 0"},
+    {"bubble_both", BUB("{\"film\":\"soap\",\"thickness\":0.01,\"liquid_volume\":1e-5}"), "$.fluid[0].bubble",
+     "exactly one of"},
+    {"bubble_neither", BUB("{\"film\":\"soap\"}"), "$.fluid[0].bubble", "exactly one of"},
+    {"bubble_volume_neg", BUB("{\"film\":\"soap\",\"liquid_volume\":-1}"), "$.fluid[0].bubble.liquid_volume",
+     "value -1 is out of range"},
+    {"bubble_key", BUB("{\"film\":\"soap\",\"thickness\":0.01,\"thicknes\":1}"), "$.fluid[0].bubble.thicknes",
+     "unknown key"},
+    {"bubble_liquid_block",
+     "{\"particle_radius\":0.01," DOM3 ",\"phases\":[{\"name\":\"soap\"}],\"fluid\":[{\"shape\":\"sphere\","
+     "\"center\":[0.5,0.5,0.5],\"radius\":0.1,\"bubble\":{\"film\":\"soap\",\"thickness\":0.01}}]}",
+     "$.fluid[0].phase", "a bubble's block is its gas"},
+#undef BUB
 };
 #define NBAD (sizeof bad_cases / sizeof bad_cases[0])
 
