@@ -358,6 +358,34 @@ static void test_shipped_scenes(void **state)
     globfree(&g);
 }
 
+/* A bubble's liquid_volume is checked against its surface (docs/film.md) when the simulation
+ * is built: more than its surface particles hold, one particle thick, is an input error naming
+ * file, path and the largest volume; the largest itself is accepted. */
+static void test_bubble_volume_limit(void **state)
+{
+    (void)state;
+    char json[1024];
+    const char *fmt = "{\"dimension\":2,\"particle_radius\":0.01,\"domain\":{\"min\":[0,0],\"max\":[1,1]},"
+                      "\"phases\":[{\"name\":\"soap\"},{\"name\":\"air\",\"kind\":\"gas\"}],"
+                      "\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5],\"radius\":0.1,\"phase\":\"air\","
+                      "\"bubble\":{\"film\":\"soap\",\"liquid_volume\":%g}}]}";
+    pfsph_error err;
+    snprintf(json, sizeof json, fmt, 1.0);
+    assert_int_equal(parse(json, &err), PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    assert_int_equal(pfsph_sim_create(&sim, &g_scene, &err), PFSPH_EINPUT);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "dir/bad.json: $.fluid[0].bubble.liquid_volume: 1 m^2 is more than"));
+    /* the largest it names is accepted: N_s V0 */
+    const char *at = strstr(err.msg, "hold (");
+    assert_non_null(at);
+    const double vmax = atof(at + 6);
+    snprintf(json, sizeof json, fmt, 0.999 * vmax); /* %g prints it rounded */
+    assert_int_equal(parse(json, &err), PFSPH_OK);
+    assert_int_equal(pfsph_sim_create(&sim, &g_scene, &err), PFSPH_OK);
+    pfsph_sim_destroy(sim);
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Bad inputs: each must fail with code EINPUT and a message naming file, path and reason. */
 
@@ -622,6 +650,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_touching_blocks_ok),
         cmocka_unit_test(test_two_containers_keep_fluid),
         cmocka_unit_test(test_block_jitter),
+        cmocka_unit_test(test_bubble_volume_limit),
         cmocka_unit_test(test_error_leaves_scene_unchanged),
         cmocka_unit_test(test_default_scene),
         cmocka_unit_test(test_load_file),
