@@ -681,7 +681,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     size_t ckpt_bytes = 0;
     double ckpt_s = 0;
     /* The state at the last finished frame, kept in memory so that a blow-up can leave it
-     * behind as a checkpoint (41 bytes per fluid particle in single precision). */
+     * behind as a checkpoint (46 bytes per fluid particle in single precision). */
     void *good = NULL;
     size_t good_len = 0;
     int good_frame = frame0;
