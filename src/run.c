@@ -228,8 +228,10 @@ static int read_run_end(const char *dir, double *end, pfsph_error *err)
     return PFSPH_OK;
 }
 
-static int write_set(const pfsph_scene *s, const char *dir, const char *name, int frame,
-                     const pfsph_particles *ps, const char *aux, double time, pfsph_error *err)
+/* layer: the fluid's surface layers (NULL for other sets); film: bubbles' film fractions */
+static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name, int frame,
+                        const pfsph_particles *ps, const char *aux, double time, const uint8_t *layer,
+                        bool film, pfsph_error *err)
 {
     char path[PFSPH_PATH_LEN + 64];
     pfsph_io_opts o = {.dim = s->dim,
@@ -237,6 +239,8 @@ static int write_set(const pfsph_scene *s, const char *dir, const char *name, in
                        .write_speed = (s->output.fields & PFSPH_OUT_SPEED) != 0,
                        .aux_name = aux,
                        .time = time,
+                       .surface_layer = layer,
+                       .write_film = film,
                        .diffuse = !strcmp(name, "diffuse")};
     int rc;
     if (s->output.vtp) {
@@ -248,6 +252,12 @@ static int write_set(const pfsph_scene *s, const char *dir, const char *name, in
         if ((rc = pfsph_write_ply(path, ps, &o, err))) return rc;
     }
     return PFSPH_OK;
+}
+
+static int write_set(const pfsph_scene *s, const char *dir, const char *name, int frame,
+                     const pfsph_particles *ps, const char *aux, double time, pfsph_error *err)
+{
+    return write_set_ex(s, dir, name, frame, ps, aux, time, NULL, false, err);
 }
 
 /* The boundary particles with ids >= first (bodies) or below it (static solids) as one set. */
@@ -340,6 +350,13 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     double t = pfsph_sim_time(sim);
     int rc;
+    /* the outer two layers of surface particles (docs/film.md), every frame */
+    uint8_t *layer = malloc(c->fluid->n ? c->fluid->n : 1);
+    if (!layer || pfsph_sim_surface_layers(sim, 2, layer)) {
+        free(layer);
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the surface layers of frame %d", frame);
+    }
+    const bool film = s->film.nbubbles > 0;
     if (s->pairwise.enabled) {
         /* the pair-force liquid's pressure is the solver's plus the virial (Laplace's law holds
          * for that one): written as the fluid's extra field */
@@ -347,13 +364,15 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
         fl.aux = malloc((fl.n ? fl.n : 1) * sizeof(pfsph_real));
         if (!fl.aux || pfsph_sim_mechanical_pressure(sim, fl.aux)) {
             free(fl.aux);
+            free(layer);
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the mechanical pressure of frame %d", frame);
         }
-        rc = write_set(s, dir, "fluid", frame, &fl, "mechanical_pressure", t, err);
+        rc = write_set_ex(s, dir, "fluid", frame, &fl, "mechanical_pressure", t, layer, film, err);
         free(fl.aux);
     } else {
-        rc = write_set(s, dir, "fluid", frame, c->fluid, NULL, t, err);
+        rc = write_set_ex(s, dir, "fluid", frame, c->fluid, NULL, t, layer, film, err);
     }
+    free(layer);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     if (!rc && frame == 0 && c->boundary->n && s->output.write_boundary) {
         if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
@@ -662,7 +681,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     size_t ckpt_bytes = 0;
     double ckpt_s = 0;
     /* The state at the last finished frame, kept in memory so that a blow-up can leave it
-     * behind as a checkpoint (41 bytes per fluid particle in single precision). */
+     * behind as a checkpoint (46 bytes per fluid particle in single precision). */
     void *good = NULL;
     size_t good_len = 0;
     int good_frame = frame0;

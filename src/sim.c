@@ -10,11 +10,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/reduce.h"
 #include "pfsph/bodies.h"
 #include "pfsph/diffuse.h"
 #include "pfsph/emitter.h"
+#include "pfsph/film.h"
+#include "pfsph/surface_detect.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/thermostat.h"
 #include "physics/boundary.h"
@@ -26,7 +29,7 @@
 #include "scene/shapes.h"
 
 const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
-    "grid", "density", "forces", "pairwise", "pressure", "integrate", "diffuse", "bodies", "output"};
+    "grid", "density", "forces", "pairwise", "pressure", "integrate", "diffuse", "bodies", "film", "output"};
 
 /* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
@@ -69,6 +72,7 @@ struct pfsph_sim {
     size_t removed_before;  /* removed count before this step's sort */
     pfsph_pairwise *pw;
     pfsph_diffuse *df;
+    pfsph_film *film;       /* bubbles in air, or NULL */
     pfsph_bodies *bodies;
     pfsph_emitters *em;     /* NULL: the scene has no emitter */
     stage stages[MAX_STAGES];
@@ -78,12 +82,19 @@ struct pfsph_sim {
     size_t removed;
     pfsph_step_stats stats;
     double stage_s[PFSPH_NSTAGES];
+    double stage_cpu[PFSPH_NSTAGES]; /* process CPU time per slot (benchmarks on a loaded machine) */
 };
 
 /* compression (rho / rho0 - 1) that stops a run as unstable */
 #define PFSPH_DENSITY_ERROR_LIMIT 0.5
 
 static double now(void) { return omp_get_wtime(); }
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 static double max_speed(const pfsph_particles *f, size_t *worst);
 static void build_stages(pfsph_sim *sim);
 
@@ -178,6 +189,7 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
                 for (int f = 0; f < PFSPH_NFIELDS; f++) fluid->f[f][w] = fluid->f[f][j];
                 fluid->phase[w] = fluid->phase[j];
             }
+            fluid->bubble[w] = s->blocks[i].bubble >= 0 ? (uint8_t)(s->blocks[i].bubble + 1) : 0;
             fluid->id[w] = (uint32_t)w;
             w++;
         }
@@ -390,6 +402,21 @@ static void auto_sound_speed(pfsph_sim *sim)
     sim->sound_speed = s->sound_speed > 0 ? s->sound_speed : 10 * vref;
 }
 
+int pfsph_sim_surface_layers(const pfsph_sim *sim, int layers, uint8_t *out)
+{
+    const size_t n = sim->fluid.n;
+    uint8_t *work = layers > 1 ? malloc(n ? n : 1) : NULL;
+    if (layers > 1 && !work) return PFSPH_ENOMEM;
+    /* particles moved since the step's sort by at most a step's travel: one cell more each way
+     * keeps every neighbour within the radius in the ranges walked */
+    int reach = sim->grid.reach + 1;
+    pfsph_surface_opts o = {.radius = 0, .layers = layers, .group = sim->film ? sim->fluid.bubble : NULL,
+                            .boundary = true, .reach = reach > 3 ? 3 : reach};
+    pfsph_surface_detect(&sim->ctx, &o, out, work);
+    free(work);
+    return PFSPH_OK;
+}
+
 int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out)
 {
     if (!sim->pw) return PFSPH_EINPUT;
@@ -412,6 +439,7 @@ void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s)
     c->phases = s->phases;
     c->pairwise = &s->pairwise;
     c->diffuse = &s->diffuse;
+    c->film = &s->film;
 }
 
 int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err)
@@ -541,6 +569,11 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     sim->stats.vmax = max_speed(&sim->fluid, &worst0);
     sim->vbound = sim->solver->speed_bound(sim->solver_state, c);
 
+    if (s->film.nbubbles > 0 && sim->fluid.n) {
+        if (pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed)) goto nomem;
+        if ((rc = pfsph_film_create(&sim->film, c, &s->film, s->source, err))) goto fail;
+        if (pfsph_film_update(sim->film, c) < 0) goto nomem; /* frame 0 carries the film */
+    }
     if (s->pairwise.enabled && (rc = pfsph_pairwise_create(&sim->pw, c, err))) goto fail;
     if (s->diffuse.enabled && (rc = pfsph_diffuse_create(&sim->df, c, err))) goto fail;
     /* The first step's force criterion needs the accelerations the pair forces give: from |g|
@@ -572,6 +605,7 @@ void pfsph_sim_destroy(pfsph_sim *sim)
     if (sim->solver && sim->solver_state) sim->solver->destroy(sim->solver_state);
     if (sim->pw) pfsph_pairwise_destroy(sim->pw);
     if (sim->df) pfsph_diffuse_destroy(sim->df);
+    pfsph_film_destroy(sim->film);
     pfsph_bodies_destroy(sim->bodies);
     pfsph_emitters_destroy(sim->em);
     pfsph_particles_free(&sim->fluid);
@@ -683,6 +717,16 @@ static int st_shift(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)bad;
     (void)err;
     pfsph_pairwise_shift(sim->pw, &sim->ctx);
+    return PFSPH_OK;
+}
+
+/* bubbles in air: each bubble's surface layer and its film fraction (PF Section 4.2.2), on the
+ * positions this step's forces see */
+static int st_film(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
+{
+    (void)bad;
+    if (pfsph_film_update(sim->film, &sim->ctx) < 0)
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory in the film stage");
     return PFSPH_OK;
 }
 
@@ -924,6 +968,7 @@ static void build_stages(pfsph_sim *sim)
 #define ADD(nm, sl, fn) sim->stages[n++] = (stage){nm, sl, fn}
     ADD("grid", PFSPH_STAGE_GRID, st_grid);
     if (sim->pw) ADD("pairwise", PFSPH_STAGE_PAIRWISE, st_shift);
+    if (sim->film) ADD("film", PFSPH_STAGE_FILM, st_film);
     ADD("density", PFSPH_STAGE_DENSITY, st_density);
     ADD("timestep", PFSPH_STAGE_FORCES, st_timestep);
     if (sim->solver->pre_forces) ADD("divergence", PFSPH_STAGE_PRESSURE, st_divergence);
@@ -942,14 +987,16 @@ static void build_stages(pfsph_sim *sim)
 int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
 {
     sim->t_limit = t_limit;
-    double t0 = now();
+    double t0 = now(), c0 = cpu_now();
     for (int k = 0; k < sim->nstages; k++) {
         const stage *st = &sim->stages[k];
         blowup_info bad = {SIZE_MAX, "", NULL};
         int rc = st->run(sim, &bad, err);
-        double t1 = now();
+        double t1 = now(), c1 = cpu_now();
         sim->stage_s[st->slot] += t1 - t0;
+        sim->stage_cpu[st->slot] += c1 - c0;
         t0 = t1;
+        c0 = c1;
         if (rc == PFSPH_EUNSTABLE && bad.what[0]) return report_blowup(sim, st->name, &bad, err);
         if (rc) return rc;
     }
@@ -975,6 +1022,7 @@ const pfsph_ctx *pfsph_sim_ctx(const pfsph_sim *sim) { return &sim->ctx; }
 const pfsph_scene *pfsph_sim_scene(const pfsph_sim *sim) { return &sim->scene; }
 const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim) { return &sim->stats; }
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim) { return sim->stage_s; }
+const double *pfsph_sim_stage_cpu_seconds(const pfsph_sim *sim) { return sim->stage_cpu; }
 size_t pfsph_sim_removed(const pfsph_sim *sim) { return sim->removed; }
 void pfsph_sim_diffuse_counts(const pfsph_sim *sim, size_t counts[3])
 {
@@ -1084,6 +1132,11 @@ int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_par
         if (fluid->phase[i] >= s->nphases || s->phases[fluid->phase[i]].kind == PFSPH_PHASE_SOLID)
             return pfsph_fail(err, PFSPH_EINPUT, "restore: fluid particle %zu has phase %d, not a fluid phase of the scene",
                               i, fluid->phase[i]);
+    for (size_t i = 0; i < fluid->n; i++)
+        if (fluid->bubble[i] > s->film.nbubbles || !(fluid->film[i] >= 0 && fluid->film[i] <= 1) ||
+            (fluid->film[i] > 0 && !fluid->bubble[i]))
+            return pfsph_fail(err, PFSPH_EINPUT, "restore: fluid particle %zu has bubble %d and film fraction %g; the "
+                              "scene has %d bubbles", i, fluid->bubble[i], (double)fluid->film[i], s->film.nbubbles);
     if (sim->df && !diffuse)
         return pfsph_fail(err, PFSPH_EINPUT, "restore: the scene has diffuse particles on but the state has none");
     if (!sim->df && diffuse && diffuse->n)
@@ -1105,6 +1158,7 @@ int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_par
         if (fluid->n) memcpy(f->f[k], fluid->f[k], fluid->n * sizeof(pfsph_real));
     if (fluid->n) {
         memcpy(f->phase, fluid->phase, fluid->n);
+        memcpy(f->bubble, fluid->bubble, fluid->n);
         memcpy(f->id, fluid->id, fluid->n * sizeof(uint32_t));
     }
     f->n = fluid->n;

@@ -8,7 +8,7 @@
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 
-#define PFSPH_CHECKPOINT_VERSION 2u
+#define PFSPH_CHECKPOINT_VERSION 3u
 /* Checkpoints kept in RUN/checkpoints (older ones are deleted after a new one is written). */
 #define PFSPH_CHECKPOINT_KEEP 2
 

@@ -47,6 +47,7 @@ typedef struct pfsph_ctx {
     const pfsph_phase *phases;         /* nphases entries */
     const pfsph_pairwise_params *pairwise; /* resolved; pairwise->enabled may be false */
     const pfsph_diffuse_params *diffuse;
+    const pfsph_film_params *film;     /* bubbles in air; NULL or nbubbles 0: none */
     double time, dt;
     uint64_t step;
 } pfsph_ctx;

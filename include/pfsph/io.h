@@ -16,6 +16,9 @@ typedef struct pfsph_io_opts {
     bool write_speed;     /* float "speed" = |v| */
     const char *aux_name; /* name for the aux field, NULL to skip it (e.g. "volume", "lifetime") */
     double time;          /* simulated time, stored as field data / comment */
+    const uint8_t *surface_layer; /* per particle, "surface_layer" (UInt8 / uchar: 0 interior,
+                           * 1 outermost layer, 2 the next one in); NULL to skip */
+    bool write_film;      /* the film fraction of bubbles in air, "film" (docs/film.md) */
     bool diffuse;         /* a diffuse set: the class is written as "type" (0 spray, 1 foam,
                            * 2 bubble), no density or pressure (readers put "type" in phase) */
 } pfsph_io_opts;

@@ -103,6 +103,26 @@ double pfsph_pairwise_shape(double r, double R);
  * 3D: (pi/8) R^5 (U^4 - 12 U^2 + 24) / U^5; 2D: (1/3) R^4 (U^3 - 6 U - 6) / U^4; U = 3 pi / 2. */
 double pfsph_pairwise_lambda(int dim, double R);
 
+/* ---- bubbles in air: two-phase film particles (physics/film.c, include/pfsph/film.h) ---- */
+
+#define PFSPH_MAX_BUBBLES 250 /* bubble k is stored as k + 1 in the uint8 particle field */
+
+/* PF Section 4.2.2: a bubble is a droplet of a gas phase whose outermost particles (surface
+ * detection) each carry the same liquid volume fraction a of a film phase; the fraction follows
+ * the surface count so that the film's liquid volume stays V_L (docs/film.md). */
+typedef struct pfsph_film_params {
+    int nbubbles;
+    int film[PFSPH_MAX_PHASES];     /* per gas phase: its bubbles' film liquid phase, -1: none */
+    int gas[PFSPH_MAX_BUBBLES];     /* the bubble's gas phase */
+    int block[PFSPH_MAX_BUBBLES];   /* the scene block it came from (messages) */
+    double thickness[PFSPH_MAX_BUBBLES]; /* film thickness at the start [m], 0: volume given */
+    double volume[PFSPH_MAX_BUBBLES];    /* liquid volume of the film [m^dim; 2D m^2 per metre];
+                                            from the thickness: filled by the simulation */
+} pfsph_film_params;
+
+/* No bubbles; film[] = -1. */
+void pfsph_film_defaults(pfsph_film_params *p);
+
 /* ---- diffuse material (physics/diffuse.c, include/pfsph/diffuse.h) ---- */
 
 /* Diffuse particle types, stored in pfsph_particles.phase. */

@@ -13,6 +13,8 @@ enum pfsph_field {
     PFSPH_F_RHO,  /* density [kg/m^3] */
     PFSPH_F_P,    /* pressure [Pa] */
     PFSPH_F_AUX,  /* per-set extra: boundary volume [m^d] / diffuse remaining lifetime [s] */
+    PFSPH_F_FILM, /* fluid: liquid volume fraction of a bubble's film particle (PF Sec. 4.2.2,
+                   * the a, b of Eq. 24; 0 for every other particle); 0 in other sets */
     PFSPH_NFIELDS
 };
 
@@ -26,11 +28,14 @@ typedef struct pfsph_particles {
             pfsph_real *vx, *vy, *vz;
             pfsph_real *rho, *p;
             pfsph_real *aux;
+            pfsph_real *film;
         };
     };
     uint8_t *phase; /* index into the phase table (fluid/boundary) or diffuse type */
     uint8_t *wall;  /* boundary: its solid's wall model (pfsph_ctx wall tables; 0 = the
                      * default, no slip with the fluid's viscosity); 0 in other sets */
+    uint8_t *bubble; /* fluid: 0, or k + 1 for a particle of bubble k (a block with a "bubble"
+                      * key, docs/film.md); 0 in other sets */
     uint32_t *id;   /* stable id, assigned at creation, never reused within a run */
     uint32_t next_id;
 } pfsph_particles;

@@ -45,6 +45,7 @@ typedef struct pfsph_block {
     int axis;              /* CYLINDER: 0 x, 1 y, 2 z */
     double velocity[3];    /* initial velocity, m/s */
     double jitter;         /* random lattice displacement, fraction of the spacing (0: none) */
+    int bubble;            /* -1, or the bubble (index into the scene's film params) it is */
 } pfsph_block;
 
 /* Tangential friction of a solid on the fluid (Akinci 2012 wall viscosity) or none. */
@@ -170,6 +171,7 @@ typedef struct pfsph_scene {
     pfsph_emitter_params emitters[PFSPH_MAX_EMITTERS];
     pfsph_pairwise_params pairwise; /* see pairwise.h */
     pfsph_diffuse_params diffuse;   /* see diffuse.h */
+    pfsph_film_params film;         /* bubbles in air (film.h) */
     pfsph_output output;
     pfsph_camera camera;
 } pfsph_scene;

@@ -11,7 +11,7 @@
 enum pfsph_stage {
     PFSPH_STAGE_GRID, PFSPH_STAGE_DENSITY, PFSPH_STAGE_FORCES, PFSPH_STAGE_PAIRWISE,
     PFSPH_STAGE_PRESSURE, PFSPH_STAGE_INTEGRATE, PFSPH_STAGE_DIFFUSE, PFSPH_STAGE_BODIES,
-    PFSPH_STAGE_OUTPUT,
+    PFSPH_STAGE_FILM, PFSPH_STAGE_OUTPUT,
     PFSPH_NSTAGES
 };
 extern const char *const pfsph_stage_names[PFSPH_NSTAGES];
@@ -39,6 +39,11 @@ int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err);
  * pressures, so frame 0 carries real values. */
 void pfsph_sim_prime_output(pfsph_sim *sim);
 
+/* Surface layers of the fluid as it is now (include/pfsph/surface_detect.h): out[i] in 0
+ * (interior) .. layers, fluid order; boundary particles cover; with bubbles each bubble on its
+ * own. For the frames' `surface_layer` field. Returns PFSPH_OK or PFSPH_ENOMEM. */
+int pfsph_sim_surface_layers(const pfsph_sim *sim, int layers, uint8_t *out);
+
 double pfsph_sim_time(const pfsph_sim *sim);
 uint64_t pfsph_sim_steps(const pfsph_sim *sim);
 const pfsph_ctx *pfsph_sim_ctx(const pfsph_sim *sim);
@@ -53,6 +58,9 @@ const pfsph_step_stats *pfsph_sim_stats(const pfsph_sim *sim);
  * (fluid->n entries). PFSPH_EINPUT without pair forces, PFSPH_ENOMEM. */
 int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out);
 /* Seconds spent per stage so far. */
+/* Process CPU time per stage slot since creation [s] (not checkpointed; for benchmarks: with
+ * one thread it is the stage's own CPU time, whatever else loads the machine). */
+const double *pfsph_sim_stage_cpu_seconds(const pfsph_sim *sim);
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);
 size_t pfsph_sim_removed(const pfsph_sim *sim);
 /* Account time spent outside the step (output) to a stage. */

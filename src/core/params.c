@@ -83,3 +83,9 @@ void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, 
     *foam_max = p->foam_max_neighbors >= 0 ? p->foam_max_neighbors
                                            : (int)lround(2.0 / 3.0 * full);
 }
+
+void pfsph_film_defaults(pfsph_film_params *p)
+{
+    memset(p, 0, sizeof(*p));
+    for (int a = 0; a < PFSPH_MAX_PHASES; a++) p->film[a] = -1;
+}

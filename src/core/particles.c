@@ -25,6 +25,9 @@ int pfsph_particles_reserve(pfsph_particles *ps, size_t cap)
     q = grow(ps->wall, ps->cap, cap);
     if (!q) return PFSPH_ENOMEM;
     ps->wall = q;
+    q = grow(ps->bubble, ps->cap, cap);
+    if (!q) return PFSPH_ENOMEM;
+    ps->bubble = q;
     q = grow(ps->id, ps->cap * sizeof(uint32_t), cap * sizeof(uint32_t));
     if (!q) return PFSPH_ENOMEM;
     ps->id = q;
@@ -44,6 +47,7 @@ void pfsph_particles_free(pfsph_particles *ps)
     for (int k = 0; k < PFSPH_NFIELDS; k++) free(ps->f[k]);
     free(ps->phase);
     free(ps->wall);
+    free(ps->bubble);
     free(ps->id);
     memset(ps, 0, sizeof(*ps));
 }
@@ -67,6 +71,7 @@ long pfsph_particles_push(pfsph_particles *ps, const pfsph_real x[3], const pfsp
     }
     ps->phase[i] = phase;
     ps->wall[i] = 0;
+    ps->bubble[i] = 0;
     ps->id[i] = ps->next_id++;
     return (long)i;
 }
@@ -99,6 +104,8 @@ int pfsph_particles_permute(pfsph_particles *ps, const uint32_t *perm, size_t n_
     memcpy(ps->phase, tb, n_new);
     for (size_t i = 0; i < n_new; i++) tb[i] = ps->wall[perm[i]];
     memcpy(ps->wall, tb, n_new);
+    for (size_t i = 0; i < n_new; i++) tb[i] = ps->bubble[perm[i]];
+    memcpy(ps->bubble, tb, n_new);
     ps->n = n_new;
     free(own);
     return PFSPH_OK;
@@ -106,5 +113,5 @@ int pfsph_particles_permute(pfsph_particles *ps, const uint32_t *perm, size_t n_
 
 size_t pfsph_particles_bytes_per_particle(void)
 {
-    return PFSPH_NFIELDS * sizeof(pfsph_real) + 2 * sizeof(uint8_t) + sizeof(uint32_t);
+    return PFSPH_NFIELDS * sizeof(pfsph_real) + 3 * sizeof(uint8_t) + sizeof(uint32_t);
 }

@@ -108,6 +108,13 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
         h_f64(h, b->height);
         h_int(h, b->axis);
         h_vec(h, b->velocity, 3);
+        if (b->bubble >= 0) { /* a bubble's film (docs/film.md); only then: older hashes stay */
+            const int k = b->bubble;
+            h_int(h, s->film.gas[k]);
+            h_int(h, s->film.film[s->film.gas[k]]);
+            h_f64(h, s->film.thickness[k]);
+            h_f64(h, s->film.thickness[k] > 0 ? 0.0 : s->film.volume[k]);
+        }
     }
     h_int(h, s->nsolids);
     for (int i = 0; i < s->nsolids && i < PFSPH_MAX_SOLIDS; i++) {
@@ -251,7 +258,7 @@ static void w_f64(wbuf *w, double v) { w_raw(w, &v, 8); }
 
 static size_t set_bytes(size_t n)
 {
-    return 8 + 4 + n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 1 + 4);
+    return 8 + 4 + n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 2 + 4);
 }
 
 static void w_set(wbuf *w, const pfsph_particles *ps)
@@ -267,6 +274,8 @@ static void w_set(wbuf *w, const pfsph_particles *ps)
         }
     }
     if (ps->n) memcpy(w->p + w->len, ps->phase, ps->n);
+    w->len += ps->n;
+    if (ps->n) memcpy(w->p + w->len, ps->bubble, ps->n);
     w->len += ps->n;
     for (size_t i = 0; i < ps->n; i++) w_u32(w, ps->id[i]);
 }
@@ -415,7 +424,7 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
     memset(ps, 0, sizeof(*ps));
     uint64_t n = r_u64(r);
     uint32_t next_id = r_u32(r);
-    const size_t per = PFSPH_NFIELDS * sizeof(pfsph_real) + 1 + 4;
+    const size_t per = PFSPH_NFIELDS * sizeof(pfsph_real) + 2 + 4;
     if (r->bad || n > (r->len - r->pos) / per)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle count %llu exceeds the file",
                           name, what, (unsigned long long)n);
@@ -431,6 +440,8 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
         }
     }
     memcpy(ps->phase, r->p + r->pos, (size_t)n);
+    r->pos += (size_t)n;
+    memcpy(ps->bubble, r->p + r->pos, (size_t)n);
     r->pos += (size_t)n;
     for (size_t i = 0; i < n; i++) ps->id[i] = r_u32(r);
     ps->n = (size_t)n;

@@ -35,6 +35,8 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
     if (o->write_id) pfsph__enc_printf(&e, "property uint id\n");
     if (o->write_speed) pfsph__enc_printf(&e, "property %s speed\n", REAL_PLY);
     if (o->aux_name) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, o->aux_name);
+    if (o->surface_layer) pfsph__enc_printf(&e, "property uchar surface_layer\n");
+    if (o->write_film) pfsph__enc_printf(&e, "property %s film\n", REAL_PLY);
     pfsph__enc_printf(&e, "end_header\n");
     const pfsph_real zero = 0;
     const bool d2 = o->dim == 2;
@@ -57,6 +59,8 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
             pfsph__enc_put(&e, &s, rs);
         }
         if (o->aux_name) pfsph__enc_put(&e, &ps->aux[i], rs);
+        if (o->surface_layer) pfsph__enc_put(&e, &o->surface_layer[i], 1);
+        if (o->write_film) pfsph__enc_put(&e, &ps->film[i], rs);
     }
     rc = pfsph__enc_flush(&e);
     pfsph__enc_free(&e);

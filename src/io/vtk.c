@@ -11,7 +11,7 @@
 #define REAL_VTK (sizeof(pfsph_real) == 4 ? "Float32" : "Float64")
 
 /* One appended array: what the header says and how many bytes its block holds. */
-enum { A_TIME, A_VEL, A_RHO, A_P, A_PHASE, A_ID, A_SPEED, A_AUX, A_POINTS, A_CONN, A_OFFS };
+enum { A_TIME, A_VEL, A_RHO, A_P, A_PHASE, A_ID, A_SPEED, A_AUX, A_LAYER, A_FILM, A_POINTS, A_CONN, A_OFFS };
 typedef struct vtp_array {
     int kind;
     const char *name;
@@ -36,7 +36,7 @@ static void put_reals(pfsph__enc *e, const pfsph_real *a, size_t n)
 int pfsph__check_aux_name(const char *path, const char *name, pfsph_error *err)
 {
     static const char *const taken[] = {"x", "y", "z", "vx", "vy", "vz", "velocity", "density",
-                                        "pressure", "phase", "type", "id", "speed", "Points",
+                                        "pressure", "phase", "type", "id", "speed", "surface_layer", "film", "Points",
                                         "TimeValue", "connectivity", "offsets"};
     size_t len = strlen(name);
     if (len == 0 || len > 64)
@@ -72,7 +72,7 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
         if (r != PFSPH_OK) return r;
     }
 
-    vtp_array arr[12];
+    vtp_array arr[14];
     int na = 0;
     arr[na++] = (vtp_array){A_TIME, "TimeValue", "Float64", 1, 8};
     arr[na++] = (vtp_array){A_VEL, "velocity", REAL_VTK, 3, 3 * rs * n};
@@ -84,6 +84,8 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
     if (o->write_id) arr[na++] = (vtp_array){A_ID, "id", "UInt32", 1, 4 * (uint64_t)n};
     if (o->write_speed) arr[na++] = (vtp_array){A_SPEED, "speed", REAL_VTK, 1, rs * n};
     if (o->aux_name) arr[na++] = (vtp_array){A_AUX, o->aux_name, REAL_VTK, 1, rs * n};
+    if (o->surface_layer) arr[na++] = (vtp_array){A_LAYER, "surface_layer", "UInt8", 1, n};
+    if (o->write_film) arr[na++] = (vtp_array){A_FILM, "film", REAL_VTK, 1, rs * n};
     arr[na++] = (vtp_array){A_POINTS, "Points", REAL_VTK, 3, 3 * rs * n};
     arr[na++] = (vtp_array){A_CONN, "connectivity", itype, 1, is * n};
     arr[na++] = (vtp_array){A_OFFS, "offsets", itype, 1, is * n};
@@ -157,6 +159,10 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
             }
             break;
         case A_AUX: put_reals(&e, ps->aux, n); break;
+        case A_LAYER:
+            for (size_t i = 0; i < n; i++) pfsph__enc_put(&e, &o->surface_layer[i], 1);
+            break;
+        case A_FILM: put_reals(&e, ps->film, n); break;
         case A_POINTS:
             for (size_t i = 0; i < n; i++) {
                 pfsph__enc_put(&e, &ps->x[i], rs);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "pfsph/eigen.h"
+#include "pfsph/film.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -113,6 +114,10 @@ void pfsph_pairwise_shift(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 typedef struct pw_job {
     const pfsph_ctx *ctx;
     double coef[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES]; /* c[a][b] m_b: acceleration per unit f */
+    bool two_phase;  /* bubbles in air: film fractions enter through Eq. 24 */
+    const double (*c)[PFSPH_MAX_PHASES]; /* the raw matrix, for Eq. 24 */
+    const int *film; /* film phase of each gas phase */
+    double mass[PFSPH_MAX_PHASES];
     pfsph_real R, R2;
     double U_R;      /* 3 pi / (2 R) */
     pfsph_kernel kk; /* cubic spline with support k h, for Eq. 7 (NOTES item 2) */
@@ -128,6 +133,10 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx)
     for (int a = 0; a < PFSPH_MAX_PHASES; a++)
         for (int b = 0; b < PFSPH_MAX_PHASES; b++)
             J->coef[a][b] = pp->c[a][b] * (double)ctx->mass[b];
+    for (int b = 0; b < PFSPH_MAX_PHASES; b++) J->mass[b] = (double)ctx->mass[b];
+    J->two_phase = ctx->film && ctx->film->nbubbles > 0;
+    J->c = (const double (*)[PFSPH_MAX_PHASES])pp->c;
+    J->film = ctx->film ? ctx->film->film : NULL;
     double R = pp->k * (double)ctx->h;
     J->R = (pfsph_real)R;
     J->R2 = (pfsph_real)(R * R);
@@ -145,7 +154,7 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx)
  * d = x_j - x_i (Eq. 7). */
 static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g,
                            size_t self, pfsph_real xi, pfsph_real yi, pfsph_real zi, int pa,
-                           double acc[3], bool want_vir, double S[6], double *sw, double sx[3],
+                           double ai, int bi, double acc[3], bool want_vir, double S[6], double *sw, double sx[3],
                            double sxx[6])
 {
     pfsph_ranges rg;
@@ -158,7 +167,17 @@ static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfs
             pfsph_real r2 = dx * dx + dy * dy + dz * dz;
             if (r2 >= J->R2 || r2 <= 0) continue; /* r = 0: no direction, no force */
             double r = sqrt((double)r2);
-            double cf = coef[ps->phase[j]];
+            double cf;
+            if (J->two_phase) { /* Eq. 24 where a film particle takes part */
+                const int pb = ps->phase[j];
+                const double aj = (double)ps->film[j];
+                const int bj = ps->bubble[j];
+                const bool apart = bi && bj && bi != bj;
+                cf = ai > 0 || aj > 0 || apart ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
+                                               : coef[pb];
+            } else {
+                cf = coef[ps->phase[j]];
+            }
             if (cf != 0.0) {
                 /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0). */
                 /* float cosine: the force is accumulated in double, its shape needs 1e-7, and
@@ -206,9 +225,11 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
     double sw = (double)pfsph_kernel_w0(&J->kk); /* the sum of Eq. 7 includes j = i */
     double sx[3] = {0, 0, 0}, sxx[6] = {0, 0, 0, 0, 0, 0};
     acc[0] = acc[1] = acc[2] = 0;
-    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, acc, want_vir, S, &sw, sx, sxx);
+    const double ai = J->two_phase ? (double)f->film[i] : 0.0;
+    const int bi = J->two_phase ? f->bubble[i] : 0;
+    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, acc, want_vir, S, &sw, sx, sxx);
     if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0)
-        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)-1, xi, yi, zi, pa, acc, want_vir, S, &sw,
+        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)-1, xi, yi, zi, pa, ai, bi, acc, want_vir, S, &sw,
                 sx, sxx);
     double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     if (J->filter) {

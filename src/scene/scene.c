@@ -607,6 +607,62 @@ static int parse_solids(parser *p, const cJSON *root)
     return PFSPH_OK;
 }
 
+/* A fluid block that is a bubble in air (PF Section 4.2.2, docs/film.md): "bubble": {"film":
+ * liquid phase, "thickness": m | "liquid_volume": m^dim}. The block's phase is the gas. */
+static int parse_bubble(parser *p, const cJSON *e, const char *P, int index, pfsph_block *b)
+{
+    pfsph_scene *s = p->s;
+    char BP[160], kp[200];
+    path_key(BP, sizeof BP, P, "bubble");
+    const cJSON *o = get(e, "bubble");
+    if (!cJSON_IsObject(o)) return pfsph__json_fail(&p->ctx, BP, "expected an object {\"film\": phase, \"thickness\": m}");
+    static const char *const keys[] = {"film", "thickness", "liquid_volume", "comment", NULL};
+    TRY(pfsph__json_check_keys(o, BP, keys, &p->ctx));
+    TRY(require(p, o, BP, "film"));
+    if (s->film.nbubbles >= PFSPH_MAX_BUBBLES)
+        return pfsph__json_fail(&p->ctx, BP, "too many bubbles (at most %d)", PFSPH_MAX_BUBBLES);
+    path_key(kp, sizeof kp, P, "phase");
+    if (s->phases[b->phase].kind != PFSPH_PHASE_GAS)
+        return pfsph__json_fail(&p->ctx, kp, "phase \"%s\" is a %s phase; a bubble's block is its gas: give a phase "
+                                "of kind \"gas\"", s->phases[b->phase].name, kind_names[s->phases[b->phase].kind]);
+    char name[PFSPH_NAME_LEN];
+    TRY(pfsph__json_string(o, BP, "film", name, sizeof name, &p->ctx));
+    path_key(kp, sizeof kp, BP, "film");
+    const int film = pfsph_scene_phase_index(s, name);
+    if (film < 0) return pfsph__json_fail(&p->ctx, kp, "unknown phase \"%.64s\"", name);
+    if (s->phases[film].kind != PFSPH_PHASE_FLUID)
+        return pfsph__json_fail(&p->ctx, kp, "phase \"%s\" is a %s phase; a film is a liquid (kind \"fluid\")",
+                                name, kind_names[s->phases[film].kind]);
+    if (s->film.film[b->phase] >= 0 && s->film.film[b->phase] != film)
+        return pfsph__json_fail(&p->ctx, kp, "gas \"%s\" already has the film \"%s\" (one film liquid per gas "
+                                "phase)", s->phases[b->phase].name, s->phases[s->film.film[b->phase]].name);
+    const bool th = get(o, "thickness") != NULL, vol = get(o, "liquid_volume") != NULL;
+    if (th == vol)
+        return pfsph__json_fail(&p->ctx, BP, "give exactly one of \"thickness\" (m) and \"liquid_volume\" (m^%d)",
+                                s->dim);
+    const int k = s->film.nbubbles;
+    double t = 0, v = 0;
+    const double sp = 2.0 * s->particle_radius;
+    if (th) {
+        /* a film thicker than a particle is no film: the fraction a = t / d must stay <= 1 */
+        TRY(pfsph__json_number(o, BP, "thickness", 0.0, sp, &t, &p->ctx));
+        path_key(kp, sizeof kp, BP, "thickness");
+        if (!(t > 0)) return pfsph__json_fail(&p->ctx, kp, "thickness %g m: must be above 0", t);
+    } else {
+        TRY(pfsph__json_number(o, BP, "liquid_volume", 0.0, 1e6, &v, &p->ctx));
+        path_key(kp, sizeof kp, BP, "liquid_volume");
+        if (!(v > 0)) return pfsph__json_fail(&p->ctx, kp, "liquid volume %g m^%d: must be above 0", v, s->dim);
+    }
+    s->film.film[b->phase] = film;
+    s->film.gas[k] = b->phase;
+    s->film.block[k] = index;
+    s->film.thickness[k] = t;
+    s->film.volume[k] = v;
+    s->film.nbubbles = k + 1;
+    b->bubble = k;
+    return PFSPH_OK;
+}
+
 static int parse_fluid(parser *p, const cJSON *root)
 {
     pfsph_scene *s = p->s;
@@ -632,11 +688,11 @@ static int parse_fluid(parser *p, const cJSON *root)
         memset(b, 0, sizeof *b);
         TRY(json_enum(p, e, P, "shape", block_shapes, &b->shape));
         static const char *const k_box[] = {"shape", "phase", "velocity", "jitter", "min", "max",
-                                            "comment", NULL};
+                                            "bubble", "comment", NULL};
         static const char *const k_sph[] = {"shape", "phase", "velocity", "jitter", "center",
-                                            "radius", "comment", NULL};
+                                            "radius", "bubble", "comment", NULL};
         static const char *const k_cyl[] = {"shape", "phase", "velocity", "jitter", "center",
-                                            "radius", "height", "axis", "comment", NULL};
+                                            "radius", "height", "axis", "bubble", "comment", NULL};
         const char *const *keys = b->shape == PFSPH_SHAPE_BOX      ? k_box
                                   : b->shape == PFSPH_SHAPE_SPHERE ? k_sph
                                                                    : k_cyl;
@@ -652,6 +708,8 @@ static int parse_fluid(parser *p, const cJSON *root)
             path_key(kp, sizeof kp, P, "phase");
             return pfsph__json_fail(&p->ctx, kp, "no fluid or gas phase is defined in $.phases");
         }
+        b->bubble = -1;
+        if (get(e, "bubble")) TRY(parse_bubble(p, e, P, i, b));
         /* Spheres and cylinders also get their bounding box in min/max (used by samplers and
          * the checks below). */
         geo g = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
@@ -964,6 +1022,7 @@ void pfsph_scene_defaults(pfsph_scene *s)
     s->div_max_iter = 100;
     pfsph_pairwise_defaults(&s->pairwise);
     pfsph_diffuse_defaults(&s->diffuse);
+    pfsph_film_defaults(&s->film);
     snprintf(s->output.dir, sizeof s->output.dir, "runs/scene");
     s->output.vtp = true;
     s->output.ply = false;

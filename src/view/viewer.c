@@ -1136,7 +1136,7 @@ static int write_outputs(app *A)
     free(rgb);
     if (!rc && A->o.dump) {
         char p[PFSPH_PATH_LEN + 32];
-        pfsph_io_opts io = {A->scene->dim, true, true, NULL, A->shown->time, false};
+        pfsph_io_opts io = {.dim = A->scene->dim, .write_id = true, .write_speed = true, .time = A->shown->time};
         if (!(rc = pfsph_mkdirs(A->o.dump, &err))) {
             snprintf(p, sizeof p, "%s/fluid.vtp", A->o.dump);
             rc = pfsph_write_vtp(p, &A->shown->fluid, &io, &err);

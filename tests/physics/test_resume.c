@@ -3,7 +3,9 @@
  * (fluid and diffuse, a middle frame and the last) and the same stats.csv; with the newest
  * checkpoint corrupted, `pfsph run --resume` says so, falls back to the previous one and still
  * matches. A floating box (a rigid body, issue 5) rides the wave: its particles, surfaces and
- * bodies.csv must match too. Same thread count throughout (this process's). */
+ * bodies.csv must match too. Same thread count throughout (this process's). Two bubbles in air
+ * (docs/film.md) resumed mid-collision: the film fractions and bubble ids come back from the
+ * checkpoint, frames (with their film and surface_layer fields) the same bytes. */
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -85,6 +87,45 @@ static void test_resume_library(void **st)
     free(b);
 }
 
+/* Two 2D soap bubbles (80 particles each) driven together; frames 7 and 10 and stats.csv. */
+static void test_resume_film(void **st)
+{
+    (void)st;
+    static pfsph_scene s;
+    const char *json =
+        "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
+        " \"domain\": {\"min\": [-0.2, -0.2], \"max\": [0.2, 0.2]}, \"time\": {\"end\": 0.4, \"fps\": 25, \"dt_max\": 0.002},"
+        " \"phases\": [{\"name\": \"soap\", \"kind\": \"fluid\", \"viscosity\": 0.005},"
+        " {\"name\": \"air\", \"kind\": \"gas\", \"rest_density\": 1000, \"viscosity\": 0.005}],"
+        " \"fluid\": [{\"shape\": \"sphere\", \"center\": [-0.055, 0], \"radius\": 0.05, \"phase\": \"air\","
+        " \"velocity\": [0.2, 0], \"bubble\": {\"film\": \"soap\", \"thickness\": 0.004}},"
+        " {\"shape\": \"sphere\", \"center\": [0.055, 0.01], \"radius\": 0.05, \"phase\": \"air\","
+        " \"velocity\": [-0.2, 0], \"bubble\": {\"film\": \"soap\", \"liquid_volume\": 0.0001}}],"
+        " \"pairwise\": {\"k\": 1.633, \"coefficients\": [{\"phases\": [\"soap\", \"soap\"], \"sigma\": 4},"
+        " {\"phases\": [\"air\", \"air\"], \"sigma\": 2}, {\"phases\": [\"soap\", \"air\"], \"sigma\": 0}]},"
+        " \"output\": {\"formats\": [\"vtp\"], \"fields\": [\"id\"], \"checkpoint_interval\": 5}}";
+    pfsph_error err = {0};
+    int rc = pfsph_scene_parse(&s, json, "film-resume", &err);
+    if (rc) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    char a[1024], b[1024];
+    snprintf(a, sizeof a, "%s/film_full", tu_tmpdir());
+    snprintf(b, sizeof b, "%s/film_part", tu_tmpdir());
+    run(&s, a, -1, false);
+    run(&s, b, 0.2, false);
+    run(&s, b, 0.4, true);
+    tu_assert_same_file(a, b, "frames/fluid_00007.vtp");
+    tu_assert_same_file(a, b, "frames/fluid_00010.vtp");
+    tu_assert_same_file(a, b, "stats.csv");
+    size_t len;
+    char p[1100];
+    snprintf(p, sizeof p, "%s/frames/fluid_00010.vtp", b);
+    unsigned char *buf = tu_slurp(p, &len);
+    assert_non_null(strstr((char *)buf, "Name=\"film\""));
+    assert_non_null(strstr((char *)buf, "Name=\"surface_layer\""));
+    free(buf);
+}
+
 /* Through the program: a corrupt newest checkpoint is reported and the previous one used. */
 static void test_resume_fallback_cli(void **st)
 {
@@ -137,6 +178,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_resume_library),
         cmocka_unit_test(test_resume_fallback_cli),
+        cmocka_unit_test(test_resume_film),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -81,7 +81,7 @@ static void test_paraview(void **state)
     const char *j = json_after(out, "pfsph_pvd_info: ");
     assert_non_null(j);
     assert_non_null(strstr(j, "\"steps\": 3"));
-    assert_non_null(strstr(j, "\"point_arrays\": [\"density\", \"phase\", \"pressure\", \"velocity\"]"));
+    assert_non_null(strstr(j, "\"point_arrays\": [\"density\", \"phase\", \"pressure\", \"surface_layer\", \"velocity\"]"));
     assert_non_null(strstr(j, "\"times\": [0.0, 0.05, 0.1]"));
     assert_non_null(strstr(j, "\"points\": 1500"));
     snprintf(cmd, sizeof cmd, "pvpython '%s/tools/paraview/pfsph_pvd_info.py' '%s/liquid.pvd'", tu_source_dir(), g_run);

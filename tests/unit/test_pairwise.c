@@ -1,13 +1,15 @@
 /* Unit tests of the pair forces and the anisotropic filter (src/physics/pairwise.c) on
  * hand-made particle sets: the sign and range of Eq. 3/6 on two particles, T = I on lattices,
  * the anisotropy of a half-space, exact momentum balance with the filter off, the grid loops
- * against an O(N^2) oracle, thread-count independence. */
+ * against an O(N^2) oracle, thread-count independence; two-phase film particles (PF Eq. 24):
+ * the pair coefficient against the formula, and momentum and thread independence with them. */
 #include <math.h>
 #include <omp.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "pfsph/film.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/sim.h"
 #include "testutil.h"
@@ -496,6 +498,148 @@ static void test_create_checks_grid(void **state)
     world_free(&w);
 }
 
+/* PF Eq. 24: two gas particles of a bubble (phase beta = 1, rho 400) holding film fractions a and
+ * b of the liquid alpha = 0 (rho 1000): the force on each is c~ m_i m_j f(r) with
+ * c~ = a b c_aa + (a (1 - b) + (1 - a) b) c_ab + (1 - a)(1 - b) c_bb, opposite on the two
+ * (symmetric in i, j), for a, b in {0, 0.3, 1}; a film particle against a solid (phase 2) and
+ * against an ordinary liquid particle mixes the same matrix. */
+static void test_film_eq24(void **state)
+{
+    (void)state;
+    const double rho[3] = {1000, 400, 2000};
+    const int kinds[3] = {PFSPH_PHASE_FLUID, PFSPH_PHASE_GAS, PFSPH_PHASE_SOLID};
+    const double d = 0.01, caa = 2.0e4, cab = 5.0e3, cbb = 1.0e3, caw = 7.0e3, cbw = 3.0e3;
+    const double fr[3] = {0, 0.3, 1};
+    double maxrel = 0;
+    for (int dim = 2; dim <= 3; dim++)
+        for (int p = 0; p < 3; p++)
+            for (int q = 0; q < 3; q++)
+                for (int other = 0; other < 3; other++) { /* j: film particle, liquid, solid */
+                    if (other && q) continue;          /* b is the film particle's only */
+                    world w;
+                    world_init(&w, dim, d, 3, rho, kinds);
+                    pfsph_pairwise_params *pp = &w.scene->pairwise;
+                    pp->filter = false;
+                    pp->c[0][0] = caa;
+                    pp->c[0][1] = pp->c[1][0] = cab;
+                    pp->c[1][1] = cbb;
+                    pp->c[0][2] = pp->c[2][0] = caw;
+                    pp->c[1][2] = pp->c[2][1] = cbw;
+                    pfsph_film_defaults(&w.scene->film);
+                    w.scene->film.nbubbles = 1;
+                    w.scene->film.film[1] = 0;
+                    const double r = 0.7 * pp->k * 2 * d; /* attractive range */
+                    const double e[3] = {0.48, 0.6, dim == 3 ? 0.64 : 0};
+                    const double en = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+                    add(&w.fluid, 0, 0, 0, 1);
+                    if (other == 2) add(&w.boundary, r * e[0] / en, r * e[1] / en, r * e[2] / en, 2);
+                    else add(&w.fluid, r * e[0] / en, r * e[1] / en, r * e[2] / en, other == 1 ? 0 : 1);
+                    world_finish(&w);
+                    const size_t i = find(&w.fluid, 0, 0, 0), j = 1 - i;
+                    const double a = fr[p], b = fr[q];
+                    w.fluid.film[i] = (pfsph_real)a;
+                    if (other == 0) w.fluid.film[j] = (pfsph_real)b;
+                    apply(&w);
+                    double expect_c;
+                    int pj;
+                    if (other == 0) {
+                        expect_c = a * b * caa + (a * (1 - b) + (1 - a) * b) * cab + (1 - a) * (1 - b) * cbb; /* Eq. 24 */
+                        pj = 1;
+                    } else if (other == 1) {
+                        expect_c = a * caa + (1 - a) * cab;
+                        pj = 0;
+                    } else {
+                        expect_c = a * caw + (1 - a) * cbw;
+                        pj = 2;
+                    }
+                    const pfsph_particles *sj = other == 2 ? &w.boundary : &w.fluid;
+                    const size_t jj = other == 2 ? 0 : j;
+                    /* the formula in the header, both orders */
+                    const double c_ij = pfsph_film_pair_c((const double (*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film, 1, a,
+                                                          pj, other == 0 ? b : 0, false);
+                    const double c_ji = pfsph_film_pair_c((const double (*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film, pj,
+                                                          other == 0 ? b : 0, 1, a, false);
+                    assert_true(fabs(c_ij - expect_c) <= 1e-12 * expect_c);
+                    assert_true(c_ij == c_ji);
+                    const double rr = sqrt(pow(sj->x[jj] - w.fluid.x[i], 2) + pow(sj->y[jj] - w.fluid.y[i], 2) +
+                                           pow(sj->z[jj] - w.fluid.z[i], 2));
+                    const double R = pp->k * 2 * d;
+                    const double mi = w.ctx.mass[1], mj = w.ctx.mass[pj];
+                    const double F = expect_c * mi * mj * cos(1.5 * PI * rr / R); /* Eq. 3, 6 */
+                    const double Fi[3] = {mi * w.ctx.ax[i], mi * w.ctx.ay[i], mi * w.ctx.az[i]};
+                    for (int k = 0; k < 3; k++) {
+                        const double ex = (0 - (k == 0 ? sj->x[jj] : k == 1 ? sj->y[jj] : sj->z[jj])) / rr * F;
+                        const double rel = fabs(Fi[k] - ex) / fabs(F);
+                        maxrel = fmax(maxrel, rel);
+                        assert_true(rel <= 1e-5);
+                        if (other != 2) { /* action and reaction */
+                            const double Fj = w.ctx.mass[pj] * (k == 0 ? w.ctx.ax[j] : k == 1 ? w.ctx.ay[j] : w.ctx.az[j]);
+                            assert_true(fabs(Fi[k] + Fj) <= 1e-6 * fabs(F));
+                        }
+                    }
+                    world_free(&w);
+                }
+    print_message("Eq. 24: largest relative force error %.2g over a, b in {0, 0.3, 1}, film-film, film-liquid, "
+                  "film-solid, 2D and 3D\n", maxrel);
+}
+
+/* Momentum (filter off or eta 0) and 1 vs 2 threads with two-phase particles: the cloud's
+ * phase-1 particles are a bubble's gas, half of them film particles with fractions in (0, 1). */
+static void test_film_momentum_threads(void **state)
+{
+    (void)state;
+    for (int dim = 2; dim <= 3; dim++)
+        for (int mode = 0; mode < 3; mode++) {
+            world w;
+            random_cloud(&w, dim, dim == 2 ? 400 : 1000, dim == 2 ? 60 : 200);
+            w.scene->phases[1].kind = PFSPH_PHASE_GAS;
+            pfsph_film_defaults(&w.scene->film);
+            w.scene->film.nbubbles = 1;
+            w.scene->film.film[1] = 0;
+            size_t nfilm = 0;
+            for (size_t i = 0; i < w.fluid.n; i++)
+                if (w.fluid.phase[i] == 1 && urand() < 0.5) {
+                    w.fluid.film[i] = (pfsph_real)(0.05 + 0.9 * urand());
+                    w.fluid.bubble[i] = 1;
+                    nfilm++;
+                }
+            w.scene->pairwise.filter = mode == 1 ? false : true;
+            w.scene->pairwise.eta = mode == 0 ? 0.0 : 0.2;
+            omp_set_num_threads(1);
+            apply(&w);
+            const size_t n = w.fluid.n;
+            pfsph_real *a1 = malloc(3 * n * sizeof(pfsph_real));
+            assert_non_null(a1);
+            memcpy(a1, w.ctx.ax, n * sizeof(pfsph_real));
+            memcpy(a1 + n, w.ctx.ay, n * sizeof(pfsph_real));
+            memcpy(a1 + 2 * n, w.ctx.az, n * sizeof(pfsph_real));
+            omp_set_num_threads(2);
+            apply(&w);
+            assert_memory_equal(a1, w.ctx.ax, n * sizeof(pfsph_real));
+            assert_memory_equal(a1 + n, w.ctx.ay, n * sizeof(pfsph_real));
+            assert_memory_equal(a1 + 2 * n, w.ctx.az, n * sizeof(pfsph_real));
+            free(a1);
+            if (mode < 2) { /* momentum: fluid-fluid pairs only (walls are static) */
+                w.boundary.n = 0;
+                apply(&w);
+                double sum[3] = {0, 0, 0}, mag = 0;
+                for (size_t i = 0; i < n; i++) {
+                    const double m = w.ctx.mass[w.fluid.phase[i]];
+                    const double F[3] = {m * w.ctx.ax[i], m * w.ctx.ay[i], m * w.ctx.az[i]};
+                    for (int a = 0; a < 3; a++) {
+                        sum[a] += F[a];
+                        mag += fabs(F[a]);
+                    }
+                }
+                const double rel = (fabs(sum[0]) + fabs(sum[1]) + fabs(sum[2])) / mag;
+                print_message("dim %d, %zu film particles, %s: |sum F| / sum |F| = %.3g; 1 and 2 threads: same bits\n",
+                              dim, nfilm, mode == 0 ? "filter on, eta 0" : "filter off", rel);
+                assert_true(rel < (sizeof(pfsph_real) == 4 ? 2e-6 : 1e-13));
+            }
+            world_free(&w);
+        }
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -508,6 +652,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_momentum),
         cmocka_unit_test(test_brute_force),
         cmocka_unit_test(test_create_checks_grid),
+        cmocka_unit_test(test_film_eq24),
+        cmocka_unit_test(test_film_momentum_threads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

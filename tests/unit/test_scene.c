@@ -358,6 +358,34 @@ static void test_shipped_scenes(void **state)
     globfree(&g);
 }
 
+/* A bubble's liquid_volume is checked against its surface (docs/film.md) when the simulation
+ * is built: more than its surface particles hold, one particle thick, is an input error naming
+ * file, path and the largest volume; the largest itself is accepted. */
+static void test_bubble_volume_limit(void **state)
+{
+    (void)state;
+    char json[1024];
+    const char *fmt = "{\"dimension\":2,\"particle_radius\":0.01,\"domain\":{\"min\":[0,0],\"max\":[1,1]},"
+                      "\"phases\":[{\"name\":\"soap\"},{\"name\":\"air\",\"kind\":\"gas\"}],"
+                      "\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5],\"radius\":0.1,\"phase\":\"air\","
+                      "\"bubble\":{\"film\":\"soap\",\"liquid_volume\":%g}}]}";
+    pfsph_error err;
+    snprintf(json, sizeof json, fmt, 1.0);
+    assert_int_equal(parse(json, &err), PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    assert_int_equal(pfsph_sim_create(&sim, &g_scene, &err), PFSPH_EINPUT);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "dir/bad.json: $.fluid[0].bubble.liquid_volume: 1 m^2 is more than"));
+    /* the largest it names is accepted: N_s V0 */
+    const char *at = strstr(err.msg, "hold (");
+    assert_non_null(at);
+    const double vmax = atof(at + 6);
+    snprintf(json, sizeof json, fmt, 0.999 * vmax); /* %g prints it rounded */
+    assert_int_equal(parse(json, &err), PFSPH_OK);
+    assert_int_equal(pfsph_sim_create(&sim, &g_scene, &err), PFSPH_OK);
+    pfsph_sim_destroy(sim);
+}
+
 /* ---------------------------------------------------------------------------------------- */
 /* Bad inputs: each must fail with code EINPUT and a message naming file, path and reason. */
 
@@ -545,6 +573,30 @@ static const bad_case bad_cases[] = {
      "unknown key"},
     {"seed_fraction", SCENE3(",\"seed\":1.5"), "$.seed", "expected an integer"},
     {"huge_number", SCENE3(",\"support_factor\":1e999"), "$.support_factor", "not a finite number"},
+    /* bubbles in air (docs/film.md) */
+#define BUB(b) "{\"particle_radius\":0.01," DOM3 ",\"phases\":[{\"name\":\"soap\"},{\"name\":\"air\",\"kind\":\"gas\"}]," \
+               "\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"radius\":0.1,\"phase\":\"air\",\"bubble\":" b "}]}"
+    {"bubble_not_object", BUB("1"), "$.fluid[0].bubble", "expected an object"},
+    {"bubble_no_film", BUB("{\"thickness\":0.01}"), "$.fluid[0].bubble.film", "missing required key"},
+    {"bubble_film_unknown", BUB("{\"film\":\"soup\",\"thickness\":0.01}"), "$.fluid[0].bubble.film",
+     "unknown phase \"soup\""},
+    {"bubble_film_gas", BUB("{\"film\":\"air\",\"thickness\":0.01}"), "$.fluid[0].bubble.film", "a film is a liquid"},
+    {"bubble_thickness_big", BUB("{\"film\":\"soap\",\"thickness\":0.03}"), "$.fluid[0].bubble.thickness",
+     "value 0.03 is out of range [0, 0.02]"},
+    {"bubble_thickness_zero", BUB("{\"film\":\"soap\",\"thickness\":0}"), "$.fluid[0].bubble.thickness",
+     "must be above 0"},
+    {"bubble_both", BUB("{\"film\":\"soap\",\"thickness\":0.01,\"liquid_volume\":1e-5}"), "$.fluid[0].bubble",
+     "exactly one of"},
+    {"bubble_neither", BUB("{\"film\":\"soap\"}"), "$.fluid[0].bubble", "exactly one of"},
+    {"bubble_volume_neg", BUB("{\"film\":\"soap\",\"liquid_volume\":-1}"), "$.fluid[0].bubble.liquid_volume",
+     "value -1 is out of range"},
+    {"bubble_key", BUB("{\"film\":\"soap\",\"thickness\":0.01,\"thicknes\":1}"), "$.fluid[0].bubble.thicknes",
+     "unknown key"},
+    {"bubble_liquid_block",
+     "{\"particle_radius\":0.01," DOM3 ",\"phases\":[{\"name\":\"soap\"}],\"fluid\":[{\"shape\":\"sphere\","
+     "\"center\":[0.5,0.5,0.5],\"radius\":0.1,\"bubble\":{\"film\":\"soap\",\"thickness\":0.01}}]}",
+     "$.fluid[0].phase", "a bubble's block is its gas"},
+#undef BUB
 };
 #define NBAD (sizeof bad_cases / sizeof bad_cases[0])
 
@@ -598,6 +650,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_touching_blocks_ok),
         cmocka_unit_test(test_two_containers_keep_fluid),
         cmocka_unit_test(test_block_jitter),
+        cmocka_unit_test(test_bubble_volume_limit),
         cmocka_unit_test(test_error_leaves_scene_unchanged),
         cmocka_unit_test(test_default_scene),
         cmocka_unit_test(test_load_file),

@@ -1,0 +1,132 @@
+/* Free-surface particles layer by layer (Barecasco, Terissa & Naa 2013; PF Fig. 9). See
+ * include/pfsph/surface_detect.h and docs/film.md. */
+#include "pfsph/surface_detect.h"
+
+#include <math.h>
+#include <string.h>
+
+/* One peel: for each particle still in (layer[i] == 0, or every particle on the first pass)
+ * out[i] = 1 when its sphere has an uncovered point. Neighbours already peeled do not cover. */
+static void peel(const pfsph_ctx *ctx, const pfsph_surface_opts *o, double radius, int reach,
+                 bool first, const uint8_t *layer, uint8_t *out)
+{
+    const pfsph_particles *f = ctx->fluid;
+    const pfsph_particles *b = o->boundary && ctx->boundary && ctx->bgrid ? ctx->boundary : NULL;
+    const size_t n = f->n;
+    const double R2 = radius * radius, rc = 0.5 * radius, rc2 = rc * rc;
+    const uint8_t *grp = o->group;
+#pragma omp parallel for schedule(dynamic, 256)
+    for (size_t i = 0; i < n; i++) {
+        if (!first && layer[i]) {
+            out[i] = 0;
+            continue;
+        }
+        const double xi = f->x[i], yi = f->y[i], zi = f->z[i];
+        const uint8_t gi = grp ? grp[i] : 0;
+        double s[3] = {0, 0, 0};
+        int nn = 0;
+        pfsph_ranges rg;
+        /* the unit vectors from the neighbours to i: their sum points to the least covered
+         * side of i's sphere */
+        pfsph_grid_ranges_reach(ctx->grid, f->x[i], f->y[i], f->z[i], reach, &rg);
+        for (int q = 0; q < rg.n; q++)
+            for (uint32_t j = rg.b[q]; j < rg.e[q]; j++) {
+                if (j == i || (grp && grp[j] != gi) || (!first && layer[j])) continue;
+                const double dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                const double r2 = dx * dx + dy * dy + dz * dz;
+                if (r2 >= R2 || r2 <= 0) continue;
+                const double inv = 1.0 / sqrt(r2);
+                s[0] += dx * inv;
+                s[1] += dy * inv;
+                s[2] += dz * inv;
+                nn++;
+            }
+        pfsph_ranges rb;
+        rb.n = 0;
+        if (b) {
+            pfsph_grid_ranges_reach(ctx->bgrid, f->x[i], f->y[i], f->z[i], reach, &rb);
+            for (int q = 0; q < rb.n; q++)
+                for (uint32_t j = rb.b[q]; j < rb.e[q]; j++) {
+                    const double dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
+                    const double r2 = dx * dx + dy * dy + dz * dz;
+                    if (r2 >= R2 || r2 <= 0) continue;
+                    const double inv = 1.0 / sqrt(r2);
+                    s[0] += dx * inv;
+                    s[1] += dy * inv;
+                    s[2] += dz * inv;
+                    nn++;
+                }
+        }
+        if (!nn) { /* alone: all of its sphere is uncovered */
+            out[i] = 1;
+            continue;
+        }
+        const double sn = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+        /* a balanced neighbourhood (a lattice's interior: |s| is round-off) */
+        if (!(sn > 1e-6 * nn)) {
+            out[i] = 0;
+            continue;
+        }
+        /* the test points on i's sphere: where the neighbours are fewest (Barecasco et al.),
+         * then a ring 30 degrees off it (ours: a particle in a one-site notch of a lattice
+         * surface has an uncovered arc of 30 degrees that the sum's direction can miss) */
+        const double u[3] = {s[0] / sn, s[1] / sn, s[2] / sn};
+        double e1[3], e2[3] = {0, 0, 0};
+        if (ctx->dim == 2) {
+            e1[0] = -u[1], e1[1] = u[0], e1[2] = 0;
+        } else { /* an orthonormal pair perpendicular to u */
+            const double t[3] = {fabs(u[0]) < 0.9 ? 1.0 : 0.0, fabs(u[0]) < 0.9 ? 0.0 : 1.0, 0};
+            e1[0] = u[1] * t[2] - u[2] * t[1], e1[1] = u[2] * t[0] - u[0] * t[2], e1[2] = u[0] * t[1] - u[1] * t[0];
+            const double l = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+            for (int a = 0; a < 3; a++) e1[a] /= l;
+            e2[0] = u[1] * e1[2] - u[2] * e1[1], e2[1] = u[2] * e1[0] - u[0] * e1[2], e2[2] = u[0] * e1[1] - u[1] * e1[0];
+        }
+        const double C = 0.86602540378443865, Sn = 0.5; /* cos, sin of 30 degrees */
+        const int npts = ctx->dim == 2 ? 3 : 5;
+        const double ring[5][2] = {{0, 0}, {1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+        bool covered = true;
+        for (int t = 0; t < npts && covered; t++) {
+            const double cu = t ? C : 1.0, se = t ? Sn : 0.0;
+            double dir[3];
+            for (int a = 0; a < 3; a++) dir[a] = cu * u[a] + se * (ring[t][0] * e1[a] + ring[t][1] * e2[a]);
+            const double px = xi + rc * dir[0], py = yi + rc * dir[1], pz = zi + rc * dir[2];
+            covered = false;
+            for (int q = 0; q < rg.n && !covered; q++)
+                for (uint32_t j = rg.b[q]; j < rg.e[q]; j++) {
+                    if (j == i || (grp && grp[j] != gi) || (!first && layer[j])) continue;
+                    const double dx = px - f->x[j], dy = py - f->y[j], dz = pz - f->z[j];
+                    if (dx * dx + dy * dy + dz * dz < rc2) {
+                        covered = true;
+                        break;
+                    }
+                }
+            for (int q = 0; q < rb.n && !covered; q++)
+                for (uint32_t j = rb.b[q]; j < rb.e[q]; j++) {
+                    const double dx = px - b->x[j], dy = py - b->y[j], dz = pz - b->z[j];
+                    if (dx * dx + dy * dy + dz * dz < rc2) {
+                        covered = true;
+                        break;
+                    }
+                }
+        }
+        out[i] = covered ? 0 : 1;
+    }
+}
+
+void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uint8_t *layer,
+                          uint8_t *work)
+{
+    const size_t n = ctx->fluid->n;
+    if (!n) return;
+    double radius = o->radius;
+    if (!(radius > 0)) radius = fmin(2.0 * (double)ctx->spacing, (double)ctx->h);
+    int reach = o->reach > 0 ? o->reach : ctx->grid->reach;
+    if (reach > 3) reach = 3;
+    int layers = o->layers < 1 ? 1 : o->layers > PFSPH_SURFACE_MAX_LAYERS ? PFSPH_SURFACE_MAX_LAYERS : o->layers;
+    peel(ctx, o, radius, reach, true, layer, layer);
+    for (int L = 2; L <= layers; L++) {
+        peel(ctx, o, radius, reach, false, layer, work);
+        for (size_t i = 0; i < n; i++)
+            if (work[i]) layer[i] = (uint8_t)L;
+    }
+}

@@ -1,0 +1,322 @@
+/* Bubbles in air (PF Section 4.2.2, Eq. 24; docs/film.md), 2D, no gravity, the default
+ * thermostat, PCISPH. A bubble is a gas block whose outer layer carries a liquid film of
+ * fraction a = V_L / (N_s V0).
+ *
+ * One bubble from an elongated start (a 22 d x 16 d rectangle, 352 particles, moment ratio
+ * 0.53) over 2 s, viscosity 0.005 m^2/s (at 0.003 the l = 2 wobble, period ~0.8 s, still has
+ * ~10 % amplitude in the second second and the average ratio is 0.893; at 0.01 the relaxation
+ * is overdamped and reaches 0.84 only at 2 s; docs/film.md):
+ * - film liquid volume sum_i a_i V0 within 2 % of V_L at every sample (the film stage's
+ *   bookkeeping: it fails when the fraction lags the surface count or is held at 1). The
+ *   fraction itself is printed: it does not simply rise as the rectangle rounds (0.500 ->
+ *   0.468), because a thermal liquid's rough surface has more surface particles than a
+ *   lattice's flat one (docs/film.md);
+ * - enclosed gas volume, measured geometrically: the polygon through the film particles
+ *   (sorted by angle about the bubble's centroid) plus the outer half of each film particle,
+ *   V_bubble = A_poly + N_s V0 / 2, less the liquid: within 2 % of its start at every sample
+ *   (for a rectangle and a disc of one area the formula agrees to 0.1 %);
+ * - round at the end: smallest / largest principal second moment averaged over the second
+ *   half >= 0.95;
+ * - closed film: no gas particle (a = 0) farther from the centroid than the film polygon at its
+ *   angle, at any sample.
+ * Two bubbles (discs of radius 8 d, 2 x 200 particles) driven together at 0.2 m/s each: they
+ * touch (closest pair across them below 1.2 d), flatten against each other (moment ratio of
+ * one bubble below 0.95 at some sample), and the gas particles (a = 0) form exactly two
+ * connected components (links shorter than h) at every sample over 1.5 s: a double bubble, not
+ * one drop. That is what the physics asks: soap bubbles that touch share a wall and keep their
+ * gases apart until the film drains and ruptures, which this model does not simulate
+ * (docs/film.md). Every assertion's measured value is printed. */
+#include <math.h>
+#include <omp.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pfsph/eigen.h"
+#include "pfsph/sim.h"
+#include "testutil.h"
+
+static const double PI = 3.14159265358979323846;
+
+/* Phases, pair coefficients; FILM_NU, FILM_SIGMA_GAS, FILM_V override (studies, docs/film.md). */
+static const char *phases_and_pairs(void)
+{
+    static char buf[1024];
+    const char *nu = getenv("FILM_NU"), *sg = getenv("FILM_SIGMA_GAS");
+    snprintf(buf, sizeof buf,
+             "\"phases\": [{\"name\": \"soap\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": %s},"
+             " {\"name\": \"air\", \"kind\": \"gas\", \"rest_density\": 1000, \"viscosity\": %s}],"
+             " \"pairwise\": {\"k\": 1.633, \"coefficients\": [{\"phases\": [\"soap\", \"soap\"], \"sigma\": 4},"
+             " {\"phases\": [\"air\", \"air\"], \"sigma\": %s}, {\"phases\": [\"soap\", \"air\"], \"sigma\": 0}]}",
+             nu ? nu : "0.005", nu ? nu : "0.005", sg ? sg : "2");
+    return buf;
+}
+
+typedef struct bubble_m {
+    int ns;          /* film particles */
+    double a;        /* their fraction (mean) */
+    double liquid;   /* sum a_i V0 */
+    double gas;      /* A_poly + ns V0 / 2 - liquid */
+    double ratio;    /* moment ratio */
+    int gas_outside; /* gas particles beyond the film polygon */
+} bubble_m;
+
+typedef struct ang {
+    double t, r;
+} ang;
+
+static int by_angle(const void *a, const void *b)
+{
+    const ang *p = a, *q = b;
+    return p->t < q->t ? -1 : p->t > q->t;
+}
+
+/* Polygon radius at angle t (linear in angle between neighbours, wrapping). */
+static double poly_r(const ang *A, int n, double t)
+{
+    int k = 0;
+    while (k < n && A[k].t < t) k++;
+    const ang *p = &A[(k - 1 + n) % n], *q = &A[k % n];
+    double t0 = p->t, t1 = q->t;
+    if (k == 0) t0 -= 2 * PI;
+    if (k == n) t1 += 2 * PI;
+    const double u = t1 > t0 ? (t - t0) / (t1 - t0) : 0.5;
+    return p->r + u * (q->r - p->r);
+}
+
+/* The particles of bubble k (fluid->bubble == k + 1). */
+static bubble_m measure(const pfsph_ctx *c, int k, ang *A)
+{
+    const pfsph_particles *f = c->fluid;
+    const double V0 = c->V0;
+    double cx = 0, cy = 0;
+    int n = 0;
+    for (size_t i = 0; i < f->n; i++)
+        if (f->bubble[i] == k + 1) cx += f->x[i], cy += f->y[i], n++;
+    cx /= n;
+    cy /= n;
+    bubble_m m = {0, 0, 0, 0, 0, 0};
+    double C[2][2] = {{0, 0}, {0, 0}};
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->bubble[i] != k + 1) continue;
+        const double x = f->x[i] - cx, y = f->y[i] - cy;
+        C[0][0] += x * x, C[0][1] += x * y, C[1][1] += y * y;
+        if (f->film[i] > 0) {
+            A[m.ns].t = atan2(y, x);
+            A[m.ns].r = hypot(x, y);
+            m.ns++;
+            m.liquid += f->film[i] * V0;
+        }
+    }
+    C[1][0] = C[0][1];
+    double w[2], v[2][2];
+    pfsph_eigen_sym2(C, w, v);
+    m.ratio = w[1] / w[0];
+    m.a = m.liquid / (m.ns * V0);
+    qsort(A, (size_t)m.ns, sizeof *A, by_angle);
+    double area = 0;
+    for (int q = 0; q < m.ns; q++) {
+        const ang *p = &A[q], *r = &A[(q + 1) % m.ns];
+        area += 0.5 * p->r * r->r * sin(r->t - p->t + (q + 1 == m.ns ? 2 * PI : 0));
+    }
+    m.gas = area + 0.5 * m.ns * V0 - m.liquid;
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->bubble[i] != k + 1 || f->film[i] > 0) continue;
+        const double x = f->x[i] - cx, y = f->y[i] - cy;
+        if (hypot(x, y) > poly_r(A, m.ns, atan2(y, x))) m.gas_outside++;
+    }
+    return m;
+}
+
+static pfsph_sim *make(const char *json, const char *name)
+{
+    pfsph_scene *s = malloc(sizeof *s);
+    assert_non_null(s);
+    pfsph_error err = {0};
+    int rc = pfsph_scene_parse(s, json, name, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    rc = pfsph_sim_create(&sim, s, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    free(s);
+    return sim;
+}
+
+static void test_bubble_at_rest(void **state)
+{
+    (void)state;
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
+             " \"domain\": {\"min\": [-0.5, -0.5], \"max\": [0.5, 0.5]}, \"time\": {\"dt_max\": 0.002}, %s,"
+             " \"fluid\": [{\"shape\": \"box\", \"min\": [-0.11, -0.08], \"max\": [0.11, 0.08], \"phase\": \"air\","
+             " \"bubble\": {\"film\": \"soap\", \"thickness\": 0.005}}]}",
+             phases_and_pairs());
+    pfsph_sim *sim = make(json, "bubble.json");
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    ang *A = malloc(c->fluid->n * sizeof *A);
+    assert_non_null(A);
+    const bubble_m m0 = measure(c, 0, A);
+    const double VL = m0.liquid;
+    print_message("t = 0: %zu particles, %d film, a = %.4f, film liquid %.4g m^2, gas %.4g m^2, moment ratio %.3f\n",
+                  c->fluid->n, m0.ns, m0.a, m0.liquid, m0.gas, m0.ratio);
+    assert_true(fabs(m0.a - 0.5) < 1e-6); /* thickness d / 2 */
+    double max_dl = 0, max_dg = 0, avg_ratio = 0;
+    int navg = 0, outside = 0;
+    const double dt = 0.05, T = 2.0;
+    const int ns = (int)lround(T / dt);
+    bubble_m m = m0;
+    for (int k = 1; k <= ns; k++) {
+        pfsph_error err = {0};
+        int rc = pfsph_sim_advance(sim, k * dt, &err);
+        if (rc) print_message("%s\n", err.msg);
+        assert_int_equal(rc, PFSPH_OK);
+        m = measure(c, 0, A);
+        max_dl = fmax(max_dl, fabs(m.liquid / VL - 1));
+        max_dg = fmax(max_dg, fabs(m.gas / m0.gas - 1));
+        outside += m.gas_outside;
+        if (2 * k > ns) avg_ratio += m.ratio, navg++;
+        if (k % 8 == 0)
+            print_message("t = %.2f s: %d film particles, a = %.4f, liquid %+.3f %%, gas %+.3f %%, moment ratio %.3f, "
+                          "gas outside the film %d\n",
+                          k * dt, m.ns, m.a, 100 * (m.liquid / VL - 1), 100 * (m.gas / m0.gas - 1), m.ratio,
+                          m.gas_outside);
+    }
+    avg_ratio /= navg;
+    print_message("over 2 s: largest change of the film liquid %.3f %%, of the enclosed gas %.3f %% (bound 2 %%); "
+                  "moment ratio over the second half %.4f (bound 0.95); a %.4f -> %.4f; gas particles outside the "
+                  "film, summed over the samples: %d\n",
+                  100 * max_dl, 100 * max_dg, avg_ratio, m0.a, m.a, outside);
+    assert_int_equal(pfsph_sim_removed(sim), 0);
+    assert_true(max_dl <= 0.02);
+    assert_true(max_dg <= 0.02);
+    assert_true(avg_ratio >= 0.95);
+    assert_int_equal(outside, 0);
+    free(A);
+    pfsph_sim_destroy(sim);
+}
+
+/* Connected components of the gas particles (a = 0, any bubble), links shorter than 1.5 d
+ * (nearest neighbours: the first minimum of a 2D liquid's pair distribution; across two film
+ * layers pressed to 0.8 d the gases of two bubbles come within 2 d without touching). Returns
+ * the number of components; *mixed: how many hold gas of both bubbles. */
+static int gas_components(const pfsph_ctx *c, int *par, int *mixed)
+{
+    const pfsph_particles *f = c->fluid;
+    const double l2 = 2.25 * (double)c->spacing * (double)c->spacing;
+    for (size_t i = 0; i < f->n; i++) par[i] = (int)i;
+    for (size_t i = 0; i < f->n; i++) {
+        if (!f->bubble[i] || f->film[i] > 0) continue;
+        for (size_t j = i + 1; j < f->n; j++) {
+            if (!f->bubble[j] || f->film[j] > 0) continue;
+            const double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j];
+            if (dx * dx + dy * dy < l2) {
+                int a = (int)i, b = (int)j;
+                while (par[a] != a) a = par[a];
+                while (par[b] != b) b = par[b];
+                if (a != b) par[a] = b;
+            }
+        }
+    }
+    int n = 0;
+    *mixed = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        if (!f->bubble[i] || f->film[i] > 0) continue;
+        int r = (int)i;
+        while (par[r] != r) r = par[r];
+        if (r == (int)i) n++;
+    }
+    for (size_t i = 0; i < f->n; i++) { /* a root holding both: some member of the other bubble */
+        if (!f->bubble[i] || f->film[i] > 0 || par[i] != (int)i) continue;
+        bool has[3] = {false, false, false};
+        for (size_t j = 0; j < f->n; j++) {
+            if (!f->bubble[j] || f->film[j] > 0) continue;
+            int r = (int)j;
+            while (par[r] != r) r = par[r];
+            if (r == (int)i) has[f->bubble[j] > 2 ? 0 : f->bubble[j]] = true;
+        }
+        if (has[1] && has[2]) (*mixed)++;
+    }
+    return n;
+}
+
+static void test_two_bubbles(void **state)
+{
+    (void)state;
+    char json[4096];
+    snprintf(json, sizeof json,
+             "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
+             " \"domain\": {\"min\": [-0.5, -0.5], \"max\": [0.5, 0.5]}, \"time\": {\"dt_max\": 0.002}, %s,"
+             " \"fluid\": [{\"shape\": \"sphere\", \"center\": [-0.09, 0.0], \"radius\": 0.08, \"phase\": \"air\","
+             " \"velocity\": [%s, 0], \"bubble\": {\"film\": \"soap\", \"thickness\": 0.005}},"
+             " {\"shape\": \"sphere\", \"center\": [0.09, 0.02], \"radius\": 0.08, \"phase\": \"air\","
+             " \"velocity\": [-%s, 0], \"bubble\": {\"film\": \"soap\", \"thickness\": 0.005}}]}",
+             phases_and_pairs(), getenv("FILM_V") ? getenv("FILM_V") : "0.1",
+             getenv("FILM_V") ? getenv("FILM_V") : "0.1");
+    pfsph_sim *sim = make(json, "two_bubbles.json");
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    const size_t n = c->fluid->n;
+    int *par = malloc(n * sizeof *par);
+    ang *A = malloc(n * sizeof *A);
+    assert_true(par && A);
+    int mixed = 0, comp0 = gas_components(c, par, &mixed);
+    print_message("t = 0: %zu particles, gas components %d\n", n, comp0);
+    assert_int_equal(comp0, 2);
+    int mixed_max = 0, comp_max = 2;
+    double closest = 1e9, min_ratio = 1;
+    int worst_comp = 2;
+    const double dt = 0.05, T = 1.5;
+    const int ns = (int)lround(T / dt);
+    for (int k = 1; k <= ns; k++) {
+        pfsph_error err = {0};
+        int rc = pfsph_sim_advance(sim, k * dt, &err);
+        if (rc) print_message("%s\n", err.msg);
+        assert_int_equal(rc, PFSPH_OK);
+        const pfsph_particles *f = c->fluid;
+        double dmin2 = 1e30;
+        for (size_t i = 0; i < n; i++)
+            if (f->bubble[i] == 1)
+                for (size_t j = 0; j < n; j++)
+                    if (f->bubble[j] == 2) {
+                        const double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j];
+                        dmin2 = fmin(dmin2, dx * dx + dy * dy);
+                    }
+        const double dmin = sqrt(dmin2) / c->spacing;
+        closest = fmin(closest, dmin);
+        const int comp = gas_components(c, par, &mixed);
+        if (comp != 2) worst_comp = comp;
+        if (comp > comp_max) comp_max = comp;
+        if (mixed > mixed_max) mixed_max = mixed;
+        const bubble_m m1 = measure(c, 0, A), m2 = measure(c, 1, A);
+        min_ratio = fmin(min_ratio, fmin(m1.ratio, m2.ratio));
+        if (k % 5 == 0)
+            print_message("t = %.2f s: closest pair across %.3f d, gas components %d (%d with both gases), moment "
+                          "ratios %.3f %.3f, film a %.3f %.3f\n",
+                          k * dt, dmin, comp, mixed, m1.ratio, m2.ratio, m1.a, m2.a);
+    }
+    print_message("over %.1f s: closest pair across the bubbles %.3f d (bound 1.2 d), smallest moment ratio %.3f "
+                  "(bound 0.95), gas components always 2: %s (most %d; most holding both gases %d)\n",
+                  T, closest, min_ratio, worst_comp == 2 ? "yes" : "no", comp_max, mixed_max);
+    assert_int_equal(pfsph_sim_removed(sim), 0);
+    assert_true(closest < 1.2);
+    assert_true(min_ratio < 0.95);
+    assert_int_equal(worst_comp, 2);
+    free(par);
+    free(A);
+    pfsph_sim_destroy(sim);
+}
+
+int main(int argc, char **argv)
+{
+    tu_init(argc, argv);
+    omp_set_num_threads(1); /* a few hundred particles: threads only add synchronisation */
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_bubble_at_rest), cmocka_unit_test(test_two_bubbles)};
+    if (getenv("FILM_ONLY")) { /* studies: one test by number */
+        const struct CMUnitTest one[1] = {tests[atoi(getenv("FILM_ONLY")) & 1]};
+        return cmocka_run_group_tests(one, NULL, NULL);
+    }
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
