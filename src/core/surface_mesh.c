@@ -572,33 +572,41 @@ static int bmap_put(bmap *m, int64_t key, int32_t v)
 /* one kernel into the block whose first node is O (global node index): rows of BN nodes along x.
  * A node's offset from the centre is (global index - I) - f, exact integers converted, and its
  * unit-kernel coordinates are formed in a fixed order, so its term has the same bits in every
- * block that holds it. Rows whose line misses the ellipsoid are skipped (a function of the row
- * and the kernel alone, hence the same in every block too). */
+ * block that holds it. The ellipsoid q^2 = r^T M r < 1 (M = G G) is rasterised: per z slice the
+ * rows that meet it (each row then evaluated whole, two 4-wide vectors). The ranges are those of a
+ * slightly larger ellipsoid (1.0001, plus 1e-3 cell), so that whatever is skipped has q^2 >= 1
+ * beyond any rounding and would add exactly nothing: a node gets the same terms in every block. */
+#define GROW 1.0001f
+#define MARGIN 1e-3f
 static void splat(float *restrict fv, const kern *k, const int32_t O[3])
 {
-    const float *g = k->g, rad = k->rad * 1.0001f + 1e-3f; /* bounds: a superset of the support */
+    const float *g = k->g, rad = k->rad * GROW + MARGIN; /* bounds: a superset of the support */
     float cen[3];
     for (int u = 0; u < 3; u++) cen[u] = (float)(k->I[u] - O[u]) + k->f[u];
-    if (cen[0] + rad < 0 || cen[0] - rad > BS) return;
-    int lo[2], hi[2];
-    for (int u = 1; u < 3; u++) {
-        float a = ceilf(cen[u] - rad), b = floorf(cen[u] + rad);
-        if (b < 0 || a > BS) return;
-        lo[u - 1] = a < 0 ? 0 : (int)a;
-        hi[u - 1] = b > BS ? BS : (int)b;
-    }
-    const float gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2], igg = 1.0f / gg, amp = k->amp;
-    const int32_t ux0 = O[0] - k->I[0];
+    if (cen[0] + rad < 0 || cen[0] - rad > BS || cen[1] + rad < 0 || cen[1] - rad > BS) return;
+    float za = ceilf(cen[2] - rad), zb = floorf(cen[2] + rad);
+    if (zb < 0 || za > BS) return;
+    const int c0 = za < 0 ? 0 : (int)za, c1 = zb > BS ? BS : (int)zb;
+    /* M = G G (G symmetric), and the Schur complements that give a slice's row range */
+    const float m00 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2], m01 = g[0] * g[1] + g[1] * g[3] + g[2] * g[4],
+                m02 = g[0] * g[2] + g[1] * g[4] + g[2] * g[5], m11 = g[1] * g[1] + g[3] * g[3] + g[4] * g[4],
+                m12 = g[1] * g[2] + g[3] * g[4] + g[4] * g[5], m22 = g[2] * g[2] + g[4] * g[4] + g[5] * g[5];
+    const float i00 = 1.0f / m00, sa = m11 - m01 * m01 * i00, sb = m12 - m01 * m02 * i00,
+                sc = m22 - m02 * m02 * i00, isa = 1.0f / sa, amp = k->amp;
+    const int32_t ux0 = O[0] - k->I[0], vy0 = O[1] - k->I[1];
     float us[BN];
     for (int a = 0; a < BN; a++) us[a] = (float)(ux0 + a) - k->f[0];
-    for (int c = lo[1]; c <= hi[1]; c++) {
+    for (int c = c0; c <= c1; c++) {
         const float w = (float)(O[2] + c - k->I[2]) - k->f[2];
-        for (int b = lo[0]; b <= hi[0]; b++) {
-            const float v = (float)(O[1] + b - k->I[1]) - k->f[1];
-            const float rt0 = g[1] * v + g[2] * w, rt1 = g[3] * v + g[4] * w, rt2 = g[4] * v + g[5] * w;
-            /* the least |t|^2 along the row's line */
-            const float rg = rt0 * g[0] + rt1 * g[1] + rt2 * g[2];
-            if (rt0 * rt0 + rt1 * rt1 + rt2 * rt2 - rg * rg * igg >= 1.0001f) continue;
+        /* rows: sa v^2 + 2 sb w v + sc w^2 < GROW, v = (y - I) - f */
+        const float B = sb * w, disc = B * B - sa * (sc * w * w - GROW);
+        if (disc < 0) continue;
+        const float sq = sqrtf(disc), ylo = cen[1] + (-B - sq) * isa - MARGIN, yhi = cen[1] + (-B + sq) * isa + MARGIN;
+        const int b0 = ylo < 0 ? 0 : (int)ceilf(ylo), b1 = yhi > BS ? BS : (int)floorf(yhi);
+        const float wr0 = g[2] * w, wr1 = g[4] * w, wr2 = g[5] * w;
+        for (int b = b0; b <= b1; b++) {
+            const float v = (float)(vy0 + b) - k->f[1];
+            const float rt0 = g[1] * v + wr0, rt1 = g[3] * v + wr1, rt2 = g[4] * v + wr2;
             float *restrict row = fv + NIDX(0, b, c);
 #pragma omp simd
             for (int a = 0; a < BN; a++) {
