@@ -287,39 +287,45 @@ static double lattice_sigma(double r)
 
 /* weighted sums over the candidates (bx, by, bz: offsets in units of d from the cell's corner,
  * padded with FAR to a multiple of LANES) of the point xi: weight, count, first and second
- * moments. Fixed lanes, summed in a fixed order: the same bits on any thread, in any build that
- * does not contract or reassociate. */
+ * moments. A vectorised reduction: its order is fixed by the code and the buffers (16-byte
+ * aligned from malloc), so the same bits on any thread. Eleven scalar sums keep the vector
+ * accumulators in registers (explicit lanes of eight spilled them). */
 static void pca_sums(const float *bx, const float *by, const float *bz, size_t nb, const float xi[3], float r,
                      double out[11])
 {
-    float acc[11][LANES];
-    memset(acc, 0, sizeof acc);
-    const float r2 = r * r, ir = 1.0f / r;
-    for (size_t q = 0; q < nb; q += LANES)
-        for (int l = 0; l < LANES; l++) {
-            float ex = bx[q + l] - xi[0], ey = by[q + l] - xi[1], ez = bz[q + l] - xi[2];
-            float s2 = ex * ex + ey * ey + ez * ez;
-            float s = sqrtf(s2) * ir;
-            float in = s2 < r2 ? 1.0f : 0.0f;
-            float w = s2 < r2 ? 1.0f - s * s * s : 0.0f; /* a select: FAR gives 0, not 0 * inf */
-            float wx = w * ex, wy = w * ey, wz = w * ez;
-            acc[0][l] += w;
-            acc[1][l] += in;
-            acc[2][l] += wx;
-            acc[3][l] += wy;
-            acc[4][l] += wz;
-            acc[5][l] += wx * ex;
-            acc[6][l] += wx * ey;
-            acc[7][l] += wx * ez;
-            acc[8][l] += wy * ey;
-            acc[9][l] += wy * ez;
-            acc[10][l] += wz * ez;
-        }
-    for (int k = 0; k < 11; k++) {
-        double s = 0;
-        for (int l = 0; l < LANES; l++) s += acc[k][l];
-        out[k] = s;
+    const float r2 = r * r, ir = 1.0f / r, x0 = xi[0], y0 = xi[1], z0 = xi[2];
+    float sw = 0, sn = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+#pragma omp simd reduction(+ : sw, sn, sx, sy, sz, sxx, sxy, sxz, syy, syz, szz)
+    for (size_t q = 0; q < nb; q++) {
+        float ex = bx[q] - x0, ey = by[q] - y0, ez = bz[q] - z0;
+        float s2 = ex * ex + ey * ey + ez * ez;
+        float s = sqrtf(s2) * ir;
+        float in = s2 < r2 ? 1.0f : 0.0f;
+        float w = s2 < r2 ? 1.0f - s * s * s : 0.0f; /* a select: FAR gives 0, not 0 * inf */
+        float wx = w * ex, wy = w * ey, wz = w * ez;
+        sw += w;
+        sn += in;
+        sx += wx;
+        sy += wy;
+        sz += wz;
+        sxx += wx * ex;
+        sxy += wx * ey;
+        sxz += wx * ez;
+        syy += wy * ey;
+        syz += wy * ez;
+        szz += wz * ez;
     }
+    out[0] = sw;
+    out[1] = sn;
+    out[2] = sx;
+    out[3] = sy;
+    out[4] = sz;
+    out[5] = sxx;
+    out[6] = sxy;
+    out[7] = sxz;
+    out[8] = syy;
+    out[9] = syz;
+    out[10] = szz;
 }
 
 /* Kernels of n points: centres, anisotropy, in grid cells of cellw. surf[i] (may be NULL) gets
