@@ -344,9 +344,19 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
     for (size_t i = 0; i < 3 * n; i++) cell[i] = (int32_t)floor(x[i] / cs);
     rc = grid_build(&g, cell, n);
     free(cell);
-    if (rc) {
+    /* positions in units of d, in cell order: the candidates' gather reads them contiguously */
+    double *ps = rc ? NULL : malloc(3 * (n ? n : 1) * sizeof *ps);
+    if (rc || !ps) {
         grid_free(&g);
-        return rc;
+        return rc ? rc : PFSPH_ENOMEM;
+    }
+    const double inv_d = 1.0 / d, csd = 0.5 * r;
+    double *xs = ps, *ys = ps + n, *zs = ps + 2 * n;
+    for (size_t q = 0; q < n; q++) {
+        const double *xq = x + 3 * (size_t)g.idx[q];
+        xs[q] = xq[0] * inv_d;
+        ys[q] = xq[1] * inv_d;
+        zs[q] = xq[2] * inv_d;
     }
     float rmax = 0;
     int fail = 0;
@@ -359,7 +369,7 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
         for (size_t U = 0; U < g.nu; U++) {
             if (fail) continue;
             const int32_t *uc = g.ucell + 3 * U;
-            const double corner[3] = {uc[0] * cs, uc[1] * cs, uc[2] * cs};
+            const double cx = uc[0] * csd, cy = uc[1] * csd, cz = uc[2] * csd; /* the cell's corner / d */
             size_t nb = 0;
             /* the 5 x 5 columns of 5 cells within two cells: every point within r = 2 cells */
             for (int64_t a = uc[0] - 2; a <= uc[0] + 2; a++)
@@ -379,12 +389,11 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
                         }
                     }
                     for (uint32_t q = s; q < e; q++) {
-                        const double *xj = x + 3 * (size_t)g.idx[q];
-                        bx[nb] = (float)((xj[0] - corner[0]) / d);
-                        by[nb] = (float)((xj[1] - corner[1]) / d);
-                        bz[nb] = (float)((xj[2] - corner[2]) / d);
-                        nb++;
+                        bx[nb + q - s] = (float)(xs[q] - cx);
+                        by[nb + q - s] = (float)(ys[q] - cy);
+                        bz[nb + q - s] = (float)(zs[q] - cz);
                     }
+                    nb += e - s;
                 }
             if (fail) continue;
             while (nb % LANES) {
@@ -394,8 +403,7 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
             for (uint32_t q = g.ustart[U]; q < g.ustart[U + 1]; q++) {
                 const size_t i = g.idx[q];
                 const double *xi = x + 3 * i;
-                const float xr[3] = {(float)((xi[0] - corner[0]) / d), (float)((xi[1] - corner[1]) / d),
-                                     (float)((xi[2] - corner[2]) / d)};
+                const float xr[3] = {(float)(xs[q] - cx), (float)(ys[q] - cy), (float)(zs[q] - cz)};
                 double S[11];
                 pca_sums(bx, by, bz, nb, xr, (float)r, S);
                 const double sw = S[0];
@@ -460,6 +468,7 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
         free(bz);
     }
     grid_free(&g);
+    free(ps);
     *rad_max = rmax;
     return fail ? PFSPH_ENOMEM : PFSPH_OK;
 }
