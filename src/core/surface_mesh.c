@@ -438,11 +438,12 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
                 if (surf) surf[i] = (uint8_t)(cnt < n_eps || flat || off > 0.1 * r);
                 kern *k = K + i;
                 /* G = V diag(cellw / (h s)) V^T: cell offsets to unit-kernel coordinates */
-                double G[3][3];
+                double G[3][3], is[3];
+                for (int a = 0; a < 3; a++) is[a] = cellw / (h * scale[a]);
                 for (int u = 0; u < 3; u++)
                     for (int v = 0; v < 3; v++) {
                         double acc = 0;
-                        for (int a = 0; a < 3; a++) acc += V[u][a] * V[v][a] * cellw / (h * scale[a]);
+                        for (int a = 0; a < 3; a++) acc += V[u][a] * V[v][a] * is[a];
                         G[u][v] = acc;
                     }
                 k->g[0] = (float)G[0][0];
