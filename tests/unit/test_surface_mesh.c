@@ -238,6 +238,38 @@ static void test_threads(void **state)
     free(x);
 }
 
+/* A drop far from the sphere (metres away: the cell lists switch from a dense box to sorted
+ * keys) changes nothing of the sphere's surface: its vertices come out bit for bit as alone, and
+ * the drop is a second closed component. */
+static void test_far_drop(void **state)
+{
+    (void)state;
+    const double c[3] = {0.0012, -0.0007, 0.0003}, far[3] = {2.0, 1.5, -1.8};
+    double *x = malloc(3 * 4000 * sizeof *x);
+    size_t n0 = sphere(x, 0, c, 8.5 * D);
+    pfsph_surface_mesh a, b;
+    reconstruct(x, n0, &a);
+    size_t n = sphere(x, n0, far, 3 * D);
+    reconstruct(x, n, &b);
+    assert_int_equal(check_manifold(&b), 4);
+    assert_int_equal(components(&b), 2);
+    size_t k = 0;
+    for (size_t i = 0; i < b.nverts; i++) {
+        const double *v = b.v + 3 * i;
+        if (fabs(v[0] - c[0]) > 0.5) continue;
+        assert_true(k < a.nverts);
+        assert_memory_equal(v, a.v + 3 * k, 3 * sizeof *v);
+        assert_memory_equal(b.n + 3 * i, a.n + 3 * k, 3 * sizeof *b.n);
+        k++;
+    }
+    assert_int_equal(k, a.nverts);
+    printf("far drop: %zu + %zu particles, the sphere's %zu vertices unchanged, the drop's %zu\n", n0, n - n0,
+           a.nverts, b.nverts - a.nverts);
+    pfsph_surface_mesh_free(&a);
+    pfsph_surface_mesh_free(&b);
+    free(x);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -246,6 +278,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_box),
         cmocka_unit_test(test_two_drops),
         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_far_drop),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
