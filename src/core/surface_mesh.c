@@ -24,7 +24,7 @@
 #define NEDGE (BNODES * 7) /* edges of a block: lower node x direction (1..7 as xyz bits) */
 #define MAXTRI (BS * BS * BS * 12)
 #define COORD_BITS 21
-#define LANES 8          /* PCA accumulators: lane l takes candidates l, l + 8, ... */
+#define LANES 8          /* PCA candidates are padded to a multiple of this (any vector width) */
 #define FAR 1e18f        /* padding candidate: beyond every radius, squares stay finite */
 #define PI 3.14159265358979323846
 
@@ -287,9 +287,9 @@ static double lattice_sigma(double r)
 
 /* weighted sums over the candidates (bx, by, bz: offsets in units of d from the cell's corner,
  * padded with FAR to a multiple of LANES) of the point xi: weight, count, first and second
- * moments. A vectorised reduction: its order is fixed by the code and the buffers (16-byte
- * aligned from malloc), so the same bits on any thread. Eleven scalar sums keep the vector
- * accumulators in registers (explicit lanes of eight spilled them). */
+ * moments. A vectorised reduction: its order is fixed by the code, the length and the buffers'
+ * 64-byte alignment, so the same bits on any thread and in any run. Eleven scalar sums keep the
+ * vector accumulators in registers (explicit lanes of eight spilled them). */
 static void pca_sums(const float *bx, const float *by, const float *bz, size_t nb, const float xi[3], float r,
                      double out[11])
 {
@@ -362,8 +362,11 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
     int fail = 0;
 #pragma omp parallel reduction(max : rmax) reduction(| : fail)
     {
+        /* 64-byte aligned: a vectorised reduction then splits the same way whatever the vector
+         * width and wherever the buffer lies (the same bits in every run) */
         size_t cap = 1024;
-        float *bx = malloc(cap * sizeof *bx), *by = malloc(cap * sizeof *by), *bz = malloc(cap * sizeof *bz);
+        float *bx = aligned_alloc(64, cap * sizeof *bx), *by = aligned_alloc(64, cap * sizeof *by),
+              *bz = aligned_alloc(64, cap * sizeof *bz);
         if (!bx || !by || !bz) fail = 1;
 #pragma omp for schedule(dynamic, 16)
         for (size_t U = 0; U < g.nu; U++) {
@@ -377,13 +380,18 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
                     uint32_t s, e;
                     grid_col(&g, a, b, (int64_t)uc[2] - 2, (int64_t)uc[2] + 2, &s, &e);
                     if (nb + (e - s) + LANES > cap) {
-                        while (nb + (e - s) + LANES > cap) cap *= 2;
-                        float *t0 = realloc(bx, cap * sizeof *bx), *t1 = t0 ? realloc(by, cap * sizeof *by) : NULL,
-                              *t2 = t1 ? realloc(bz, cap * sizeof *bz) : NULL;
-                        if (t0) bx = t0;
-                        if (t1) by = t1;
-                        if (t2) bz = t2;
-                        if (!t2) {
+                        size_t nc = cap;
+                        while (nb + (e - s) + LANES > nc) nc *= 2;
+                        float *t[3] = {aligned_alloc(64, nc * sizeof *bx), aligned_alloc(64, nc * sizeof *bx),
+                                       aligned_alloc(64, nc * sizeof *bx)};
+                        float **old[3] = {&bx, &by, &bz};
+                        for (int u = 0; u < 3; u++) {
+                            if (t[u]) memcpy(t[u], *old[u], nb * sizeof *bx);
+                            free(*old[u]);
+                            *old[u] = t[u];
+                        }
+                        cap = nc;
+                        if (!bx || !by || !bz) {
                             fail = 1;
                             break;
                         }
