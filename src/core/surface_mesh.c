@@ -602,7 +602,7 @@ static int bmap_put(bmap *m, int64_t key, int32_t v)
  * beyond any rounding and would add exactly nothing: a node gets the same terms in every block. */
 #define GROW 1.0001f
 #define MARGIN 1e-3f
-static void splat(float *restrict fv, const kern *k, const int32_t O[3])
+static void splat(float *restrict fv, const kern *k, const int32_t O[3], const int8_t rlo[BN], const int8_t rhi[BN])
 {
     const float *g = k->g, rad = k->rad * GROW + MARGIN; /* bounds: a superset of the support */
     float cen[3];
@@ -621,12 +621,13 @@ static void splat(float *restrict fv, const kern *k, const int32_t O[3])
     float us[BN];
     for (int a = 0; a < BN; a++) us[a] = (float)(ux0 + a) - k->f[0];
     for (int c = c0; c <= c1; c++) {
+        if (rlo[c] > rhi[c]) continue; /* no row of this slice wanted */
         const float w = (float)(O[2] + c - k->I[2]) - k->f[2];
         /* rows: sa v^2 + 2 sb w v + sc w^2 < GROW, v = (y - I) - f */
         const float B = sb * w, disc = B * B - sa * (sc * w * w - GROW);
         if (disc < 0) continue;
         const float sq = sqrtf(disc), ylo = cen[1] + (-B - sq) * isa - MARGIN, yhi = cen[1] + (-B + sq) * isa + MARGIN;
-        const int b0 = ylo < 0 ? 0 : (int)ceilf(ylo), b1 = yhi > BS ? BS : (int)floorf(yhi);
+        const int b0 = ylo < rlo[c] ? rlo[c] : (int)ceilf(ylo), b1 = yhi > rhi[c] ? rhi[c] : (int)floorf(yhi);
         const float wr0 = g[2] * w, wr1 = g[4] * w, wr2 = g[5] * w;
         for (int b = b0; b <= b1; b++) {
             const float v = (float)(vy0 + b) - k->f[1];
@@ -646,18 +647,30 @@ static void splat(float *restrict fv, const kern *k, const int32_t O[3])
     }
 }
 
-/* node values of a block: the kernels whose centres lie in the block cells within R, visited in
+/* node values of a block (the rows (b, c) set in `rows`, bit b + 8 c; the others 0): the kernels
+ * whose centres lie in the block cells within R, visited in
  * ascending cell then index order; a node shared with another block sees its kernels in the same
  * order there (both visit the same global order), so it gets the same sum, bit for bit */
-static void block_field(block *bl, const kern *K, const grid *kg, int R)
+static void block_field(block *bl, const kern *K, const grid *kg, int R, uint64_t rows)
 {
     memset(bl->f, 0, BNODES * sizeof *bl->f);
+    int8_t rlo[BN], rhi[BN]; /* the rows wanted in a slice form one range (own rows, then faces) */
+    for (int c = 0; c < BN; c++) {
+        unsigned m = (unsigned)(rows >> (BN * c)) & 0xffu;
+        rlo[c] = BN;
+        rhi[c] = -1;
+        for (int b = 0; b < BN; b++)
+            if (m >> b & 1) {
+                if (rlo[c] == BN) rlo[c] = (int8_t)b;
+                rhi[c] = (int8_t)b;
+            }
+    }
     const int32_t O[3] = {bl->b[0] * BS, bl->b[1] * BS, bl->b[2] * BS};
     for (int64_t a = (int64_t)bl->b[0] - R; a <= (int64_t)bl->b[0] + R; a++)
         for (int64_t b = (int64_t)bl->b[1] - R; b <= (int64_t)bl->b[1] + R; b++) {
             uint32_t s, e;
             grid_col(kg, a, b, (int64_t)bl->b[2] - R, (int64_t)bl->b[2] + R, &s, &e);
-            for (uint32_t q = s; q < e; q++) splat(bl->f, K + kg->idx[q], O);
+            for (uint32_t q = s; q < e; q++) splat(bl->f, K + kg->idx[q], O, rlo, rhi);
         }
 }
 
@@ -1002,6 +1015,7 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
     grid kg = {0};
     int64_t *pend = NULL;
     uint32_t *need = NULL;
+    int32_t *src = NULL; /* 3 per block: the blocks at +y, +z, +y+z that hold its face rows, or -1 */
     size_t *voff = NULL, *toff = NULL;
     int rc = PFSPH_ENOMEM;
     if (!K || !surf || !kc) goto out;
@@ -1045,9 +1059,11 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
             while (nc < nb + np) nc *= 2;
             block *t = realloc(bl, nc * sizeof *t);
             uint32_t *tn = realloc(need, nc * sizeof *tn);
+            int32_t *ts = realloc(src, 3 * nc * sizeof *ts);
             if (t) bl = t;
             if (tn) need = tn;
-            if (!t || !tn) goto out;
+            if (ts) src = ts;
+            if (!t || !tn || !ts) goto out;
             cb = nc;
         }
         for (size_t i = 0; i < np; i++) {
@@ -1061,11 +1077,40 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
         }
         live += np;
         if (live > peak) peak = live;
-#pragma omp parallel for schedule(dynamic, 1)
+        /* The node rows on a block's +y and +z faces are the first rows of the blocks there: taken
+         * from those blocks where they exist (from earlier generations or this one), computed
+         * otherwise. Either way the same bits (a node's sum is the same in every block). */
+        static const int NB_OFF[3][3] = {{0, 1, 0}, {0, 0, 1}, {0, 1, 1}};
+        uint64_t *rows = malloc((nb - first) * sizeof *rows);
+        if (!rows) goto out;
         for (size_t i = first; i < nb; i++) {
+            uint64_t m = 0;
+            for (int c = 0; c < BS; c++) m |= (uint64_t)0x7f << (BN * c); /* own rows: b, c < BS */
+            for (int g = 0; g < 3; g++) {
+                int j = bmap_find(&map, pack3((int64_t)bl[i].b[0] + NB_OFF[g][0], (int64_t)bl[i].b[1] + NB_OFF[g][1],
+                                              (int64_t)bl[i].b[2] + NB_OFF[g][2]));
+                src[3 * i + g] = j >= 0 && bl[j].f ? j : -1;
+                if (src[3 * i + g] >= 0) continue;
+                if (g == 0)
+                    for (int c = 0; c < BS; c++) m |= (uint64_t)1 << (BS + BN * c);
+                else if (g == 1) m |= (uint64_t)0x7f << (BN * BS);
+                else m |= (uint64_t)1 << (BS + BN * BS);
+            }
+            rows[i - first] = m;
+        }
+#pragma omp parallel for schedule(dynamic, 1)
+        for (size_t i = first; i < nb; i++) block_field(bl + i, K, &kg, R, rows[i - first]);
+        free(rows);
+#pragma omp parallel for schedule(dynamic, 4)
+        for (size_t i = first; i < nb; i++) {
+            float *f = bl[i].f;
+            if (src[3 * i] >= 0)
+                for (int c = 0; c < BS; c++) memcpy(f + NIDX(0, BS, c), bl[src[3 * i]].f + NIDX(0, 0, c), BN * sizeof *f);
+            if (src[3 * i + 1] >= 0)
+                for (int b = 0; b < BS; b++) memcpy(f + NIDX(0, b, BS), bl[src[3 * i + 1]].f + NIDX(0, b, 0), BN * sizeof *f);
+            if (src[3 * i + 2] >= 0) memcpy(f + NIDX(0, BS, BS), bl[src[3 * i + 2]].f + NIDX(0, 0, 0), BN * sizeof *f);
             int any;
-            block_field(bl + i, K, &kg, R);
-            need[i] = block_needs(bl[i].f, iso, &any);
+            need[i] = block_needs(f, iso, &any);
             if (!any) need[i] |= 1u << 31; /* not crossed: not kept */
         }
         /* crossed cells on a block's rim call for the blocks of their neighbour cells */
@@ -1167,6 +1212,7 @@ out:
     free(map.val);
     free(pend);
     free(need);
+    free(src);
     free(voff);
     free(toff);
     grid_free(&kg);
