@@ -23,15 +23,21 @@ int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, doubl
  * PFSPH_EINPUT naming the path for a malformed file or a face that is not a triangle. */
 int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time, pfsph_error *err);
 
+/* VTP PolyData of a 2D outline: points (z = 0), Normals (point data), Lines (one per segment),
+ * phase (cell data), TimeValue. Atomic. */
+int pfsph_write_contour_vtp(const char *path, const pfsph_surface_contour *c, double time, pfsph_error *err);
+
 /* Reconstruct the surface of a frame's fluid particles with the scene's output.surface settings
- * and write RUN/frames/liquid_NNNNN.{ply,obj,vtp} (the formats it names). A 2D scene is
- * PFSPH_EINPUT (meshes are 3D only). st (may be NULL) receives the statistics (arrays freed). */
+ * and write RUN/frames/liquid_NNNNN.{ply,obj,vtp} (the formats it names); in 2D the outline as
+ * liquid_NNNNN.vtp polylines (VTP only). st (may be NULL) receives the statistics (arrays freed;
+ * zero in 2D). */
 int pfsph_mesh_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid, double time,
                      pfsph_surface_mesh *st, pfsph_error *err);
 
 /* Mesh every fluid frame of a finished run (RUN/scene.json, RUN/frames/fluid_NNNNN.vtp or .ply),
  * then rewrite the .pvd collections. `over` (may be NULL) replaces the scene's output.surface.
- * *frames gets the number meshed. */
+ * A 2D run gets VTP outlines; asking it for PLY or OBJ is PFSPH_EINPUT. *frames gets the number
+ * meshed. */
 int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frames, pfsph_error *err);
 
 /* Rewrite RUN/<set>.pvd for every frame set with .vtp files in RUN/frames (fluid, boundary,

@@ -1,6 +1,7 @@
 /* Liquid surface reconstruction: anisotropic kernels (Yu & Turk 2013), a colour field on a sparse
  * block grid that follows the surface, marching cubes (each cube split into six tetrahedra) and a
- * welded, closed triangle mesh with normals from the field's gradient. 3D only. docs/surfaces.md. */
+ * welded, closed triangle mesh with normals from the field's gradient; in 2D closed polylines from
+ * marching triangles. docs/surfaces.md. */
 #ifndef PFSPH_SURFACE_MESH_H
 #define PFSPH_SURFACE_MESH_H
 
@@ -55,5 +56,27 @@ int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n,
 double pfsph_surface_calibrate_iso(const pfsph_surface_opts *o);
 
 void pfsph_surface_mesh_free(pfsph_surface_mesh *m);
+
+/* A 2D liquid's outline: closed polylines in the plane z = 0, as segments with the liquid on
+ * their left (counter-clockwise around the liquid, clockwise around a hole). */
+typedef struct pfsph_surface_contour {
+    size_t nverts, nsegs;
+    double *v;      /* 3 * nverts (z = 0) */
+    float *n;       /* 3 * nverts unit outward normals (z = 0) */
+    uint32_t *seg;  /* 2 * nsegs: from, to */
+    uint8_t *phase; /* nsegs */
+} pfsph_surface_contour;
+
+/* The 2D counterpart of pfsph_surface_reconstruct: x holds 3 coordinates per particle (z
+ * ignored); the same options (smooth_iters unused). Every vertex starts one segment and ends one.
+ * Deterministic (serial). PFSPH_EINPUT as above, or when the grid over the particles would
+ * exceed 2^26 nodes; PFSPH_ENOMEM. */
+int pfsph_surface_contour2d(const double *x, const uint8_t *phase, size_t n, const pfsph_surface_opts *o,
+                            pfsph_surface_contour *c, pfsph_error *err);
+
+/* The iso-level of a calibrated 2D contour (a flat lattice slab, as in 3D). */
+double pfsph_surface_calibrate_iso2d(const pfsph_surface_opts *o);
+
+void pfsph_surface_contour_free(pfsph_surface_contour *c);
 
 #endif

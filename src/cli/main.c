@@ -43,7 +43,7 @@ static const char *HELP =
     "  check    validate a scene: particle counts, memory estimate, coefficients\n"
     "  render   PNG previews (and an mp4) of a run directory's frames\n"
     "  export   Houdini geometry (.geo) of a run directory's fluid frames\n"
-    "  mesh     liquid surface meshes (PLY, OBJ, VTP) of a 3D run directory's fluid frames\n"
+    "  mesh     liquid surface meshes (PLY, OBJ, VTP) of a run directory's fluid frames (2D: outlines)\n"
     "  view     a window: a scene simulated live, or a run directory replayed\n"
     "  help     this text, or a command's: pfsph help run\n"
     "  --version  the version, precision and OpenMP thread count\n"
@@ -107,7 +107,7 @@ static const char *HELP_RENDER =
 static const char *HELP_MESH =
     "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
     "\n"
-    "Reconstruct the liquid surface of every fluid frame of RUN_DIR (a finished or stopped 3D\n"
+    "Reconstruct the liquid surface of every fluid frame of RUN_DIR (a finished or stopped\n"
     "run) into RUN_DIR/frames/liquid_NNNNN.{ply,obj,vtp}, one closed mesh per fluid phase with\n"
     "the phase per face, and rewrite the .pvd collections. Anisotropic kernels (Yu & Turk 2013);\n"
     "docs/surfaces.md. Settings default to the scene's output.surface.\n"
@@ -118,7 +118,8 @@ static const char *HELP_MESH =
     "  --threads N     OpenMP threads (the meshes are the same bytes for any count)\n"
     "  -h, --help      this text\n"
     "\n"
-    "A 2D run is refused (exit status 2): meshes are 3D only.\n";
+    "A 2D run gets the liquid's outline as VTP polylines (liquid_NNNNN.vtp) instead; PLY or OBJ\n"
+    "for a 2D run is refused (exit status 2).\n";
 
 static const char *HELP_EXPORT =
     "usage: pfsph export RUN_DIR --houdini\n"

@@ -1,5 +1,5 @@
-/* Liquid surface files (PLY, OBJ, VTP with the phase per face), meshing a run's frames, and the
- * ParaView .pvd collections of a run directory. */
+/* Liquid surface files (PLY, OBJ, VTP with the phase per face; 2D outlines as VTP polylines),
+ * meshing a run's frames, and the ParaView .pvd collections of a run directory. */
 #include "pfsph/meshing.h"
 
 #include <dirent.h>
@@ -250,7 +250,31 @@ done:
     return rc;
 }
 
-static int mesh_particles(const pfsph_surface_output *so, double spacing, const char *dir, int frame,
+int pfsph_write_contour_vtp(const char *path, const pfsph_surface_contour *c, double time, pfsph_error *err)
+{
+    pfsph__afile af;
+    pfsph__enc e;
+    int rc = pfsph__enc_open(&e, &af, path, err);
+    if (rc != PFSPH_OK) return rc;
+    pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n");
+    pfsph__enc_printf(&e, "<FieldData>\n<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n</FieldData>\n", time);
+    pfsph__enc_printf(&e, "<Piece NumberOfPoints=\"%zu\" NumberOfLines=\"%zu\">\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n", c->nverts, c->nsegs);
+    for (size_t i = 0; i < c->nverts; i++)
+        pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", c->v[3 * i], c->v[3 * i + 1], c->v[3 * i + 2]);
+    pfsph__enc_printf(&e, "</DataArray>\n</Points>\n<PointData Normals=\"Normals\">\n<DataArray type=\"Float32\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (size_t i = 0; i < c->nverts; i++)
+        pfsph__enc_printf(&e, "%.5f %.5f %.5f\n", c->n[3 * i], c->n[3 * i + 1], c->n[3 * i + 2]);
+    pfsph__enc_printf(&e, "</DataArray>\n</PointData>\n<Lines>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n");
+    for (size_t t = 0; t < c->nsegs; t++) pfsph__enc_printf(&e, "%u %u\n", c->seg[2 * t], c->seg[2 * t + 1]);
+    pfsph__enc_printf(&e, "</DataArray>\n<DataArray type=\"UInt32\" Name=\"offsets\" format=\"ascii\">\n");
+    for (size_t t = 1; t <= c->nsegs; t++) pfsph__enc_printf(&e, "%zu\n", 2 * t);
+    pfsph__enc_printf(&e, "</DataArray>\n</Lines>\n<CellData Scalars=\"phase\">\n<DataArray type=\"UInt8\" Name=\"phase\" format=\"ascii\">\n");
+    for (size_t t = 0; t < c->nsegs; t++) pfsph__enc_printf(&e, "%d\n", c->phase[t]);
+    pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
+    return finish(&e, &af, err);
+}
+
+static int mesh_particles(const pfsph_surface_output *so, int dim, double spacing, const char *dir, int frame,
                           const pfsph_particles *ps, double time, pfsph_surface_mesh *st, pfsph_error *err)
 {
     double *x = malloc(3 * (ps->n ? ps->n : 1) * sizeof *x);
@@ -265,11 +289,22 @@ static int mesh_particles(const pfsph_surface_output *so, double spacing, const 
     o.isotropic = so->isotropic;
     o.smooth_iters = so->smoothing;
     o.cell = so->cell;
+    char path[PFSPH_PATH_LEN + 64];
+    if (dim == 2) { /* the outline as polylines, VTP only (docs/surfaces.md#2d-contours) */
+        pfsph_surface_contour c;
+        int rc = pfsph_surface_contour2d(x, ps->phase, ps->n, &o, &c, err);
+        free(x);
+        if (rc) return rc;
+        snprintf(path, sizeof path, "%s/frames/liquid_%05d.vtp", dir, frame);
+        rc = pfsph_write_contour_vtp(path, &c, time, err);
+        pfsph_surface_contour_free(&c);
+        if (st) memset(st, 0, sizeof *st);
+        return rc;
+    }
     pfsph_surface_mesh m;
     int rc = pfsph_surface_reconstruct(x, ps->phase, ps->n, &o, &m, err);
     free(x);
     if (rc) return rc;
-    char path[PFSPH_PATH_LEN + 64];
     if (so->ply) {
         snprintf(path, sizeof path, "%s/frames/liquid_%05d.ply", dir, frame);
         rc = pfsph_write_surface_ply(path, &m, time, err);
@@ -297,10 +332,7 @@ static int mesh_particles(const pfsph_surface_output *so, double spacing, const 
 int pfsph_mesh_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid, double time,
                      pfsph_surface_mesh *st, pfsph_error *err)
 {
-    if (s->dim != 3)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: surface meshes are made for 3D scenes only (this one is 2D)",
-                          s->source);
-    return mesh_particles(&s->output.surface, 2 * s->particle_radius, dir, frame, fluid, time, st, err);
+    return mesh_particles(&s->output.surface, s->dim, 2 * s->particle_radius, dir, frame, fluid, time, st, err);
 }
 
 /* frame files "<set>_NNNNN.<ext>" in RUN/frames: the largest number, -1 when none */
@@ -343,13 +375,16 @@ int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frame
         free(s);
         return rc;
     }
-    if (s->dim != 3) {
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: a 2D run: surface meshes are made for 3D runs only; nothing written",
-                        dir);
-        free(s);
-        return rc;
-    }
     pfsph_surface_output so = over ? *over : s->output.surface;
+    if (s->dim == 2) {
+        if (so.ply || so.obj) {
+            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: a 2D run: its outline is written as VTP polylines only "
+                            "(--formats vtp); nothing written", dir);
+            free(s);
+            return rc;
+        }
+        so.vtp = true;
+    }
     if (!so.ply && !so.obj && !so.vtp) so.ply = so.vtp = true;
     snprintf(frames_dir, sizeof frames_dir, "%s/frames", dir);
     const char *ext = "vtp";
@@ -373,7 +408,7 @@ int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frame
         double t = k * frame_dt;
         rc = ext[0] == 'v' ? pfsph_read_vtp(path, &ps, &t, err) : pfsph_read_ply(path, &ps, &t, err);
         if (rc) break;
-        rc = mesh_particles(&so, 2 * s->particle_radius, dir, (int)k, &ps, t, NULL, err);
+        rc = mesh_particles(&so, s->dim, 2 * s->particle_radius, dir, (int)k, &ps, t, NULL, err);
         pfsph_particles_free(&ps);
         if (!rc) (*frames)++;
     }

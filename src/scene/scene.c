@@ -851,8 +851,14 @@ static int parse_surface(parser *p, const cJSON *v)
         }
     } else
         return pfsph__json_fail(&p->ctx, P, "expected true, false or an object (formats, smoothing, isotropic, cell)");
-    if (o->on && p->s->dim != 3)
-        return pfsph__json_fail(&p->ctx, P, "surface meshes are made for 3D scenes only (this scene is 2D)");
+    /* 2D: the outline as VTP polylines only (docs/surfaces.md#2d-contours) */
+    if (o->on && p->s->dim == 2) {
+        if (get(v, "formats") && (o->ply || o->obj))
+            return pfsph__json_fail(&p->ctx, "$.output.surface.formats",
+                                    "a 2D scene's outline is written as VTP polylines only (formats [\"vtp\"])");
+        o->ply = o->obj = false;
+        o->vtp = true;
+    }
     return PFSPH_OK;
 }
 

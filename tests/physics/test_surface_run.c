@@ -1,7 +1,7 @@
 /* Liquid surfaces in a run (issue 14): output.surface meshes while running, `pfsph mesh` gives
  * the same bytes afterwards with another thread count, the meshes are closed, the .pvd
- * collections list every frame, frame 0 carries densities, 2D and bad keys are refused with the
- * JSON path, diffuse frames name their class "type" and carry no density or pressure. */
+ * collections list every frame, frame 0 carries densities, a 2D run gets closed VTP outlines
+ * (the same bytes again from `pfsph mesh`), PLY for 2D and bad keys are refused with the JSON path, diffuse frames name their class "type" and carry no density or pressure. */
 #include <png.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -246,19 +246,89 @@ static void test_render_meshes(void **state)
     assert_int_equal(parts, 0);
 }
 
+static const char *SCENE2 =
+    "{\"dimension\": 2, \"particle_radius\": 0.01, \"gravity\": [0, -9.81],\n"
+    " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.7, 0.6]}, \"time\": {\"end\": 0.1, \"fps\": 20},\n"
+    " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}],\n"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.2, 0.3], \"phase\": \"water\"}],\n"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.6, 0.5], \"open_top\": true,\n"
+    "             \"phase\": \"wall\"}],\n"
+    " \"output\": {\"formats\": [\"vtp\"], \"surface\": true}}\n";
+
+/* 2D: output.surface writes the outline as VTP polylines while running (closed: every point
+ * starts one line and ends one), `pfsph mesh` gives the same bytes, liquid.pvd lists them, and
+ * PLY or OBJ for a 2D run is refused */
+static void test_contour_run(void **state)
+{
+    (void)state;
+    char out[8192], path[1400], run[1200], scene[1200];
+    snprintf(scene, sizeof scene, "%s/s2run.json", tu_tmpdir());
+    snprintf(run, sizeof run, "%s/run2", tu_tmpdir());
+    assert_int_equal(tu_write_file(scene, SCENE2), 0);
+    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --threads 2 --quiet", scene, run), 0);
+    size_t len, len2;
+    unsigned char *first[3];
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/frames/liquid_%05d.vtp", run, k);
+        first[k] = slurp(path, &len);
+        assert_non_null(first[k]);
+        const char *t = (const char *)first[k];
+        size_t np = 0, nl = 0;
+        assert_int_equal(sscanf(strstr(t, "<Piece"), "<Piece NumberOfPoints=\"%zu\" NumberOfLines=\"%zu\"", &np, &nl), 2);
+        printf("frame %d: %zu points, %zu lines\n", k, np, nl);
+        assert_true(np > 50);
+        assert_int_equal(np, nl);
+        int *seen_from = calloc(np, sizeof *seen_from), *seen_to = calloc(np, sizeof *seen_to);
+        const char *c = strstr(t, "Name=\"connectivity\"");
+        c = strchr(c, '\n') + 1;
+        for (size_t l = 0; l < nl; l++) {
+            unsigned a, b;
+            int used;
+            assert_int_equal(sscanf(c, "%u %u%n", &a, &b, &used), 2);
+            c += used;
+            assert_true(a < np && b < np && a != b);
+            seen_from[a]++;
+            seen_to[b]++;
+        }
+        for (size_t i = 0; i < np; i++) {
+            assert_int_equal(seen_from[i], 1);
+            assert_int_equal(seen_to[i], 1);
+        }
+        free(seen_from);
+        free(seen_to);
+    }
+    snprintf(path, sizeof path, "%s/liquid.pvd", run);
+    char *pvd = (char *)slurp(path, &len);
+    assert_non_null(pvd);
+    assert_int_equal(count(pvd, "<DataSet "), 3);
+    free(pvd);
+    assert_int_equal(pf(out, sizeof out, "mesh '%s' --threads 1", run), 0);
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/frames/liquid_%05d.vtp", run, k);
+        unsigned char *again = slurp(path, &len2);
+        assert_non_null(again);
+        assert_int_equal(strlen((const char *)first[k]), len2);
+        assert_memory_equal(first[k], again, len2);
+        free(again);
+        free(first[k]);
+    }
+    assert_int_equal(pf(out, sizeof out, "mesh '%s' --formats ply", run), 2);
+    assert_non_null(strstr(out, "VTP"));
+}
+
 static void test_refusals(void **state)
 {
     (void)state;
     char out[8192], path[1400];
-    /* output.surface in a 2D scene, a bad format: exit 2 with the JSON path */
+    /* PLY for a 2D scene's outline, a bad format: exit 2 with the JSON path */
     snprintf(path, sizeof path, "%s/s2.json", tu_tmpdir());
     assert_int_equal(tu_write_file(path,
         "{\"dimension\": 2, \"particle_radius\": 0.01, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},\n"
         " \"phases\": [{\"name\": \"water\"}], \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.1, 0.1]}],\n"
-        " \"output\": {\"surface\": true}}\n"), 0);
+        " \"output\": {\"surface\": {\"formats\": [\"ply\"]}}}\n"), 0);
     assert_int_equal(pf(out, sizeof out, "check '%s'", path), 2);
-    assert_non_null(strstr(out, "$.output.surface"));
-    assert_non_null(strstr(out, "3D"));
+    assert_non_null(strstr(out, "$.output.surface.formats"));
+    assert_non_null(strstr(out, "VTP"));
     snprintf(path, sizeof path, "%s/s3bad.json", tu_tmpdir());
     char text[2048];
     snprintf(text, sizeof text, "%s", SCENE3);
@@ -306,6 +376,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_run_and_mesh),
         cmocka_unit_test(test_render_meshes),
+        cmocka_unit_test(test_contour_run),
         cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_diffuse_type),
         cmocka_unit_test(test_houdini_roundtrip),

@@ -1,5 +1,5 @@
 /* The artist's pipeline in the real tools (label "tools", issue 14): ParaView's pvpython opens a
- * run's .pvd collections as time series with the point arrays; Blender (background mode) runs the
+ * run's .pvd collections as time series with the point arrays (a 2D run's outline too); Blender (background mode) runs the
  * loader on a small run (object count, frame range, the mesh face counts of the PLY files) and the
  * render script writes a PNG. Each test is skipped when its program is not installed. */
 #include <math.h>
@@ -95,6 +95,41 @@ static void test_paraview(void **state)
     assert_non_null(strstr(j, "\"point_arrays\": [\"Normals\"]"));
 }
 
+/* a 2D run's outline (liquid.pvd of VTP polylines): a time series with Normals and phase, as many
+ * line cells as points (closed curves) */
+static void test_paraview_2d(void **state)
+{
+    (void)state;
+    if (!have("pvpython")) skip();
+    char scene[1400], run[1400], cmd[4096], out[16384];
+    snprintf(scene, sizeof scene, "%s/outline.json", tu_tmpdir());
+    snprintf(run, sizeof run, "%s/outline", tu_tmpdir());
+    assert_int_equal(tu_write_file(scene,
+        "{\"dimension\": 2, \"particle_radius\": 0.01, \"gravity\": [0, -9.81],\n"
+        " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.7, 0.6]}, \"time\": {\"end\": 0.1, \"fps\": 20},\n"
+        " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}],\n"
+        " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.2, 0.3], \"phase\": \"water\"}],\n"
+        " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.6, 0.5], \"open_top\": true,\n"
+        "             \"phase\": \"wall\"}],\n"
+        " \"output\": {\"formats\": [\"vtp\"], \"surface\": true}}\n"), 0);
+    snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet", tu_pfsph_bin(), scene, run);
+    assert_int_equal(tu_run(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "pvpython '%s/tools/paraview/pfsph_pvd_info.py' '%s/liquid.pvd'", tu_source_dir(), run);
+    int st = tu_run(cmd, out, sizeof out);
+    printf("%s", out);
+    assert_int_equal(st, 0);
+    const char *j = json_after(out, "pfsph_pvd_info: ");
+    assert_non_null(j);
+    assert_non_null(strstr(j, "\"steps\": 3"));
+    assert_non_null(strstr(j, "\"cell_arrays\": [\"phase\"]"));
+    assert_non_null(strstr(j, "\"point_arrays\": [\"Normals\"]"));
+    long pts = -1, cells = -2;
+    const char *p = strstr(j, "\"points\": "), *c = strstr(j, "\"cells\": ");
+    assert_true(p && c && sscanf(p, "\"points\": %ld", &pts) == 1 && sscanf(c, "\"cells\": %ld", &cells) == 1);
+    assert_true(pts > 50);
+    assert_int_equal(cells, pts);
+}
+
 static long ply_faces(const char *path)
 {
     FILE *f = fopen(path, "rb");
@@ -183,6 +218,7 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_paraview),
+        cmocka_unit_test(test_paraview_2d),
         cmocka_unit_test(test_blender_load),
         cmocka_unit_test(test_blender_render),
     };

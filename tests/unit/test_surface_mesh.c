@@ -238,6 +238,148 @@ static void test_threads(void **state)
     free(x);
 }
 
+/* A drop far from the sphere (metres away: the cell lists switch from a dense box to sorted
+ * keys) changes nothing of the sphere's surface: its vertices come out bit for bit as alone, and
+ * the drop is a second closed component. */
+static void test_far_drop(void **state)
+{
+    (void)state;
+    const double c[3] = {0.0012, -0.0007, 0.0003}, far[3] = {2.0, 1.5, -1.8};
+    double *x = malloc(3 * 4000 * sizeof *x);
+    size_t n0 = sphere(x, 0, c, 8.5 * D);
+    pfsph_surface_mesh a, b;
+    reconstruct(x, n0, &a);
+    size_t n = sphere(x, n0, far, 3 * D);
+    reconstruct(x, n, &b);
+    assert_int_equal(check_manifold(&b), 4);
+    assert_int_equal(components(&b), 2);
+    size_t k = 0;
+    for (size_t i = 0; i < b.nverts; i++) {
+        const double *v = b.v + 3 * i;
+        if (fabs(v[0] - c[0]) > 0.5) continue;
+        assert_true(k < a.nverts);
+        assert_memory_equal(v, a.v + 3 * k, 3 * sizeof *v);
+        assert_memory_equal(b.n + 3 * i, a.n + 3 * k, 3 * sizeof *b.n);
+        k++;
+    }
+    assert_int_equal(k, a.nverts);
+    printf("far drop: %zu + %zu particles, the sphere's %zu vertices unchanged, the drop's %zu\n", n0, n - n0,
+           a.nverts, b.nverts - a.nverts);
+    pfsph_surface_mesh_free(&a);
+    pfsph_surface_mesh_free(&b);
+    free(x);
+}
+
+/* 2D lattice points inside the disc |x - c| < R (z = 0) */
+static size_t disc(double *x, size_t at, const double c[2], double R)
+{
+    int m = (int)ceil(R / D) + 1;
+    for (int i = -m; i <= m; i++)
+        for (int j = -m; j <= m; j++) {
+            if ((double)(i * i + j * j) * D * D >= R * R) continue;
+            x[3 * at] = c[0] + i * D;
+            x[3 * at + 1] = c[1] + j * D;
+            x[3 * at + 2] = 0;
+            at++;
+        }
+    return at;
+}
+
+/* every vertex starts exactly one segment and ends exactly one; returns the number of loops */
+static int check_loops(const pfsph_surface_contour *c)
+{
+    int *out = calloc(c->nverts, sizeof *out), *inc = calloc(c->nverts, sizeof *inc);
+    uint32_t *next = malloc(c->nverts * sizeof *next);
+    for (size_t s = 0; s < c->nsegs; s++) {
+        uint32_t a = c->seg[2 * s], b = c->seg[2 * s + 1];
+        assert_true(a != b && a < c->nverts && b < c->nverts);
+        out[a]++;
+        inc[b]++;
+        next[a] = b;
+    }
+    for (size_t i = 0; i < c->nverts; i++) {
+        assert_int_equal(out[i], 1);
+        assert_int_equal(inc[i], 1);
+    }
+    int loops = 0;
+    for (size_t i = 0; i < c->nverts; i++) {
+        if (out[i] < 0) continue;
+        loops++;
+        for (uint32_t v = (uint32_t)i; out[v] >= 0; v = next[v]) out[v] = -1;
+    }
+    free(out);
+    free(inc);
+    free(next);
+    return loops;
+}
+
+static double contour_area(const pfsph_surface_contour *c)
+{
+    double a = 0;
+    for (size_t s = 0; s < c->nsegs; s++) {
+        const double *p = c->v + 3 * c->seg[2 * s], *q = c->v + 3 * c->seg[2 * s + 1];
+        a += p[0] * q[1] - q[0] * p[1];
+    }
+    return a / 2;
+}
+
+/* 2D: a lattice disc gives one closed counter-clockwise curve enclosing the particles' area n d^2
+ * within 2 %, near the circle of that area, with outward normals; two discs give two curves;
+ * 1 and 2 threads the same bytes */
+static void test_contour_2d(void **state)
+{
+    (void)state;
+    double *x = malloc(3 * 2000 * sizeof *x);
+    const double c0[2] = {0.0013, -0.0004}, c1[2] = {0.3, 0.1};
+    size_t n = disc(x, 0, c0, 12.5 * D);
+    pfsph_surface_opts o;
+    pfsph_surface_opts_default(&o, D);
+    pfsph_surface_contour c, c2;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_surface_contour2d(x, NULL, n, &o, &c, &err), 0);
+    assert_int_equal(check_loops(&c), 1);
+    const double A = (double)n * D * D, R = sqrt(A / PI), area = contour_area(&c);
+    double dsum = 0, dmax = 0;
+    size_t outward = 0;
+    for (size_t i = 0; i < c.nverts; i++) {
+        const double *v = c.v + 3 * i;
+        double rx = v[0] - c0[0], ry = v[1] - c0[1], dr = fabs(sqrt(rx * rx + ry * ry) - R);
+        dsum += dr;
+        if (dr > dmax) dmax = dr;
+        outward += rx * c.n[3 * i] + ry * c.n[3 * i + 1] > 0;
+    }
+    printf("disc: %zu particles, %zu vertices, %zu segments, area %.4f of n d^2, |r - R| mean %.3f d max %.3f d\n", n,
+           c.nverts, c.nsegs, area / A, dsum / (double)c.nverts / D, dmax / D);
+    assert_true(fabs(area / A - 1) < 0.02);
+    assert_true(dsum / (double)c.nverts < 0.1 * D);
+    assert_true(dmax < 0.4 * D);
+    assert_int_equal(outward, c.nverts);
+    pfsph_surface_contour_free(&c);
+    /* two discs (phases 0 and 2): two curves, faces tagged; threads do not matter */
+    size_t n0 = n;
+    n = disc(x, n0, c1, 6 * D);
+    uint8_t *ph = malloc(n);
+    for (size_t i = 0; i < n; i++) ph[i] = i < n0 ? 0 : 2;
+    omp_set_num_threads(1);
+    assert_int_equal(pfsph_surface_contour2d(x, ph, n, &o, &c, &err), 0);
+    omp_set_num_threads(2);
+    assert_int_equal(pfsph_surface_contour2d(x, ph, n, &o, &c2, &err), 0);
+    assert_int_equal(check_loops(&c), 2);
+    assert_int_equal(c.nverts, c2.nverts);
+    assert_int_equal(c.nsegs, c2.nsegs);
+    assert_memory_equal(c.v, c2.v, 3 * c.nverts * sizeof *c.v);
+    assert_memory_equal(c.seg, c2.seg, 2 * c.nsegs * sizeof *c.seg);
+    size_t p2 = 0;
+    for (size_t s = 0; s < c.nsegs; s++) p2 += c.phase[s] == 2;
+    assert_true(p2 > 0 && p2 < c.nsegs);
+    pfsph_surface_contour_free(&c);
+    pfsph_surface_contour_free(&c2);
+    o.spacing = 0;
+    assert_int_equal(pfsph_surface_contour2d(x, ph, n, &o, &c, &err), PFSPH_EINPUT);
+    free(ph);
+    free(x);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -246,6 +388,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_box),
         cmocka_unit_test(test_two_drops),
         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_far_drop),
+        cmocka_unit_test(test_contour_2d),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
