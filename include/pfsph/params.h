@@ -90,6 +90,8 @@ typedef struct pfsph_pairwise_params {
     bool resolved;
     double radius;    /* k*h [m] */
     double lambda;    /* Eq. 13 constant for the cosine force [m^(dim+2)] */
+    double theta;     /* reduced temperature kT / (sigma_ref d^(dim-1)); 0: thermostat off */
+    double sigma_factor; /* measured tension / Eq. 13 at theta (pfsph_pairwise_sigma_factor) */
 } pfsph_pairwise_params;
 
 void pfsph_pairwise_defaults(pfsph_pairwise_params *p);
@@ -102,6 +104,14 @@ double pfsph_pairwise_shape(double r, double R);
  * step density profile (docs/pairwise.md): sigma = lambda * c * n^2 m^2 = lambda c rho^2.
  * 3D: (pi/8) R^5 (U^4 - 12 U^2 + 24) / U^5; 2D: (1/3) R^4 (U^3 - 6 U - 6) / U^4; U = 3 pi / 2. */
 double pfsph_pairwise_lambda(int dim, double R);
+
+/* Surface tension at temperature: the measured tension of the pair-force liquid divided by
+ * Eq. 13's lambda c rho^2, at reduced temperature theta = kT / (lambda c rho^2 d^(dim-1))
+ * (docs/thermostat.md, "Surface tension at temperature"). A table measured in 2D, interpolated
+ * linearly, held at its ends; 1 in 3D (not calibrated) and for theta <= 0 (thermostat off). */
+double pfsph_pairwise_sigma_factor(int dim, double theta);
+/* The largest theta of that table: beyond it the factor is extrapolated as a constant. */
+double pfsph_pairwise_sigma_theta_max(void);
 
 /* ---- diffuse material (physics/diffuse.c, include/pfsph/diffuse.h) ---- */
 

@@ -25,6 +25,31 @@ double pfsph_pairwise_lambda(int dim, double R)
     return PI / 8.0 * R * R * R * R * R * (U2 * U2 - 12.0 * U2 + 24.0) / (U2 * U2 * U);
 }
 
+/* Measured in 2D (docs/thermostat.md, "Surface tension at temperature"; bench/pf_sigma.c):
+ * lattice discs of radius 15 d, sigma target 4 N/m, k 1.7, h = 2 d, nu 1e-3, WCSPH, the
+ * interior mechanical pressure averaged over 1-4 s (Laplace: dp = sigma / R). Checked on other
+ * radii and with PCISPH by test_pf_laplace. */
+static const double sigma_theta[] = {0.005, 0.01, 0.02, 0.04, 0.08};
+static const double sigma_ratio[] = {1.0, 1.0, 1.0, 1.0, 1.0};
+#define NSIGMA (sizeof sigma_theta / sizeof sigma_theta[0])
+
+double pfsph_pairwise_sigma_factor(int dim, double theta)
+{
+    /* Thermostat off: a frozen particle solid, whose "tension" depends on how it froze (Laplace
+     * slopes of 0.76-0.88 sigma, docs/pairwise.md); Eq. 13 stays the reference. 3D: not
+     * calibrated. */
+    if (dim != 2 || !(theta > 0)) return 1.0;
+    if (theta <= sigma_theta[0]) return sigma_ratio[0];
+    for (size_t i = 1; i < NSIGMA; i++)
+        if (theta <= sigma_theta[i]) {
+            double u = (theta - sigma_theta[i - 1]) / (sigma_theta[i] - sigma_theta[i - 1]);
+            return sigma_ratio[i - 1] + u * (sigma_ratio[i] - sigma_ratio[i - 1]);
+        }
+    return sigma_ratio[NSIGMA - 1]; /* beyond the table: its last value (check warns) */
+}
+
+double pfsph_pairwise_sigma_theta_max(void) { return sigma_theta[NSIGMA - 1]; }
+
 void pfsph_pairwise_defaults(pfsph_pairwise_params *p)
 {
     memset(p, 0, sizeof(*p));
