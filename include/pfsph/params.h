@@ -110,6 +110,16 @@ double pfsph_pairwise_lambda(int dim, double R);
  * (docs/thermostat.md, "Surface tension at temperature"). A table measured in 2D, interpolated
  * linearly, held at its ends; 1 in 3D (not calibrated) and for theta <= 0 (thermostat off). */
 double pfsph_pairwise_sigma_factor(int dim, double theta);
+/* Contact angle -> Eq. 21's adhesion ratio r = c_wa rho_w / (c_aa rho_a) at reduced
+ * temperature theta: a table measured in 2D at the default temperature (docs/pairwise.md,
+ * "Contact angles at temperature"); Eq. 21, r = (1 + cos angle) / 2, in 3D and with the
+ * thermostat off (theta <= 0). Angles more wetting than the table reaches extend its last
+ * segment. */
+double pfsph_pairwise_angle_ratio(int dim, double theta, double angle_deg);
+/* The inverse: the static angle [deg] expected for ratio r. */
+double pfsph_pairwise_angle_expected(int dim, double theta, double r);
+/* The largest ratio the table measured. */
+double pfsph_pairwise_angle_ratio_max(void);
 /* The largest theta of that table: beyond it the factor is extrapolated as a constant. */
 double pfsph_pairwise_sigma_theta_max(void);
 

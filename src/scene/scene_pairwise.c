@@ -179,7 +179,6 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
 
 /* ---- targets -> coefficients, once the spacing and h are known ---- */
 
-static const double PI = 3.14159265358979323846;
 
 
 pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h)
@@ -192,7 +191,8 @@ static bool is_solid(const pfsph_scene *s, int a) { return s->phases[a].kind == 
 
 /* Steps 1-3 of the conversion: targets -> coefficients with the tension constant lam_t (Eq. 13's
  * lambda times the factor of the tension at temperature). Coefficients the scene gave are kept. */
-static int convert_targets(pfsph_scene *s, double lam_t, const double *rho, pfsph_error *err)
+static int convert_targets(pfsph_scene *s, double lam_t, double theta, const double *rho,
+                           pfsph_error *err)
 {
     pfsph_pairwise_params *pp = &s->pairwise;
     const int np = s->nphases;
@@ -230,7 +230,9 @@ static int convert_targets(pfsph_scene *s, double lam_t, const double *rho, pfsp
         }
     /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. It is
      * Young's law with the Kirkwood-Buff tensions of Eq. 13 (the wall a half-space of density
-     * rho_w), so the factor of the tensions at temperature cancels in it. */
+     * rho_w), so the factor of the tensions at temperature cancels in it; but the particle
+     * liquid at temperature wets less than Eq. 21 says, so there the ratio comes from a
+     * measured table (docs/pairwise.md). */
     for (int a = 0; a < np; a++)
         for (int b = a + 1; b < np; b++) {
             if (!pp->angle_set[a][b]) continue;
@@ -250,8 +252,9 @@ static int convert_targets(pfsph_scene *s, double lam_t, const double *rho, pfsp
                                   "pairwise: contact angle on \"%s\" needs its rest_density > 0 "
                                   "(boundary particle mass)",
                                   s->phases[so].name);
-            double th = pp->angle_deg[a][b] * PI / 180.0;
-            double cw = 0.5 * (1.0 + cos(th)) * pp->c[fl][fl] * rho[fl] / rho[so];
+            /* Eq. 21's ratio, or at temperature the measured one (pfsph_pairwise_angle_ratio) */
+            double cw = pfsph_pairwise_angle_ratio(s->dim, theta, pp->angle_deg[a][b]) *
+                        pp->c[fl][fl] * rho[fl] / rho[so];
             if (cw < 0) cw = 0; /* cos(180 deg) rounding */
             pp->c[a][b] = pp->c[b][a] = cw;
         }
@@ -280,9 +283,10 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
      * sigma_ref the largest Eq. 13 liquid-air tension of the coefficients: with the reduced
      * temperature given, theta is known and one pass settles f; with kT given, theta depends
      * on c and c on f(theta), a fixed point that a few passes reach (f varies slowly). */
-    double f = 1.0, theta = 0.0;
+    double theta = tp->enabled && tp->kT < 0 ? tp->reduced : 0.0;
+    double f = pfsph_pairwise_sigma_factor(s->dim, theta);
     for (int it = 0; it < 16; it++) {
-        int rc = convert_targets(s, f * lam, rho, err);
+        int rc = convert_targets(s, f * lam, theta, rho, err);
         if (rc) return rc;
         tp->sigma_ref = 0;
         tp->rho_ref = 0;
@@ -291,12 +295,14 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
                 double sg = lam * pp->c[a][a] * rho[a] * rho[a];
                 if (sg > tp->sigma_ref) tp->sigma_ref = sg, tp->rho_ref = rho[a];
             }
-        theta = !tp->enabled ? 0.0
-                : tp->kT >= 0 ? (tp->sigma_ref > 0 ? tp->kT / (tp->sigma_ref * dd) : 0.0)
-                              : tp->reduced;
-        const double fn = pfsph_pairwise_sigma_factor(s->dim, theta);
-        if (fabs(fn - f) <= 1e-12 * fn) break;
+        const double tn = !tp->enabled ? 0.0
+                          : tp->kT >= 0 ? (tp->sigma_ref > 0 ? tp->kT / (tp->sigma_ref * dd) : 0.0)
+                                        : tp->reduced;
+        const double fn = pfsph_pairwise_sigma_factor(s->dim, tn);
+        const bool done = fabs(fn - f) <= 1e-12 * fn && fabs(tn - theta) <= 1e-12 * tn;
         f = fn;
+        theta = tn;
+        if (done) break;
     }
     for (int a = 0; a < np; a++)
         for (int b = 0; b < np; b++) {
@@ -392,8 +398,9 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
                 fprintf(out, "  target: sigma(%s, %s) = %g N/m -> c = %.6g\n", s->phases[a].name,
                         s->phases[b].name, pp->sigma[a][b], pp->c[a][b]);
             if (pp->angle_set[a][b])
-                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (Eq. 21)\n",
-                        s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b]);
+                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (%s)\n",
+                        s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b],
+                        s->dim == 2 && pp->theta > 0 ? "table at temperature" : "Eq. 21");
         }
     if (!pp->resolved) return;
     /* what the liquid is expected to do at its temperature: Eq. 13's tension times the
@@ -420,12 +427,15 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
             double rb = s->phases[b].rest_density;
             if (s->phases[b].kind == PFSPH_PHASE_SOLID) {
                 if (!(pp->c[a][a] > 0) || !(rb > 0)) continue;
-                double cs = 2.0 * pp->c[a][b] * rb / (pp->c[a][a] * ra) - 1.0;
-                const char *note = cs > 1 ? " (complete wetting)" : "";
-                if (cs > 1) cs = 1;
-                if (cs < -1) cs = -1;
-                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (Eq. 21)\n",
-                        s->phases[a].name, s->phases[b].name, acos(cs) * 180.0 / PI, note);
+                const double r = pp->c[a][b] * rb / (pp->c[a][a] * ra);
+                const bool table = s->dim == 2 && pp->theta > 0;
+                const double ang = pfsph_pairwise_angle_expected(s->dim, pp->theta, r);
+                const char *note = !table && r > 1 ? " (complete wetting)"
+                                   : table && r > pfsph_pairwise_angle_ratio_max()
+                                       ? " (beyond the measured table: extrapolated)" : "";
+                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (%s)\n",
+                        s->phases[a].name, s->phases[b].name, ang, note,
+                        table ? "measured at temperature, docs/pairwise.md" : "Eq. 21");
             } else {
                 double sg = lam * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb -
                                    2.0 * pp->c[a][b] * ra * rb);
