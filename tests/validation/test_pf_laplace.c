@@ -13,8 +13,9 @@
  * s within 15 % of the target sigma, |a| <= 0.25 sigma / R_max and R^2 >= 0.9. The target is
  * converted with the factor of the tension at temperature (pfsph_pairwise_sigma_factor),
  * calibrated once on discs of 15 d with WCSPH: these radii and this solver are a check of it.
- * Standard errors from 10 block averages are printed. Run time about 2 minutes on one core
- * (label validation). Under AddressSanitizer the three drops run 0.3 s and only the code
+ * Standard errors from 10 block averages are printed. Measured: p_in / (sigma / R_e) =
+ * 0.939 +- 0.014, 0.888 +- 0.010, 0.918 +- 0.011; slope 0.988 sigma, intercept -2.24 Pa (bound
+ * 6.22), R^2 0.991. Run time 144 s of CPU on one core (label validation). Under AddressSanitizer the three drops run 0.3 s and only the code
  * paths are checked.
  * Knobs for studies: PF_SOLVER, PF_THETA, PF_T (end [s]), PF_RADII ("10,13,16" in spacings). */
 #include <math.h>
