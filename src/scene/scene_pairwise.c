@@ -343,7 +343,7 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
     }
     fprintf(out, "  thermostat on: kT = %.4g %s", tp->kT_resolved, unit);
     if (tp->sigma_ref > 0)
-        fprintf(out, " = %.4g sigma d^%d (sigma = %.4g N/m)", tp->kT_resolved /
+        fprintf(out, " = %.4g sigma d^%d (sigma = %.4g N/m, Eq. 13 of the coefficients)", tp->kT_resolved /
                 (tp->sigma_ref * pow(d, s->dim - 1)), s->dim - 1, tp->sigma_ref);
     fprintf(out, "\n");
     for (int a = 0; a < s->nphases; a++) {
