@@ -90,6 +90,8 @@ typedef struct pfsph_pairwise_params {
     bool resolved;
     double radius;    /* k*h [m] */
     double lambda;    /* Eq. 13 constant for the cosine force [m^(dim+2)] */
+    double theta;     /* reduced temperature kT / (sigma_ref d^(dim-1)); 0: thermostat off */
+    double sigma_factor; /* measured tension / Eq. 13 at theta (pfsph_pairwise_sigma_factor) */
 } pfsph_pairwise_params;
 
 void pfsph_pairwise_defaults(pfsph_pairwise_params *p);
@@ -102,6 +104,24 @@ double pfsph_pairwise_shape(double r, double R);
  * step density profile (docs/pairwise.md): sigma = lambda * c * n^2 m^2 = lambda c rho^2.
  * 3D: (pi/8) R^5 (U^4 - 12 U^2 + 24) / U^5; 2D: (1/3) R^4 (U^3 - 6 U - 6) / U^4; U = 3 pi / 2. */
 double pfsph_pairwise_lambda(int dim, double R);
+
+/* Surface tension at temperature: the measured tension of the pair-force liquid divided by
+ * Eq. 13's lambda c rho^2, at reduced temperature theta = kT / (lambda c rho^2 d^(dim-1))
+ * (docs/thermostat.md, "Surface tension at temperature"). A table measured in 2D, interpolated
+ * linearly, held at its ends; 1 in 3D (not calibrated) and for theta <= 0 (thermostat off). */
+double pfsph_pairwise_sigma_factor(int dim, double theta);
+/* Contact angle -> Eq. 21's adhesion ratio r = c_wa rho_w / (c_aa rho_a) at reduced
+ * temperature theta: a table measured in 2D at the default temperature (docs/pairwise.md,
+ * "Contact angles at temperature"); Eq. 21, r = (1 + cos angle) / 2, in 3D and with the
+ * thermostat off (theta <= 0). Angles more wetting than the table reaches extend its last
+ * segment. */
+double pfsph_pairwise_angle_ratio(int dim, double theta, double angle_deg);
+/* The inverse: the static angle [deg] expected for ratio r. */
+double pfsph_pairwise_angle_expected(int dim, double theta, double r);
+/* The largest ratio the table measured. */
+double pfsph_pairwise_angle_ratio_max(void);
+/* The largest theta of that table: beyond it the factor is extrapolated as a constant. */
+double pfsph_pairwise_sigma_theta_max(void);
 
 /* ---- bubbles in air: two-phase film particles (physics/film.c, include/pfsph/film.h) ---- */
 

@@ -179,7 +179,6 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
 
 /* ---- targets -> coefficients, once the spacing and h are known ---- */
 
-static const double PI = 3.14159265358979323846;
 
 
 pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h)
@@ -190,21 +189,13 @@ pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h)
 
 static bool is_solid(const pfsph_scene *s, int a) { return s->phases[a].kind == PFSPH_PHASE_SOLID; }
 
-int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfsph_error *err)
+/* Steps 1-3 of the conversion: targets -> coefficients with the tension constant lam_t (Eq. 13's
+ * lambda times the factor of the tension at temperature). Coefficients the scene gave are kept. */
+static int convert_targets(pfsph_scene *s, double lam_t, double theta, const double *rho,
+                           pfsph_error *err)
 {
     pfsph_pairwise_params *pp = &s->pairwise;
-    pp->resolved = false;
-    if (!pp->enabled) return PFSPH_OK;
-    if (!(spacing > 0) || !(h > 0) || !(pp->k >= 1.0))
-        return pfsph_fail(err, PFSPH_EINPUT,
-                          "pairwise: need spacing > 0, h > 0 and k >= 1 (got %g, %g, %g)",
-                          (double)spacing, (double)h, pp->k);
     const int np = s->nphases;
-    const double R = pp->k * (double)h;
-    const double lam = pfsph_pairwise_lambda(s->dim, R);
-    double rho[PFSPH_MAX_PHASES];
-    for (int a = 0; a < np; a++) rho[a] = s->phases[a].rest_density;
-
     /* 1. Cohesion from a surface tension against the (unsimulated) air: Eq. 13 with
      * c_beta = 0, sigma = lambda c rho^2 (Eq. 14 with n m = rho). */
     for (int a = 0; a < np; a++) {
@@ -214,7 +205,7 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
                               "pairwise: surface tension target on phase \"%s\" needs a fluid "
                               "phase with rest_density > 0",
                               s->phases[a].name);
-        pp->c[a][a] = pp->sigma[a][a] / (lam * rho[a] * rho[a]);
+        pp->c[a][a] = pp->sigma[a][a] / (lam_t * rho[a] * rho[a]);
     }
     /* 2. Interfacial tension between two fluids: Eq. 13 solved for c_ab. */
     for (int a = 0; a < np; a++)
@@ -227,17 +218,21 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
                                   "contact_angle for a solid)",
                                   s->phases[a].name, s->phases[b].name);
             double self = pp->c[a][a] * rho[a] * rho[a] + pp->c[b][b] * rho[b] * rho[b];
-            double cab = (self - pp->sigma[a][b] / lam) / (2.0 * rho[a] * rho[b]);
+            double cab = (self - pp->sigma[a][b] / lam_t) / (2.0 * rho[a] * rho[b]);
             if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]))
                 return pfsph_fail(err, PFSPH_EINPUT,
                                   "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
                                   "more than their cohesions give with c = 0 (at most %g N/m); "
                                   "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
                                   pp->sigma[a][b], s->phases[a].name, s->phases[b].name,
-                                  lam * self, s->phases[a].name, s->phases[b].name);
+                                  lam_t * self, s->phases[a].name, s->phases[b].name);
             pp->c[a][b] = pp->c[b][a] = cab > 0 ? cab : 0.0;
         }
-    /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. */
+    /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. It is
+     * Young's law with the Kirkwood-Buff tensions of Eq. 13 (the wall a half-space of density
+     * rho_w), so the factor of the tensions at temperature cancels in it; but the particle
+     * liquid at temperature wets less than Eq. 21 says, so there the ratio comes from a
+     * measured table (docs/pairwise.md). */
     for (int a = 0; a < np; a++)
         for (int b = a + 1; b < np; b++) {
             if (!pp->angle_set[a][b]) continue;
@@ -257,11 +252,58 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
                                   "pairwise: contact angle on \"%s\" needs its rest_density > 0 "
                                   "(boundary particle mass)",
                                   s->phases[so].name);
-            double th = pp->angle_deg[a][b] * PI / 180.0;
-            double cw = 0.5 * (1.0 + cos(th)) * pp->c[fl][fl] * rho[fl] / rho[so];
+            /* Eq. 21's ratio, or at temperature the measured one (pfsph_pairwise_angle_ratio) */
+            double cw = pfsph_pairwise_angle_ratio(s->dim, theta, pp->angle_deg[a][b]) *
+                        pp->c[fl][fl] * rho[fl] / rho[so];
             if (cw < 0) cw = 0; /* cos(180 deg) rounding */
             pp->c[a][b] = pp->c[b][a] = cw;
         }
+    return PFSPH_OK;
+}
+
+int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfsph_error *err)
+{
+    pfsph_pairwise_params *pp = &s->pairwise;
+    pp->resolved = false;
+    if (!pp->enabled) return PFSPH_OK;
+    if (!(spacing > 0) || !(h > 0) || !(pp->k >= 1.0))
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "pairwise: need spacing > 0, h > 0 and k >= 1 (got %g, %g, %g)",
+                          (double)spacing, (double)h, pp->k);
+    const int np = s->nphases;
+    const double R = pp->k * (double)h;
+    const double lam = pfsph_pairwise_lambda(s->dim, R);
+    const double dd = pow((double)spacing, s->dim - 1);
+    double rho[PFSPH_MAX_PHASES];
+    for (int a = 0; a < np; a++) rho[a] = s->phases[a].rest_density;
+    pfsph_thermostat_params *tp = &pp->thermo;
+
+    /* The tension at temperature is f(theta) lambda c rho^2 (docs/thermostat.md), so a target
+     * sigma asks for c = sigma / (f lambda rho^2). theta = kT / (sigma_ref d^(dim-1)) with
+     * sigma_ref the largest Eq. 13 liquid-air tension of the coefficients: with the reduced
+     * temperature given, theta is known and one pass settles f; with kT given, theta depends
+     * on c and c on f(theta), a fixed point that a few passes reach (f varies slowly). */
+    double theta = tp->enabled && tp->kT < 0 ? tp->reduced : 0.0;
+    double f = pfsph_pairwise_sigma_factor(s->dim, theta);
+    for (int it = 0; it < 16; it++) {
+        int rc = convert_targets(s, f * lam, theta, rho, err);
+        if (rc) return rc;
+        tp->sigma_ref = 0;
+        tp->rho_ref = 0;
+        for (int a = 0; a < np; a++)
+            if (!is_solid(s, a)) {
+                double sg = lam * pp->c[a][a] * rho[a] * rho[a];
+                if (sg > tp->sigma_ref) tp->sigma_ref = sg, tp->rho_ref = rho[a];
+            }
+        const double tn = !tp->enabled ? 0.0
+                          : tp->kT >= 0 ? (tp->sigma_ref > 0 ? tp->kT / (tp->sigma_ref * dd) : 0.0)
+                                        : tp->reduced;
+        const double fn = pfsph_pairwise_sigma_factor(s->dim, tn);
+        const bool done = fabs(fn - f) <= 1e-12 * fn && fabs(tn - theta) <= 1e-12 * tn;
+        f = fn;
+        theta = tn;
+        if (done) break;
+    }
     for (int a = 0; a < np; a++)
         for (int b = 0; b < np; b++) {
             if (pp->c[a][b] != pp->c[b][a]) pp->c[b][a] = pp->c[a][b] = 0.5 * (pp->c[a][b] + pp->c[b][a]);
@@ -273,20 +315,13 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
         }
     pp->radius = R;
     pp->lambda = lam;
-    /* Thermostat: kT = reduced * sigma_ref * d^(dim-1), sigma_ref the largest liquid-air
-     * tension of the table (docs/thermostat.md). */
-    pfsph_thermostat_params *tp = &pp->thermo;
-    tp->sigma_ref = 0;
-    tp->rho_ref = 0;
-    for (int a = 0; a < np; a++)
-        if (!is_solid(s, a)) {
-            double sg = lam * pp->c[a][a] * rho[a] * rho[a];
-            if (sg > tp->sigma_ref) tp->sigma_ref = sg, tp->rho_ref = rho[a];
-        }
+    pp->theta = theta;
+    pp->sigma_factor = f;
+    /* Thermostat: kT = reduced * sigma_ref * d^(dim-1), sigma_ref the largest (Eq. 13)
+     * liquid-air tension of the table (docs/thermostat.md). */
     tp->kT_resolved = 0;
     if (tp->enabled)
-        tp->kT_resolved = tp->kT >= 0 ? tp->kT
-                                      : tp->reduced * tp->sigma_ref * pow((double)spacing, s->dim - 1);
+        tp->kT_resolved = tp->kT >= 0 ? tp->kT : tp->reduced * tp->sigma_ref * dd;
     pp->resolved = true;
     return PFSPH_OK;
 }
@@ -308,7 +343,7 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
     }
     fprintf(out, "  thermostat on: kT = %.4g %s", tp->kT_resolved, unit);
     if (tp->sigma_ref > 0)
-        fprintf(out, " = %.4g sigma d^%d (sigma = %.4g N/m)", tp->kT_resolved /
+        fprintf(out, " = %.4g sigma d^%d (sigma = %.4g N/m, Eq. 13 of the coefficients)", tp->kT_resolved /
                 (tp->sigma_ref * pow(d, s->dim - 1)), s->dim - 1, tp->sigma_ref);
     fprintf(out, "\n");
     for (int a = 0; a < s->nphases; a++) {
@@ -363,11 +398,25 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
                 fprintf(out, "  target: sigma(%s, %s) = %g N/m -> c = %.6g\n", s->phases[a].name,
                         s->phases[b].name, pp->sigma[a][b], pp->c[a][b]);
             if (pp->angle_set[a][b])
-                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (Eq. 21)\n",
-                        s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b]);
+                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (%s)\n",
+                        s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b],
+                        s->dim == 2 && pp->theta > 0 ? "table at temperature" : "Eq. 21");
         }
     if (!pp->resolved) return;
-    double lam = pp->lambda;
+    /* what the liquid is expected to do at its temperature: Eq. 13's tension times the
+     * measured factor f(theta) (docs/thermostat.md) */
+    double lam = pp->lambda * pp->sigma_factor;
+    if (!s->pairwise.thermo.enabled)
+        fprintf(out, "  expected tensions: Eq. 13 (thermostat off: the liquid freezes, and a frozen "
+                "drop's Laplace pressure reads 0.76-0.88 of it)\n");
+    else if (s->dim != 2)
+        fprintf(out, "  expected tensions at theta = %.4g: Eq. 13 (3D: the factor at temperature is "
+                "not calibrated)\n", pp->theta);
+    else
+        fprintf(out, "  expected tensions at theta = %.4g: Eq. 13 x %.3f (measured factor at "
+                "temperature, docs/thermostat.md)%s\n", pp->theta, pp->sigma_factor,
+                pp->theta > pfsph_pairwise_sigma_theta_max() ? "; theta beyond the measured table: "
+                "its last value is used" : "");
     for (int a = 0; a < np; a++) {
         if (s->phases[a].kind == PFSPH_PHASE_SOLID) continue;
         double ra = s->phases[a].rest_density;
@@ -378,12 +427,15 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
             double rb = s->phases[b].rest_density;
             if (s->phases[b].kind == PFSPH_PHASE_SOLID) {
                 if (!(pp->c[a][a] > 0) || !(rb > 0)) continue;
-                double cs = 2.0 * pp->c[a][b] * rb / (pp->c[a][a] * ra) - 1.0;
-                const char *note = cs > 1 ? " (complete wetting)" : "";
-                if (cs > 1) cs = 1;
-                if (cs < -1) cs = -1;
-                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (Eq. 21)\n",
-                        s->phases[a].name, s->phases[b].name, acos(cs) * 180.0 / PI, note);
+                const double r = pp->c[a][b] * rb / (pp->c[a][a] * ra);
+                const bool table = s->dim == 2 && pp->theta > 0;
+                const double ang = pfsph_pairwise_angle_expected(s->dim, pp->theta, r);
+                const char *note = !table && r > 1 ? " (complete wetting)"
+                                   : table && r > pfsph_pairwise_angle_ratio_max()
+                                       ? " (beyond the measured table: extrapolated)" : "";
+                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (%s)\n",
+                        s->phases[a].name, s->phases[b].name, ang, note,
+                        table ? "measured at temperature, docs/pairwise.md" : "Eq. 21");
             } else {
                 double sg = lam * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb -
                                    2.0 * pp->c[a][b] * ra * rb);

@@ -13,6 +13,7 @@
 
 static const double PI = 3.14159265358979323846;
 
+
 /* A small 2D drop resting on a plate: no gravity and no viscosity, so that a fluid particle's
  * non-pressure acceleration is its pair force alone. */
 static const char *SCENE =
@@ -41,8 +42,13 @@ static void step(pfsph_sim *sim)
     if (pfsph_sim_step(sim, 1.0, &err)) fail_msg("%s", err.msg);
 }
 
-/* the contact-angle coefficient Eq. 21 gives for angle th over a cohesion cww (equal densities) */
-static double eq21(double th_deg, double cww) { return 0.5 * (1 + cos(th_deg * PI / 180)) * cww; }
+/* the contact-angle coefficient for angle th over a cohesion cww (equal densities): Eq. 21's
+ * ratio, or at temperature the measured table (pfsph_pairwise_angle_ratio; the scene is 2D with
+ * the thermostat at its default temperature) */
+static double eq21(double th_deg, double cww)
+{
+    return pfsph_pairwise_angle_ratio(2, PFSPH_THERMO_REDUCED_DEFAULT, th_deg) * cww;
+}
 
 static void test_matrix(void **state)
 {
@@ -50,7 +56,8 @@ static void test_matrix(void **state)
     pfsph_scene *sc = malloc(sizeof *sc);
     pfsph_sim *sim = make(sc);
     const pfsph_pairwise_params *pp = &pfsph_sim_scene(sim)->pairwise;
-    const double lam = pp->lambda, c0 = 2 / (lam * 1000.0 * 1000.0);
+    /* sigma = f lambda c rho^2, f the measured factor at temperature */
+    const double lam = pp->lambda * pp->sigma_factor, c0 = 2 / (lam * 1000.0 * 1000.0);
     assert_true(fabs(pp->c[0][0] - c0) < 1e-12 * c0);
     assert_true(fabs(pp->c[0][1] - eq21(60, c0)) < 1e-12 * c0);
     pfsph_error err = {0};
