@@ -204,6 +204,8 @@ typedef struct pfsph_emitter_params {
     double speed;        /* entry speed along direction [m/s]; 0: from rate */
     double rate;         /* volume rate [m^3/s, m^2/s in 2D]; 0: from speed */
     double start, stop;  /* emits while start <= t < stop [s]; stop = INFINITY: to the end */
+    int bubble;          /* 0: none; k + 1: the particles join bubble k (their fluid->bubble), so gas
+                          * blown into a bubble's film belongs to it (docs/film.md, "Blowing") */
 } pfsph_emitter_params;
 
 #endif

@@ -233,6 +233,7 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
             h_f64(h, e->rate);
             h_f64(h, e->start);
             h_f64(h, isfinite(e->stop) ? e->stop : -1);
+            if (e->bubble) h_int(h, e->bubble); /* only when set: older emitter scenes keep their hash */
         }
     }
     return H.h;

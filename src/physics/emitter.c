@@ -293,6 +293,9 @@ size_t pfsph_emitters_step(pfsph_emitters *em, pfsph_particles *f, const pfsph_c
                 }
                 long k = pfsph_particles_push(f, xr, v, (uint8_t)z->p.phase);
                 f->rho[k] = rho0;
+                /* blown gas joins its bubble: the next film stage counts it in the bubble's
+                 * detection group, so the film spreads over the grown surface */
+                f->bubble[k] = (uint8_t)z->p.bubble;
                 z->st.emitted++;
                 added++;
             }

@@ -32,8 +32,10 @@ static void detect(pfsph_film *fm, const pfsph_ctx *ctx)
 {
     const pfsph_particles *f = ctx->fluid;
     /* one bubble at a time (group = bubble): two bubbles pressed together each keep their film
-     * on the shared face, so their gases stay apart (docs/film.md) */
-    pfsph_surface_opts o = {.radius = 0, .layers = 1, .group = f->bubble, .boundary = false, .reach = 0};
+     * on the shared face, so their gases stay apart (docs/film.md). Walls cover: a bubble blown
+     * from a tube has its film where it meets the air, not along the tube's inside, where the
+     * gas touches the wall (docs/film.md, "Blowing a bubble") */
+    pfsph_surface_opts o = {.radius = 0, .layers = 1, .group = f->bubble, .boundary = true, .reach = 0};
     pfsph_surface_detect(ctx, &o, fm->layer, NULL);
     for (int k = 0; k < fm->nb; k++) fm->ns[k] = 0;
     for (size_t i = 0; i < f->n; i++)

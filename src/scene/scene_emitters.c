@@ -43,7 +43,7 @@ static int positive(const cJSON *e, const char *P, const char *key, double hi, d
 static int parse_one(const cJSON *e, const char *P, pfsph_scene *s, pfsph_emitter_params *m, pfsph_jctx *ctx)
 {
     static const char *const keys[] = {"shape", "phase", "center", "direction", "radius", "size", "width",
-                                       "speed", "rate", "start", "stop", "comment", NULL};
+                                       "speed", "rate", "start", "stop", "bubble", "comment", NULL};
     int rc;
     char kp[192];
     if (!cJSON_IsObject(e)) return pfsph__json_fail(ctx, P, "expected an object");
@@ -79,6 +79,30 @@ static int parse_one(const cJSON *e, const char *P, pfsph_scene *s, pfsph_emitte
             return pfsph__json_fail(ctx, kp, "phase \"%s\" is a solid phase; an emitter needs a phase of kind "
                                     "\"fluid\" or \"gas\"", s->phases[idx].name);
         m->phase = idx;
+    }
+    /* bubble: the fluid block (index into $.fluid) of a bubble that the gas is blown into; its
+     * particles then carry that bubble's id and the film spreads over the grown surface
+     * (docs/film.md, "Blowing a bubble"). Without "phase" the emitter takes the bubble's gas. */
+    if (has(e, "bubble")) {
+        int bi = -1;
+        snprintf(kp, sizeof kp, "%s.bubble", P);
+        const cJSON *bv = cJSON_GetObjectItemCaseSensitive(e, "bubble");
+        if (!cJSON_IsNumber(bv) || bv->valuedouble != floor(bv->valuedouble))
+            return pfsph__json_fail(ctx, kp, "expected the index of a fluid block with a \"bubble\" key (an integer)");
+        if (!(bv->valuedouble >= 0 && bv->valuedouble < s->nblocks))
+            return pfsph__json_fail(ctx, kp, "%g is not a fluid block: $.fluid has %d (indices 0 .. %d)",
+                                    bv->valuedouble, s->nblocks, s->nblocks - 1);
+        bi = (int)bv->valuedouble;
+        const pfsph_block *b = &s->blocks[bi];
+        if (b->bubble < 0)
+            return pfsph__json_fail(ctx, kp, "%d: $.fluid[%d] is not a bubble (it has no \"bubble\" key)", bi, bi);
+        const int gas = s->film.gas[b->bubble];
+        if (!pv) m->phase = gas;
+        else if (m->phase != gas)
+            return pfsph__json_fail(ctx, kp, "%d: the emitter's phase \"%s\" is not the gas \"%s\" of bubble "
+                                    "$.fluid[%d]; blow that gas (or leave \"phase\" out)", bi,
+                                    s->phases[m->phase].name, s->phases[gas].name, bi);
+        m->bubble = b->bubble + 1;
     }
     if (m->phase < 0) return pfsph__json_fail(ctx, kp, "no fluid or gas phase is defined in $.phases");
 

@@ -39,6 +39,7 @@
 #include <string.h>
 
 #include "pfsph/eigen.h"
+#include "pfsph/emitter.h"
 #include "pfsph/sim.h"
 #include "testutil.h"
 
@@ -314,13 +315,171 @@ static void test_two_bubbles(void **state)
     pfsph_sim_destroy(sim);
 }
 
+/* Blowing a bubble (issue 12, Table 1 "Blowing bubbles"), 2D, no gravity: a disc bubble of
+ * radius 6 d (112 particles, film 0.5 d) with a gas nozzle of 3 sites at its centre pointing up,
+ * whose emitter key "bubble": 0 makes every particle it pushes join bubble 0. It blows
+ * 0.01 m^2/s (0.33 m/s) from 0.1 s to 1.0 s, then relaxes until 1.4 s. Sites blocked by the gas
+ * around the nozzle are refused, so 64 particles of 90 owed enter (67 % of the start's gas).
+ * The jet's momentum carries the bubble up while the nozzle stays put: from about 0.5 s the
+ * bubble draws a neck of gas and film down to the nozzle, as a soap bubble does on a straw.
+ * At every 0.05 s sample:
+ * - all emitted gas joins the bubble: its count is the start's plus the emitter's `emitted`,
+ *   exactly, every particle carries the id, and none is lost;
+ * - the film liquid sum_i a_i V0 within 2 % of V_L (the fraction follows the grown surface);
+ * - the enclosed gas, measured geometrically as in test_bubble_at_rest (the polygon through the
+ *   film particles sorted by angle about the centroid, plus their outer half, less the liquid;
+ *   at the start 0.0095 m^2 against N V0 - V_L = 0.0096), grows by the blown volume n_e V0:
+ *   within 20 % while blowing, once 20 % of the start's gas is blown, and within 10 % at the end
+ *   (the last 5 samples averaged, 0.2 s after the nozzle closed). Why: the polygon, star-shaped
+ *   about the centroid, misses part of the neck while it exists (measured down to -17 % at
+ *   0.7 s, with 36 blown); at rest the measure moves by 0.8 % of the gas with the thermal
+ *   wobble (test_bubble_at_rest), 1.2 % of this blown volume, so 10 % at the end is loose
+ *   enough for noise and fails a bubble that lost or failed to take a sixth of the gas;
+ * - the film stays closed: every gas particle meets a film particle along rays in all 16
+ *   directions (passing within 1.5 d of its centre: a single surface particle missed by the
+ *   detection leaves a gap of about 2 d in the film that rays through it would slip, while a
+ *   gas particle really outside has a half plane without film). Not tested: the particles
+ *   emitted in the last step (no film stage yet) and those in the nozzle's inlet slab, whose
+ *   flag lags a step behind the inlet that moves them. The polygon test of test_bubble_at_rest
+ *   does not serve here: the neck is not star-shaped about the centroid.
+ * Under ASan (~4x slower) it blows until 0.7 s (36 particles) and ends at 1.1 s. */
+#define NDIR 16
+
+/* Whether (px, py) is enclosed by the film particles (fx, fy; nf of them): a ray in each of
+ * NDIR directions passes within hit of one of them, ahead of the point. */
+static bool enclosed(double px, double py, const double *fx, const double *fy, int nf, double hit)
+{
+    for (int k = 0; k < NDIR; k++) {
+        const double ux = cos(2 * PI * k / NDIR), uy = sin(2 * PI * k / NDIR);
+        bool met = false;
+        for (int j = 0; j < nf && !met; j++) {
+            const double dx = fx[j] - px, dy = fy[j] - py, along = dx * ux + dy * uy;
+            met = along > 0 && fabs(dx * uy - dy * ux) < hit;
+        }
+        if (!met) return false;
+    }
+    return true;
+}
+
+/* The nozzle of test_blow_bubble (exit plane y = -0.005 m, 3 sites about x = 0) and the two
+ * spacings of jet in front of it: the inlet sets these particles' velocities and places new
+ * layers among them between two film stages, so their film flag lags by a step. */
+static bool at_nozzle(double x, double y, double d)
+{
+    return fabs(x) <= 2 * d && y >= -0.005 - 0.5 * d && y <= -0.005 + 2 * d;
+}
+
+/* measure()'s figures, with gas_outside from the enclosure test (hit: 1 d; film particles of a
+ * rough surface sit up to ~2 d apart, and a gas particle really outside has a half plane
+ * without film). */
+static bubble_m measure_blow(const pfsph_ctx *c, ang *A, double *fx, double *fy, size_t fresh)
+{
+    const pfsph_particles *f = c->fluid;
+    bubble_m m = measure(c, 0, A);
+    int nf = 0;
+    for (size_t i = 0; i < f->n; i++)
+        if (f->bubble[i] == 1 && f->film[i] > 0) fx[nf] = f->x[i], fy[nf] = f->y[i], nf++;
+    m.gas_outside = 0;
+    for (size_t i = 0; i < fresh; i++) /* from fresh on: emitted in the last step, no film stage yet */
+        if (f->bubble[i] == 1 && !(f->film[i] > 0) && !at_nozzle(f->x[i], f->y[i], c->spacing) &&
+            !enclosed(f->x[i], f->y[i], fx, fy, nf, 1.5 * c->spacing))
+            m.gas_outside++;
+    return m;
+}
+
+static void test_blow_bubble(void **state)
+{
+    (void)state;
+    char json[4096];
+#ifdef __SANITIZE_ADDRESS__
+    const double stop = 0.4, T = 0.5;
+#else
+    const double stop = getenv("BLOW_STOP") ? atof(getenv("BLOW_STOP")) : 1.0, T = stop + 0.4;
+#endif
+    const char *rate = getenv("BLOW_RATE") ? getenv("BLOW_RATE") : "0.01";
+    snprintf(json, sizeof json,
+             "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
+             " \"domain\": {\"min\": [-0.5, -0.5], \"max\": [0.5, 0.5]}, \"time\": {\"dt_max\": 0.002}, %s,"
+             " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0], \"radius\": 0.06, \"phase\": \"air\","
+             " \"bubble\": {\"film\": \"soap\", \"thickness\": 0.005}}],"
+             " \"emitters\": [{\"center\": [0, -0.005], \"direction\": [0, 1], \"width\": %s, \"rate\": %s,"
+             " \"start\": 0.1, \"stop\": %g, \"bubble\": 0}]}",
+             phases_and_pairs(), getenv("BLOW_W") ? getenv("BLOW_W") : "0.03", rate, stop);
+    pfsph_sim *sim = make(json, "blow.json");
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    const pfsph_emitters *em = pfsph_sim_emitters(sim);
+    assert_int_equal(pfsph_emitters_count(em), 1);
+    const size_t n0 = c->fluid->n, room = 8 * n0; /* the grown bubble's film */
+    double *fx = malloc(room * sizeof *fx), *fy = malloc(room * sizeof *fy);
+    ang *A = malloc(room * sizeof *A);
+    assert_true(fx && fy && A);
+    const double V0 = c->V0;
+    const bubble_m m0 = measure_blow(c, A, fx, fy, n0);
+    const double VL = m0.liquid;
+    print_message("t = 0: %zu particles, %d film, a = %.4f, film liquid %.4g m^2, gas %.4g m^2 (N V0 - V_L = %.4g)\n",
+                  n0, m0.ns, m0.a, m0.liquid, m0.gas, (double)n0 * V0 - VL);
+    double max_dl = 0, max_grow = 0, end_gas = 0;
+    int outside = 0, count_bad = 0;
+    const double dt = 0.05;
+    const int ns = (int)lround(T / dt);
+    bubble_m m = m0;
+    pfsph_emitter_state st = {0};
+    for (int k = 1; k <= ns; k++) {
+        pfsph_error err = {0};
+        size_t fresh = c->fluid->n;
+        while (pfsph_sim_time(sim) < k * dt - 1e-9) { /* step by step: which particles are fresh */
+            fresh = c->fluid->n;
+            int rc = pfsph_sim_step(sim, k * dt, &err);
+            if (rc) print_message("%s\n", err.msg);
+            assert_int_equal(rc, PFSPH_OK);
+        }
+        const pfsph_particles *f = c->fluid;
+        size_t nb = 0;
+        for (size_t i = 0; i < f->n; i++) nb += f->bubble[i] == 1;
+        pfsph_emitters_get_state(em, 0, &st);
+        if (nb != n0 + st.emitted || nb != f->n) count_bad++;
+        assert_true(f->n <= room);
+        m = measure_blow(c, A, fx, fy, fresh);
+        const double blown = (double)st.emitted * V0, grew = m.gas - m0.gas;
+        max_dl = fmax(max_dl, fabs(m.liquid / VL - 1));
+        if (blown >= 0.2 * m0.gas) max_grow = fmax(max_grow, fabs(grew - blown) / blown);
+        if (k > ns - 5) end_gas += m.gas / 5; /* the last 5 samples: the thermal wobble averaged */
+        outside += m.gas_outside;
+        if (k % 4 == 0 || k == ns || m.gas_outside)
+            print_message("t = %.2f s: %zu in the bubble (%zu + %llu emitted, %llu refused), %d film, a = %.4f, "
+                          "liquid %+.3f %%, gas grew %.4g m^2 for %.4g blown (%+.2f %%), outside %d\n",
+                          k * dt, nb, n0, (unsigned long long)st.emitted, (unsigned long long)st.refused, m.ns, m.a,
+                          100 * (m.liquid / VL - 1), grew, blown, blown > 0 ? 100 * (grew / blown - 1) : 0.0,
+                          m.gas_outside);
+    }
+    const double blown = (double)st.emitted * V0, end_err = (end_gas - m0.gas - blown) / blown;
+    print_message("blowing: %llu gas particles emitted (%.0f %% of the start's gas), all in the bubble: %s; film "
+                  "liquid largest change %.3f %% (bound 2 %%); gas growth against the blown volume, largest relative "
+                  "difference once 20 %% is blown %.2f %% (bound 20 %%), at the end %+.2f %% (bound 10 %%, last 5 samples); a %.4f "
+                  "-> %.4f; gas outside the film, summed over samples: %d\n",
+                  (unsigned long long)st.emitted, 100 * blown / m0.gas, count_bad ? "no" : "yes", 100 * max_dl,
+                  100 * max_grow, 100 * end_err, m0.a, m.a, outside);
+    assert_int_equal(pfsph_sim_removed(sim), 0);
+    assert_int_equal(count_bad, 0);
+    assert_true(blown >= 0.2 * m0.gas);
+    assert_true(max_dl <= 0.02);
+    assert_true(max_grow <= 0.20);
+    assert_true(fabs(end_err) <= 0.10);
+    assert_int_equal(outside, 0);
+    free(fx);
+    free(fy);
+    free(A);
+    pfsph_sim_destroy(sim);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     omp_set_num_threads(1); /* a few hundred particles: threads only add synchronisation */
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_bubble_at_rest), cmocka_unit_test(test_two_bubbles)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_bubble_at_rest), cmocka_unit_test(test_two_bubbles),
+                                       cmocka_unit_test(test_blow_bubble)};
     if (getenv("FILM_ONLY")) { /* studies: one test by number */
-        const struct CMUnitTest one[1] = {tests[atoi(getenv("FILM_ONLY")) & 1]};
+        const struct CMUnitTest one[1] = {tests[atoi(getenv("FILM_ONLY")) % 3]};
         return cmocka_run_group_tests(one, NULL, NULL);
     }
     return cmocka_run_group_tests(tests, NULL, NULL);
