@@ -17,6 +17,14 @@
 #define HEAD3 "{\"particle_radius\": 0.005, \"domain\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}," \
               " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}], "
 
+/* a water box and a bubble of air with a soap film: the emitter key "bubble" */
+#define HEADB "{\"dimension\": 2, \"particle_radius\": 0.0025, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]}," \
+              " \"phases\": [{\"name\": \"water\"}, {\"name\": \"air\", \"kind\": \"gas\"}], \"fluid\": [" \
+              "{\"shape\": \"box\", \"min\": [0, 0], \"max\": [1, 0.1]}, {\"shape\": \"sphere\", \"center\": " \
+              "[0.5, 0.5], \"radius\": 0.1, \"phase\": \"air\", \"bubble\": {\"film\": \"water\", \"thickness\": " \
+              "0.001}}], \"emitters\": [{\"center\": [0.5, 0.5], \"width\": 0.02, \"direction\": [0, 1], " \
+              "\"speed\": 0.1, "
+
 typedef struct bad_case {
     const char *json;
     const char *expect; /* after "<path>: " */
@@ -71,6 +79,13 @@ static const bad_case cases[] = {
     /* a rate that only a jet faster than 1000 m/s delivers */
     {HEAD2 "\"emitters\": [{\"center\": [0.5, 0.9], \"width\": 0.01, \"direction\": [0, -1], \"rate\": 100}]}",
      "$.emitters[0].rate: 100 through 2 sites needs an entry speed of 10000 m/s"},
+    /* "bubble": the index of a fluid block that is a bubble, blowing that bubble's gas */
+    {HEADB "\"bubble\": 1.5}]}", "$.emitters[0].bubble: expected the index of a fluid block"},
+    {HEADB "\"bubble\": \"1\"}]}", "$.emitters[0].bubble: expected the index of a fluid block"},
+    {HEADB "\"bubble\": 2}]}", "$.emitters[0].bubble: 2 is not a fluid block: $.fluid has 2 (indices 0 .. 1)"},
+    {HEADB "\"bubble\": 0}]}", "$.emitters[0].bubble: 0: $.fluid[0] is not a bubble"},
+    {HEADB "\"phase\": \"water\", \"bubble\": 1}]}",
+     "$.emitters[0].bubble: 1: the emitter's phase \"water\" is not the gas \"air\" of bubble $.fluid[1]"},
 };
 #define NCASES (sizeof cases / sizeof cases[0])
 
@@ -90,6 +105,25 @@ static void test_bad_keys_exit_2(void **st)
         rc = tu_run(cmd, out, sizeof out);
         if (rc != 2 || !strstr(out, want)) fail_msg("case %zu: run exit %d, expected 2 and \"%s\":\n%s", i, rc, want, out);
     }
+}
+
+/* "bubble": 1 names the bubble of $.fluid[1] (the scene's bubble 0): the emitter takes its gas
+ * without "phase", stores k + 1 = 1, and the key enters the checkpoint's scene hash only when set
+ * (older emitter scenes keep theirs). */
+static void test_bubble_key(void **st)
+{
+    (void)st;
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    int rc = pfsph_scene_parse(&s, HEADB "\"bubble\": 1}]}", "blow", &err);
+    if (rc) fail_msg("%s", err.msg);
+    assert_int_equal(s.emitters[0].phase, pfsph_scene_phase_index(&s, "air"));
+    assert_int_equal(s.emitters[0].bubble, 1);
+    const uint64_t h1 = pfsph_scene_hash(&s);
+    s.emitters[0].bubble = 0;
+    assert_true(pfsph_scene_hash(&s) != h1);
+    assert_int_equal(pfsph_scene_parse(&s, HEADB "\"phase\": \"air\"}]}", "plain", &err), PFSPH_OK);
+    assert_int_equal(s.emitters[0].bubble, 0);
 }
 
 /* A good scene: 20 sites (width 0.1 m at d = 5 mm), 1 m/s -> 200 layers/s, 0.1 m^2/s; open from
@@ -204,6 +238,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_keys_exit_2),
         cmocka_unit_test(test_check_counts),
+        cmocka_unit_test(test_bubble_key),
         cmocka_unit_test(test_state_checks),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
