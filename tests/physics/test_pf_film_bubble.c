@@ -392,7 +392,7 @@ static void test_blow_bubble(void **state)
     (void)state;
     char json[4096];
 #ifdef __SANITIZE_ADDRESS__
-    const double stop = 0.4, T = 0.5;
+    const double stop = 0.7, T = stop + 0.4;
 #else
     const double stop = getenv("BLOW_STOP") ? atof(getenv("BLOW_STOP")) : 1.0, T = stop + 0.4;
 #endif
