@@ -342,7 +342,8 @@ static void test_two_bubbles(void **state)
  *   emitted in the last step (no film stage yet) and those in the nozzle's inlet slab, whose
  *   flag lags a step behind the inlet that moves them. The polygon test of test_bubble_at_rest
  *   does not serve here: the neck is not star-shaped about the centroid.
- * Under ASan (~4x slower) it blows until 0.7 s (36 particles) and ends at 1.1 s. */
+ * Under ASan (~4x slower) it blows until 0.7 s (36 particles) and ends at 1.1 s. BLOW_RATE,
+ * BLOW_W (the nozzle's width) and BLOW_STOP override (studies). */
 #define NDIR 16
 
 /* Whether (px, py) is enclosed by the film particles (fx, fy; nf of them): a ray in each of
