@@ -1222,21 +1222,34 @@ out:
     return rc;
 }
 
+/* The options with their defaults filled in, checked; smoothing passes only where they are used
+ * (the 2D outline ignores them). A PCA radius of at least a cell keeps the neighbour grid's
+ * coordinates within 21 bits. */
+static int resolve_checked(const pfsph_surface_opts *in, bool smoothing, pfsph_surface_opts *o, pfsph_error *err)
+{
+    if (!(in->spacing > 0) || !isfinite(in->spacing))
+        return pfsph_fail(err, PFSPH_EINPUT, "surface: the particle spacing %g is not positive", in->spacing);
+    resolve(in, o);
+    if (o->lambda > 1 || o->kr < 1 || o->cell > 4 || o->cell < 0.05 || o->support > 8 || o->support < 0.5 ||
+        o->pca_radius > 8 || o->pca_radius < o->cell || (smoothing && o->smooth_iters > 1000)) {
+        if (smoothing)
+            return pfsph_fail(err, PFSPH_EINPUT, "surface: options out of range (lambda %g, kr %g, cell %g d, "
+                              "support %g d, neighbourhood %g d, %d smoothing passes)", o->lambda, o->kr,
+                              o->cell, o->support, o->pca_radius, o->smooth_iters);
+        return pfsph_fail(err, PFSPH_EINPUT, "surface: options out of range (lambda %g, kr %g, cell %g d, "
+                          "support %g d, neighbourhood %g d)", o->lambda, o->kr, o->cell, o->support, o->pca_radius);
+    }
+    return PFSPH_OK;
+}
+
 int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n, const pfsph_surface_opts *in,
                               pfsph_surface_mesh *m, pfsph_error *err)
 {
     memset(m, 0, sizeof *m);
     err->msg[0] = 0;
-    if (!(in->spacing > 0) || !isfinite(in->spacing))
-        return pfsph_fail(err, PFSPH_EINPUT, "surface: the particle spacing %g is not positive", in->spacing);
     pfsph_surface_opts o;
-    resolve(in, &o);
-    /* a PCA radius of at least a cell keeps the neighbour grid's coordinates within 21 bits */
-    if (o.lambda > 1 || o.kr < 1 || o.cell > 4 || o.cell < 0.05 || o.support > 8 || o.support < 0.5 ||
-        o.pca_radius > 8 || o.pca_radius < o.cell || o.smooth_iters > 1000)
-        return pfsph_fail(err, PFSPH_EINPUT, "surface: options out of range (lambda %g, kr %g, cell %g d, "
-                          "support %g d, neighbourhood %g d, %d smoothing passes)", o.lambda, o.kr, o.cell,
-                          o.support, o.pca_radius, o.smooth_iters);
+    int rc0 = resolve_checked(in, true, &o, err);
+    if (rc0 != PFSPH_OK) return rc0;
     const double reach = (double)(1 << 18) * o.cell * o.spacing; /* the grid's integer coordinates */
     for (size_t i = 0; i < 3 * n; i++) {
         if (!isfinite(x[i])) return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu has a non-finite position", i / 3);
@@ -1596,14 +1609,9 @@ int pfsph_surface_contour2d(const double *x, const uint8_t *phase, size_t n, con
 {
     memset(c, 0, sizeof *c);
     err->msg[0] = 0;
-    if (!(in->spacing > 0) || !isfinite(in->spacing))
-        return pfsph_fail(err, PFSPH_EINPUT, "surface: the particle spacing %g is not positive", in->spacing);
     pfsph_surface_opts o;
-    resolve(in, &o);
-    if (o.lambda > 1 || o.kr < 1 || o.cell > 4 || o.cell < 0.05 || o.support > 8 || o.support < 0.5 ||
-        o.pca_radius > 8 || o.pca_radius < o.cell)
-        return pfsph_fail(err, PFSPH_EINPUT, "surface: options out of range (lambda %g, kr %g, cell %g d, "
-                          "support %g d, neighbourhood %g d)", o.lambda, o.kr, o.cell, o.support, o.pca_radius);
+    int rc0 = resolve_checked(in, false, &o, err);
+    if (rc0 != PFSPH_OK) return rc0;
     const double reach = (double)(1 << 18) * o.cell * o.spacing;
     for (size_t i = 0; i < n; i++)
         for (int u = 0; u < 2; u++) {

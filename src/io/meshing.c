@@ -70,7 +70,11 @@ int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, doubl
     return finish(&e, &af, err);
 }
 
-int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
+/* VTP PolyData of a mesh or an outline: points, Normals (point data), cells of `arity` indices
+ * under `cells` ("Polys" or "Lines"), phase (cell data), TimeValue. Atomic. */
+static int write_polydata_vtp(const char *path, const double *v, const float *nrm, size_t nverts,
+                              const uint32_t *idx, const uint8_t *phase, size_t ncells, int arity,
+                              const char *cells, double time, pfsph_error *err)
 {
     pfsph__afile af;
     pfsph__enc e;
@@ -78,21 +82,29 @@ int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, doubl
     if (rc != PFSPH_OK) return rc;
     pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n");
     pfsph__enc_printf(&e, "<FieldData>\n<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n</FieldData>\n", time);
-    pfsph__enc_printf(&e, "<Piece NumberOfPoints=\"%zu\" NumberOfPolys=\"%zu\">\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n", m->nverts, m->ntris);
-    for (size_t i = 0; i < m->nverts; i++)
-        pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", m->v[3 * i], m->v[3 * i + 1], m->v[3 * i + 2]);
+    pfsph__enc_printf(&e, "<Piece NumberOfPoints=\"%zu\" NumberOf%s=\"%zu\">\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n", nverts, cells, ncells);
+    for (size_t i = 0; i < nverts; i++)
+        pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
     pfsph__enc_printf(&e, "</DataArray>\n</Points>\n<PointData Normals=\"Normals\">\n<DataArray type=\"Float32\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (size_t i = 0; i < m->nverts; i++)
-        pfsph__enc_printf(&e, "%.5f %.5f %.5f\n", m->n[3 * i], m->n[3 * i + 1], m->n[3 * i + 2]);
-    pfsph__enc_printf(&e, "</DataArray>\n</PointData>\n<Polys>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n");
-    for (size_t t = 0; t < m->ntris; t++)
-        pfsph__enc_printf(&e, "%u %u %u\n", m->tri[3 * t], m->tri[3 * t + 1], m->tri[3 * t + 2]);
+    for (size_t i = 0; i < nverts; i++)
+        pfsph__enc_printf(&e, "%.5f %.5f %.5f\n", nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+    pfsph__enc_printf(&e, "</DataArray>\n</PointData>\n<%s>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n", cells);
+    for (size_t t = 0; t < ncells; t++) {
+        const uint32_t *c = idx + (size_t)arity * t;
+        if (arity == 3) pfsph__enc_printf(&e, "%u %u %u\n", c[0], c[1], c[2]);
+        else pfsph__enc_printf(&e, "%u %u\n", c[0], c[1]);
+    }
     pfsph__enc_printf(&e, "</DataArray>\n<DataArray type=\"UInt32\" Name=\"offsets\" format=\"ascii\">\n");
-    for (size_t t = 1; t <= m->ntris; t++) pfsph__enc_printf(&e, "%zu\n", 3 * t);
-    pfsph__enc_printf(&e, "</DataArray>\n</Polys>\n<CellData Scalars=\"phase\">\n<DataArray type=\"UInt8\" Name=\"phase\" format=\"ascii\">\n");
-    for (size_t t = 0; t < m->ntris; t++) pfsph__enc_printf(&e, "%d\n", m->phase[t]);
+    for (size_t t = 1; t <= ncells; t++) pfsph__enc_printf(&e, "%zu\n", (size_t)arity * t);
+    pfsph__enc_printf(&e, "</DataArray>\n</%s>\n<CellData Scalars=\"phase\">\n<DataArray type=\"UInt8\" Name=\"phase\" format=\"ascii\">\n", cells);
+    for (size_t t = 0; t < ncells; t++) pfsph__enc_printf(&e, "%d\n", phase[t]);
     pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
     return finish(&e, &af, err);
+}
+
+int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
+{
+    return write_polydata_vtp(path, m->v, m->n, m->nverts, m->tri, m->phase, m->ntris, 3, "Polys", time, err);
 }
 
 /* ---- reader ---------------------------------------------------------------------------- */
@@ -252,26 +264,7 @@ done:
 
 int pfsph_write_contour_vtp(const char *path, const pfsph_surface_contour *c, double time, pfsph_error *err)
 {
-    pfsph__afile af;
-    pfsph__enc e;
-    int rc = pfsph__enc_open(&e, &af, path, err);
-    if (rc != PFSPH_OK) return rc;
-    pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n");
-    pfsph__enc_printf(&e, "<FieldData>\n<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n</FieldData>\n", time);
-    pfsph__enc_printf(&e, "<Piece NumberOfPoints=\"%zu\" NumberOfLines=\"%zu\">\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n", c->nverts, c->nsegs);
-    for (size_t i = 0; i < c->nverts; i++)
-        pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", c->v[3 * i], c->v[3 * i + 1], c->v[3 * i + 2]);
-    pfsph__enc_printf(&e, "</DataArray>\n</Points>\n<PointData Normals=\"Normals\">\n<DataArray type=\"Float32\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (size_t i = 0; i < c->nverts; i++)
-        pfsph__enc_printf(&e, "%.5f %.5f %.5f\n", c->n[3 * i], c->n[3 * i + 1], c->n[3 * i + 2]);
-    pfsph__enc_printf(&e, "</DataArray>\n</PointData>\n<Lines>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n");
-    for (size_t t = 0; t < c->nsegs; t++) pfsph__enc_printf(&e, "%u %u\n", c->seg[2 * t], c->seg[2 * t + 1]);
-    pfsph__enc_printf(&e, "</DataArray>\n<DataArray type=\"UInt32\" Name=\"offsets\" format=\"ascii\">\n");
-    for (size_t t = 1; t <= c->nsegs; t++) pfsph__enc_printf(&e, "%zu\n", 2 * t);
-    pfsph__enc_printf(&e, "</DataArray>\n</Lines>\n<CellData Scalars=\"phase\">\n<DataArray type=\"UInt8\" Name=\"phase\" format=\"ascii\">\n");
-    for (size_t t = 0; t < c->nsegs; t++) pfsph__enc_printf(&e, "%d\n", c->phase[t]);
-    pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
-    return finish(&e, &af, err);
+    return write_polydata_vtp(path, c->v, c->n, c->nverts, c->seg, c->phase, c->nsegs, 2, "Lines", time, err);
 }
 
 static int mesh_particles(const pfsph_surface_output *so, int dim, double spacing, const char *dir, int frame,
