@@ -36,6 +36,12 @@ enum pfsph__type { PFSPH__T_NONE = 0, PFSPH__T_I8, PFSPH__T_U8, PFSPH__T_I16, PF
 size_t pfsph__type_size(int type);
 /* A PLY scalar type name ("float", "uint8", ...) as its code; PFSPH__T_NONE if unknown. */
 int pfsph__ply_type(const char *s);
+/* The next line of a PLY header at *pos (CR-LF tolerated), copied into line[cap]: 0, or 1 when
+ * no end_header comes within the header limit, 2 when the line does not fit. Shared by the
+ * particle and the surface readers. */
+int pfsph__ply_header_line(const unsigned char *buf, size_t len, size_t *pos, char *line, size_t cap);
+/* "comment time T" sets *time (when time is not NULL); other comments are ignored. */
+void pfsph__ply_comment_time(const char *line, double *time);
 /* Decode one little-endian value of the given type as a double (exact for every type we write:
  * float, double, uint8, uint32). */
 double pfsph__get_as_double(int type, const unsigned char *src);

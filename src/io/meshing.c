@@ -141,14 +141,11 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
     size_t pos = 0, lineno = 0;
     char line[256];
     for (;;) {
-        const unsigned char *nl = memchr(buf + pos, '\n', len - pos);
-        if (!nl || (size_t)(nl - buf) > 65536) BAD("no end_header line");
-        size_t ll = (size_t)(nl - (buf + pos));
-        if (ll >= sizeof line) BAD("header line %zu too long", lineno + 1);
-        memcpy(line, buf + pos, ll);
-        line[ll] = 0;
-        if (ll && line[ll - 1] == '\r') line[--ll] = 0;
-        pos = (size_t)(nl - buf) + 1;
+        switch (pfsph__ply_header_line(buf, len, &pos, line, sizeof line)) {
+        case 1: BAD("no end_header line");
+        case 2: BAD("header line %zu too long", lineno + 1);
+        default: break;
+        }
         lineno++;
         char w[5][80];
         int nw = sscanf(line, "%79s %79s %79s %79s %79s", w[0], w[1], w[2], w[3], w[4]);
@@ -159,9 +156,7 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
         if (nw <= 0) continue;
         if (strcmp(w[0], "end_header") == 0) break;
         if (strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0) {
-            double t;
-            char tail;
-            if (time && sscanf(line, "comment time %lf %c", &t, &tail) == 1) *time = t;
+            pfsph__ply_comment_time(line, time);
             continue;
         }
         if (strcmp(w[0], "format") == 0) {

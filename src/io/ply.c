@@ -91,6 +91,26 @@ int pfsph__ply_type(const char *s)
 #define MAX_PROPS 32
 #define MAX_HEADER 65536
 
+int pfsph__ply_header_line(const unsigned char *buf, size_t len, size_t *pos, char *line, size_t cap)
+{
+    const unsigned char *nl = memchr(buf + *pos, '\n', len - *pos);
+    if (!nl || (size_t)(nl - buf) > MAX_HEADER) return 1;
+    size_t ll = (size_t)(nl - (buf + *pos));
+    if (ll >= cap) return 2;
+    memcpy(line, buf + *pos, ll);
+    line[ll] = 0;
+    if (ll && line[ll - 1] == '\r') line[--ll] = 0;
+    *pos = (size_t)(nl - buf) + 1;
+    return 0;
+}
+
+void pfsph__ply_comment_time(const char *line, double *time)
+{
+    double t;
+    char tail;
+    if (time && sscanf(line, "comment time %lf %c", &t, &tail) == 1) *time = t;
+}
+
 typedef struct ply_prop {
     int type;
     size_t offset; /* within a record */
@@ -120,14 +140,11 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
     size_t pos = 0, lineno = 0;
     char line[256];
     for (;;) {
-        const unsigned char *nl = memchr(buf + pos, '\n', len - pos);
-        if (!nl || (size_t)(nl - buf) > MAX_HEADER) BAD("no end_header line");
-        size_t ll = (size_t)(nl - (buf + pos));
-        if (ll >= sizeof line) BAD("header line %zu too long", lineno + 1);
-        memcpy(line, buf + pos, ll);
-        line[ll] = 0;
-        if (ll && line[ll - 1] == '\r') line[--ll] = 0;
-        pos = (size_t)(nl - buf) + 1;
+        switch (pfsph__ply_header_line(buf, len, &pos, line, sizeof line)) {
+        case 1: BAD("no end_header line");
+        case 2: BAD("header line %zu too long", lineno + 1);
+        default: break;
+        }
         lineno++;
         char w1[80], w2[80], w3[80], extra[8];
         int nw = sscanf(line, "%79s %79s %79s %7s", w1, w2, w3, extra);
@@ -138,9 +155,7 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
         if (nw <= 0) continue;
         if (strcmp(w1, "end_header") == 0) break;
         if (strcmp(w1, "comment") == 0 || strcmp(w1, "obj_info") == 0) {
-            double t;
-            char tail;
-            if (time && sscanf(line, "comment time %lf %c", &t, &tail) == 1) *time = t;
+            pfsph__ply_comment_time(line, time);
             continue;
         }
         if (strcmp(w1, "format") == 0) {
