@@ -19,6 +19,9 @@ typedef struct pfsph_hits {
     uint32_t j[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
     pfsph_real dx[PFSPH_HITS_CAP + PFSPH_HITS_PAD], dy[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
         dz[PFSPH_HITS_CAP + PFSPH_HITS_PAD], r2[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
+    /* per-hit scratch for the passes' terms (physics/pair_terms.h) */
+    pfsph_real t0[PFSPH_HITS_CAP + PFSPH_HITS_PAD], t1[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
+        t2[PFSPH_HITS_CAP + PFSPH_HITS_PAD], t3[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
 } pfsph_hits;
 
 /* Appends the targets j in [b, e) with r2 = |x - x_j|^2 < h2 and j != skip, in order, with

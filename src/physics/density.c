@@ -14,6 +14,7 @@
 
 #include "core/hits.h"
 #include "core/nlist.h"
+#include "physics/pair_terms.h"
 
 void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
                            const pfsph_real *z, pfsph_real *nd)
@@ -35,13 +36,13 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
             pfsph_real s = 0;
             /* the terms of the grid walk in its order (the hits keep it): the same bits */
             PFSPH_HITS_WALK(hits, &H, r, x, y, z, xi, yi, zi, h2, UINT32_MAX,
-                            for (int e = 0; e < H.n; e++) s += pfsph_kernel_w(k, pfsph_sqrt(H.r2[e])));
+                            pfsph__terms_w(k, H.n, H.r2, H.t0); for (int e = 0; e < H.n; e++) s += H.t0[e]);
             if (b->n) {
                 pfsph_real sb = 0;
                 pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
                 PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX,
-                                for (int e = 0; e < H.n; e++) sb +=
-                                    b->aux[H.j[e]] * pfsph_kernel_w(k, pfsph_sqrt(H.r2[e])));
+                                pfsph__terms_w(k, H.n, H.r2, H.t0);
+                                for (int e = 0; e < H.n; e++) sb += b->aux[H.j[e]] * H.t0[e]);
                 s += sb * inv_v0;
             }
             nd[i] = s;

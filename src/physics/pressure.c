@@ -3,6 +3,7 @@
 #include "physics/pressure.h"
 
 #include "core/hits.h"
+#include "physics/pair_terms.h"
 
 void pfsph__pressure_accel(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
                            const pfsph_real *z, const pfsph_real *nd, const pfsph_real *p,
@@ -25,9 +26,10 @@ void pfsph__pressure_accel(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
             pfsph_ranges r;
             pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
             /* the pairs within h of the grid walk, in its order: the same bits */
-            PFSPH_HITS_WALK(hits, &H, r, x, y, z, xi, yi, zi, h2, (uint32_t)i, for (int e = 0; e < H.n; e++) {
+            PFSPH_HITS_WALK(hits, &H, r, x, y, z, xi, yi, zi, h2, (uint32_t)i, pfsph__terms_dwr(k, H.n, H.r2, H.t0);
+                            for (int e = 0; e < H.n; e++) {
                 const uint32_t j = H.j[e];
-                pfsph_real s = (pi + p[j] / (nd[j] * nd[j])) * pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                pfsph_real s = (pi + p[j] / (nd[j] * nd[j])) * H.t0[e];
                 ax += s * H.dx[e];
                 ay += s * H.dy[e];
                 az += s * H.dz[e];
@@ -35,8 +37,9 @@ void pfsph__pressure_accel(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
             if (b->n && pi > 0) {
                 pfsph_real bx = 0, by = 0, bz = 0;
                 pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-                PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX, for (int e = 0; e < H.n; e++) {
-                    pfsph_real s = b->aux[H.j[e]] * pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX,
+                                pfsph__terms_dwr(k, H.n, H.r2, H.t0); for (int e = 0; e < H.n; e++) {
+                    pfsph_real s = b->aux[H.j[e]] * H.t0[e];
                     bx += s * H.dx[e];
                     by += s * H.dy[e];
                     bz += s * H.dz[e];

@@ -4,6 +4,7 @@
 
 #include "core/hits.h"
 #include "core/nlist.h"
+#include "physics/pair_terms.h"
 #include "physics/pressure.h"
 #include "pfsph/thermostat.h"
 
@@ -145,17 +146,38 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
         } else {
             pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
             /* the pairs within h of the grid walk, in its order */
-            PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, for (int e = 0; e < H.n; e++) {
-                const uint32_t j = H.j[e];
-                const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
-                visc_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, amp, ts, key, &acc);
-                if (fused) {
-                    const pfsph_real sp = (pi + p[j] / (nd[j] * nd[j])) * dwr;
-                    pax += sp * H.dx[e];
-                    pay += sp * H.dy[e];
-                    paz += sp * H.dz[e];
-                }
-            });
+            if (thermo) {
+                PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, for (int e = 0; e < H.n; e++) {
+                    const uint32_t j = H.j[e];
+                    const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                    visc_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, amp, ts, key, &acc);
+                    if (fused) {
+                        const pfsph_real sp = (pi + p[j] / (nd[j] * nd[j])) * dwr;
+                        pax += sp * H.dx[e];
+                        pay += sp * H.dy[e];
+                        paz += sp * H.dz[e];
+                    }
+                });
+            } else {
+                /* the factors of visc_pair and of the pressure term in vector code
+                 * (pair_terms.c), added in order: the same bits */
+                const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
+                PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
+                    for (int e = 0; e < H.n; e++) H.t3[e] = ctx->nu[f->phase[H.j[e]]];
+                    pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);
+                    for (int e = 0; e < H.n; e++) {
+                        acc.ax += H.t1[e] * H.dx[e];
+                        acc.ay += H.t1[e] * H.dy[e];
+                        acc.az += H.t1[e] * H.dz[e];
+                    }
+                    if (fused)
+                        for (int e = 0; e < H.n; e++) {
+                            pax += H.t2[e] * H.dx[e];
+                            pay += H.t2[e] * H.dy[e];
+                            paz += H.t2[e] * H.dz[e];
+                        }
+                });
+            }
         }
         ax = acc.ax, ay = acc.ay, az = acc.az, fx = acc.fx, fy = acc.fy, fz = acc.fz;
         /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
