@@ -119,143 +119,143 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     }
 #pragma omp parallel
     {
-    pfsph_hits H;
+        pfsph_hits H;
 #pragma omp for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-        const pfsph_real vxi = f->vx[i], vyi = f->vy[i], vzi = f->vz[i];
-        const int pa = f->phase[i];
-        const pfsph_real nui = ctx->nu[pa];
-        const double mi = (double)ctx->mass[pa], ndi = thermo ? (double)ctx->nd[i] : 0;
-        const uint32_t idi = f->id[i];
-        const pfsph_real pi = fused ? p[i] / (nd[i] * nd[i]) : 0;
-        pfsph_real pax = 0, pay = 0, paz = 0; /* pressure (fused) */
-        double fx = 0, fy = 0, fz = 0; /* thermostat */
-        pfsph_real ax = 0, ay = 0, az = 0;
-        pfsph_ranges r;
-        /* the same terms in the same order from a list or a grid walk: the same bits */
-        const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
-        visc_acc acc = {0, 0, 0, 0, 0, 0};
-        if (nl) {
-            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-                const uint32_t j = nl->idx[e];
-                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                visc_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, nl->dw[e], eps, thermo, amp, ts, key,
-                          &acc);
-            }
-        } else {
-            pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
-            /* the pairs within h of the grid walk, in its order */
-            if (thermo) {
-                PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, for (int e = 0; e < H.n; e++) {
-                    const uint32_t j = H.j[e];
-                    const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
-                    visc_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, amp, ts, key, &acc);
-                    if (fused) {
-                        const pfsph_real sp = (pi + p[j] / (nd[j] * nd[j])) * dwr;
-                        pax += sp * H.dx[e];
-                        pay += sp * H.dy[e];
-                        paz += sp * H.dz[e];
-                    }
-                });
-            } else {
-                /* the factors of visc_pair and of the pressure term in vector code
-                 * (pair_terms.c), added in order: the same bits */
-                const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
-                PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
-                    for (int e = 0; e < H.n; e++) H.t3[e] = ctx->nu[f->phase[H.j[e]]];
-                    pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);
-                    for (int e = 0; e < H.n; e++) {
-                        acc.ax += H.t1[e] * H.dx[e];
-                        acc.ay += H.t1[e] * H.dy[e];
-                        acc.az += H.t1[e] * H.dz[e];
-                    }
-                    if (fused)
-                        for (int e = 0; e < H.n; e++) {
-                            pax += H.t2[e] * H.dx[e];
-                            pay += H.t2[e] * H.dy[e];
-                            paz += H.t2[e] * H.dz[e];
-                        }
-                });
-            }
-        }
-        ax = acc.ax, ay = acc.ay, az = acc.az, fx = acc.fx, fy = acc.fy, fz = acc.fz;
-        /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
-         * says otherwise (ctx wall tables: free slip, its own viscosity); static walls rest,
-         * body particles move. With only default walls the table is skipped and the sum is
-         * the one of a single viscosity, nui times the sum. */
-        const int wall_visc = b->n && (nui > 0 || (mixed && wall_nu_max > 0));
-        if (wall_visc && bl) {
-            /* the same terms in the same order from the step's boundary list */
-            visc_acc w = {0, 0, 0, fx, fy, fz};
-            const double ampw = thermo ? amp * ts[pa][pa] : 0;
-            for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
-                const uint32_t j = bl->idx[e];
-                pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                wall_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, bl->dw[e], eps, thermo, ampw, wkey, &w);
-            }
-            fx = w.fx, fy = w.fy, fz = w.fz;
-            const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
-            ax += nub * w.ax;
-            ay += nub * w.ay;
-            az += nub * w.az;
-        } else if (wall_visc || (fused && b->n && pi > 0)) {
-            /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
-             * says otherwise (ctx wall tables: free slip, its own viscosity); static walls
-             * rest, body particles move. With only default walls the table is skipped and the
-             * sum is the one of a single viscosity, nui times the sum. Fused: the wall's
-             * pressure term (pfsph__pressure_accel) in the same walk. */
-            visc_acc w = {0, 0, 0, fx, fy, fz};
-            pfsph_real bx = 0, by = 0, bz = 0;
-            const double ampw = thermo ? amp * ts[pa][pa] : 0;
-            const int wall_p = fused && pi > 0;
-            pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-            PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX, for (int e = 0; e < H.n; e++) {
-                const uint32_t j = H.j[e];
-                const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
-                if (wall_visc)
-                    wall_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, ampw, wkey, &w);
-                if (wall_p) {
-                    const pfsph_real sb = b->aux[j] * dwr;
-                    bx += sb * H.dx[e];
-                    by += sb * H.dy[e];
-                    bz += sb * H.dz[e];
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+            const pfsph_real vxi = f->vx[i], vyi = f->vy[i], vzi = f->vz[i];
+            const int pa = f->phase[i];
+            const pfsph_real nui = ctx->nu[pa];
+            const double mi = (double)ctx->mass[pa], ndi = thermo ? (double)ctx->nd[i] : 0;
+            const uint32_t idi = f->id[i];
+            const pfsph_real pi = fused ? p[i] / (nd[i] * nd[i]) : 0;
+            pfsph_real pax = 0, pay = 0, paz = 0; /* pressure (fused) */
+            double fx = 0, fy = 0, fz = 0; /* thermostat */
+            pfsph_real ax = 0, ay = 0, az = 0;
+            pfsph_ranges r;
+            /* the same terms in the same order from a list or a grid walk: the same bits */
+            const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
+            visc_acc acc = {0, 0, 0, 0, 0, 0};
+            if (nl) {
+                for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
+                    const uint32_t j = nl->idx[e];
+                    pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                    visc_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, nl->dw[e], eps, thermo, amp, ts, key,
+                              &acc);
                 }
-            });
-            if (wall_visc) {
+            } else {
+                pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+                /* the pairs within h of the grid walk, in its order */
+                if (thermo) {
+                    PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, for (int e = 0; e < H.n; e++) {
+                        const uint32_t j = H.j[e];
+                        const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                        visc_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, amp, ts, key, &acc);
+                        if (fused) {
+                            const pfsph_real sp = (pi + p[j] / (nd[j] * nd[j])) * dwr;
+                            pax += sp * H.dx[e];
+                            pay += sp * H.dy[e];
+                            paz += sp * H.dz[e];
+                        }
+                    });
+                } else {
+                    /* the factors of visc_pair and of the pressure term in vector code
+                     * (pair_terms.c), added in order: the same bits */
+                    const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
+                    PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
+                        for (int e = 0; e < H.n; e++) H.t3[e] = ctx->nu[f->phase[H.j[e]]];
+                        pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);
+                        for (int e = 0; e < H.n; e++) {
+                            acc.ax += H.t1[e] * H.dx[e];
+                            acc.ay += H.t1[e] * H.dy[e];
+                            acc.az += H.t1[e] * H.dz[e];
+                        }
+                        if (fused)
+                            for (int e = 0; e < H.n; e++) {
+                                pax += H.t2[e] * H.dx[e];
+                                pay += H.t2[e] * H.dy[e];
+                                paz += H.t2[e] * H.dz[e];
+                            }
+                    });
+                }
+            }
+            ax = acc.ax, ay = acc.ay, az = acc.az, fx = acc.fx, fy = acc.fy, fz = acc.fz;
+            /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
+             * says otherwise (ctx wall tables: free slip, its own viscosity); static walls rest,
+             * body particles move. With only default walls the table is skipped and the sum is
+             * the one of a single viscosity, nui times the sum. */
+            const int wall_visc = b->n && (nui > 0 || (mixed && wall_nu_max > 0));
+            if (wall_visc && bl) {
+                /* the same terms in the same order from the step's boundary list */
+                visc_acc w = {0, 0, 0, fx, fy, fz};
+                const double ampw = thermo ? amp * ts[pa][pa] : 0;
+                for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
+                    const uint32_t j = bl->idx[e];
+                    pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
+                    wall_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, bl->dw[e], eps, thermo, ampw, wkey, &w);
+                }
                 fx = w.fx, fy = w.fy, fz = w.fz;
                 const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
                 ax += nub * w.ax;
                 ay += nub * w.ay;
                 az += nub * w.az;
+            } else if (wall_visc || (fused && b->n && pi > 0)) {
+                /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
+                 * says otherwise (ctx wall tables: free slip, its own viscosity); static walls
+                 * rest, body particles move. With only default walls the table is skipped and the
+                 * sum is the one of a single viscosity, nui times the sum. Fused: the wall's
+                 * pressure term (pfsph__pressure_accel) in the same walk. */
+                visc_acc w = {0, 0, 0, fx, fy, fz};
+                pfsph_real bx = 0, by = 0, bz = 0;
+                const double ampw = thermo ? amp * ts[pa][pa] : 0;
+                const int wall_p = fused && pi > 0;
+                pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
+                PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX, for (int e = 0; e < H.n; e++) {
+                    const uint32_t j = H.j[e];
+                    const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                    if (wall_visc)
+                        wall_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, ampw, wkey, &w);
+                    if (wall_p) {
+                        const pfsph_real sb = b->aux[j] * dwr;
+                        bx += sb * H.dx[e];
+                        by += sb * H.dy[e];
+                        bz += sb * H.dz[e];
+                    }
+                });
+                if (wall_visc) {
+                    fx = w.fx, fy = w.fy, fz = w.fz;
+                    const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
+                    ax += nub * w.ax;
+                    ay += nub * w.ay;
+                    az += nub * w.az;
+                }
+                if (wall_p) {
+                    /* Akinci 2012: the wall pushes with p_i alone (pressure.c) */
+                    const pfsph_real wb = pi * inv_v0;
+                    pax += wb * bx;
+                    pay += wb * by;
+                    paz += wb * bz;
+                }
             }
-            if (wall_p) {
-                /* Akinci 2012: the wall pushes with p_i alone (pressure.c) */
-                const pfsph_real wb = pi * inv_v0;
-                pax += wb * bx;
-                pay += wb * by;
-                paz += wb * bz;
+            if (fused) {
+                const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[pa];
+                ap[0][i] = inv_m * pax;
+                ap[1][i] = inv_m * pay;
+                ap[2][i] = inv_m * paz;
+            }
+            ctx->ax[i] = gx + visc_c * ax;
+            ctx->ay[i] = gy + visc_c * ay;
+            ctx->az[i] = gz + visc_c * az;
+            if (thermo) {
+                const pfsph_real nx = (pfsph_real)(fx / mi), ny = (pfsph_real)(fy / mi), nz = (pfsph_real)(fz / mi);
+                noise[0][i] = nx;
+                noise[1][i] = ny;
+                noise[2][i] = nz;
+                ctx->ax[i] += nx;
+                ctx->ay[i] += ny;
+                ctx->az[i] += nz;
             }
         }
-        if (fused) {
-            const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[pa];
-            ap[0][i] = inv_m * pax;
-            ap[1][i] = inv_m * pay;
-            ap[2][i] = inv_m * paz;
-        }
-        ctx->ax[i] = gx + visc_c * ax;
-        ctx->ay[i] = gy + visc_c * ay;
-        ctx->az[i] = gz + visc_c * az;
-        if (thermo) {
-            const pfsph_real nx = (pfsph_real)(fx / mi), ny = (pfsph_real)(fy / mi), nz = (pfsph_real)(fz / mi);
-            noise[0][i] = nx;
-            noise[1][i] = ny;
-            noise[2][i] = nz;
-            ctx->ax[i] += nx;
-            ctx->ay[i] += ny;
-            ctx->az[i] += nz;
-        }
-    }
     }
 }
 
