@@ -105,6 +105,11 @@ int main(int argc, char **argv)
     for (int k = 0; k < PFSPH_NSTAGES; k++)
         if (st[k] > 0) printf(" %s %.2f", pfsph_stage_names[k], st[k]);
     printf("\n");
+    const double *sc = pfsph_sim_stage_cpu_seconds(sim);
+    printf("  per stage, CPU [s]:");
+    for (int k = 0; k < PFSPH_NSTAGES; k++)
+        if (sc[k] > 0) printf(" %s %.4f", pfsph_stage_names[k], sc[k]);
+    printf("\n");
     pfsph_sim_destroy(sim);
     return rc ? 3 : 0;
 }

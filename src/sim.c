@@ -803,8 +803,16 @@ static int st_forces(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     (void)bad;
     (void)err;
-    if (sim->scr_noise >= 0) { /* with the thermostat's random forces, fused (viscosity.c) */
-        pfsph_real *nz[3] = {sim->scr[sim->scr_noise], sim->scr[sim->scr_noise + 1], sim->scr[sim->scr_noise + 2]};
+    pfsph_real *nz[3] = {NULL, NULL, NULL};
+    if (sim->scr_noise >= 0)
+        for (int a = 0; a < 3; a++) nz[a] = sim->scr[sim->scr_noise + a];
+    sim->ctx.pressure_done = 0;
+    if (sim->solver->eos && !sim->pw) { /* pressure in the same walk (solver.h, eos) */
+        pfsph_real *const ap[3] = {sim->scr[SCR_APX], sim->scr[SCR_APY], sim->scr[SCR_APZ]};
+        sim->solver->eos(sim->solver_state, &sim->ctx);
+        pfsph__forces_and_pressure(&sim->ctx, sim->scr_noise >= 0 ? nz : NULL, sim->fluid.p, ap);
+        sim->ctx.pressure_done = 1;
+    } else if (sim->scr_noise >= 0) { /* with the thermostat's random forces, fused (viscosity.c) */
         pfsph__nonpressure_thermo(&sim->ctx, nz);
     } else {
         pfsph__nonpressure(&sim->ctx);
@@ -856,6 +864,7 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     const pfsph_real fdt = (pfsph_real)dt;
     double amax2 = 0, anp2 = 0;
     c->nlist = c->nlist_b = NULL; /* the particles move: this step's lists no longer hold */
+    c->pressure_done = 0;
     pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
     int bad_ = 0;

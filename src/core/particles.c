@@ -88,24 +88,31 @@ int pfsph_particles_permute(pfsph_particles *ps, const uint32_t *perm, size_t n_
     pfsph_real *t = tmp;
     /* one parallel region for all fields: a region per field cost a quarter of a small
      * scene's wall time on a loaded machine (thread wake-ups) */
-#pragma omp parallel
-    for (int k = 0; k < PFSPH_NFIELDS; k++) {
-        pfsph_real *a = ps->f[k];
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n_new; i++) t[i] = a[perm[i]];
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n_new; i++) a[i] = t[i];
-    }
     uint32_t *tu = tmp;
-    for (size_t i = 0; i < n_new; i++) tu[i] = ps->id[perm[i]];
-    memcpy(ps->id, tu, n_new * sizeof(uint32_t));
     uint8_t *tb = tmp;
-    for (size_t i = 0; i < n_new; i++) tb[i] = ps->phase[perm[i]];
-    memcpy(ps->phase, tb, n_new);
-    for (size_t i = 0; i < n_new; i++) tb[i] = ps->wall[perm[i]];
-    memcpy(ps->wall, tb, n_new);
-    for (size_t i = 0; i < n_new; i++) tb[i] = ps->bubble[perm[i]];
-    memcpy(ps->bubble, tb, n_new);
+    uint8_t *const bytes[3] = {ps->phase, ps->wall, ps->bubble};
+    /* the integer fields in the same region too: serial, they were 1 % of a WCSPH step's
+     * instructions, which caps the speed-up of two threads (docs/benchmarks.md) */
+#pragma omp parallel
+    {
+        for (int k = 0; k < PFSPH_NFIELDS; k++) {
+            pfsph_real *a = ps->f[k];
+#pragma omp for schedule(static)
+            for (size_t i = 0; i < n_new; i++) t[i] = a[perm[i]];
+#pragma omp for schedule(static)
+            for (size_t i = 0; i < n_new; i++) a[i] = t[i];
+        }
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n_new; i++) tu[i] = ps->id[perm[i]];
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n_new; i++) ps->id[i] = tu[i];
+        for (int k = 0; k < 3; k++) {
+#pragma omp for schedule(static)
+            for (size_t i = 0; i < n_new; i++) tb[i] = bytes[k][perm[i]];
+#pragma omp for schedule(static)
+            for (size_t i = 0; i < n_new; i++) bytes[k][i] = tb[i];
+        }
+    }
     ps->n = n_new;
     free(own);
     return PFSPH_OK;

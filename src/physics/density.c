@@ -12,7 +12,9 @@
 #define PFSPH__SSE 0
 #endif
 
+#include "core/hits.h"
 #include "core/nlist.h"
+#include "physics/pair_terms.h"
 
 void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
                            const pfsph_real *z, pfsph_real *nd)
@@ -22,30 +24,29 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
     const pfsph_particles *b = ctx->boundary;
     const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
     const size_t n = ctx->fluid->n;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        pfsph_ranges r;
-        const pfsph_real xi = x[i], yi = y[i], zi = z[i];
-        pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
-        pfsph_real s = 0;
-        for (int q = 0; q < r.n; q++)
-            for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                pfsph_real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
-                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 < h2) s += pfsph_kernel_w(k, pfsph_sqrt(r2));
+    const pfsph_hits_fn hits = pfsph_hits_select();
+#pragma omp parallel
+    {
+        pfsph_hits H;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            pfsph_ranges r;
+            const pfsph_real xi = x[i], yi = y[i], zi = z[i];
+            pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+            pfsph_real s = 0;
+            /* the terms of the grid walk in its order (the hits keep it): the same bits */
+            PFSPH_HITS_WALK(hits, &H, r, x, y, z, xi, yi, zi, h2, UINT32_MAX,
+                            pfsph__terms_w(k, H.n, H.r2, H.t0); for (int e = 0; e < H.n; e++) s += H.t0[e]);
+            if (b->n) {
+                pfsph_real sb = 0;
+                pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
+                PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX,
+                                pfsph__terms_w(k, H.n, H.r2, H.t0);
+                                for (int e = 0; e < H.n; e++) sb += b->aux[H.j[e]] * H.t0[e]);
+                s += sb * inv_v0;
             }
-        if (b->n) {
-            pfsph_real sb = 0;
-            pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-            for (int q = 0; q < r.n; q++)
-                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                    pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                    if (r2 < h2) sb += b->aux[j] * pfsph_kernel_w(k, pfsph_sqrt(r2));
-                }
-            s += sb * inv_v0;
+            nd[i] = s;
         }
-        nd[i] = s;
     }
 }
 

@@ -2,6 +2,9 @@
  * 2008) with the Akinci 2012 boundary term. */
 #include "physics/pressure.h"
 
+#include "core/hits.h"
+#include "physics/pair_terms.h"
+
 void pfsph__pressure_accel(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
                            const pfsph_real *z, const pfsph_real *nd, const pfsph_real *p,
                            pfsph_real *apx, pfsph_real *apy, pfsph_real *apz)
@@ -11,46 +14,47 @@ void pfsph__pressure_accel(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
     const pfsph_real h2 = k->h * k->h;
     const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
     const size_t n = f->n;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        const pfsph_real xi = x[i], yi = y[i], zi = z[i];
-        const pfsph_real pi = p[i] / (nd[i] * nd[i]);
-        pfsph_real ax = 0, ay = 0, az = 0;
-        pfsph_ranges r;
-        pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
-        for (int q = 0; q < r.n; q++)
-            for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                pfsph_real dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
-                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 >= h2 || j == i) continue;
-                pfsph_real s = (pi + p[j] / (nd[j] * nd[j])) * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
-                ax += s * dx;
-                ay += s * dy;
-                az += s * dz;
+    const pfsph_hits_fn hits = pfsph_hits_select();
+#pragma omp parallel
+    {
+        pfsph_hits H;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real xi = x[i], yi = y[i], zi = z[i];
+            const pfsph_real pi = p[i] / (nd[i] * nd[i]);
+            pfsph_real ax = 0, ay = 0, az = 0;
+            pfsph_ranges r;
+            pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+            /* the pairs within h of the grid walk, in its order: the same bits */
+            PFSPH_HITS_WALK(hits, &H, r, x, y, z, xi, yi, zi, h2, (uint32_t)i, pfsph__terms_dwr(k, H.n, H.r2, H.t0);
+                            for (int e = 0; e < H.n; e++) {
+                const uint32_t j = H.j[e];
+                pfsph_real s = (pi + p[j] / (nd[j] * nd[j])) * H.t0[e];
+                ax += s * H.dx[e];
+                ay += s * H.dy[e];
+                az += s * H.dz[e];
+            });
+            if (b->n && pi > 0) {
+                pfsph_real bx = 0, by = 0, bz = 0;
+                pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
+                PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX,
+                                pfsph__terms_dwr(k, H.n, H.r2, H.t0); for (int e = 0; e < H.n; e++) {
+                    pfsph_real s = b->aux[H.j[e]] * H.t0[e];
+                    bx += s * H.dx[e];
+                    by += s * H.dy[e];
+                    bz += s * H.dz[e];
+                });
+                /* Akinci 2012: the wall pushes with p_i alone. Mirroring (2 p_i) was tried: it
+                 * pumps energy into a WCSPH tank at rest (kinetic energy x100 in 0.3 s). */
+                const pfsph_real wb = pi * inv_v0;
+                ax += wb * bx;
+                ay += wb * by;
+                az += wb * bz;
             }
-        if (b->n && pi > 0) {
-            pfsph_real bx = 0, by = 0, bz = 0;
-            pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-            for (int q = 0; q < r.n; q++)
-                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                    pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                    if (r2 >= h2) continue;
-                    pfsph_real s = b->aux[j] * pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
-                    bx += s * dx;
-                    by += s * dy;
-                    bz += s * dz;
-                }
-            /* Akinci 2012: the wall pushes with p_i alone. Mirroring (2 p_i) was tried: it
-             * pumps energy into a WCSPH tank at rest (kinetic energy x100 in 0.3 s). */
-            const pfsph_real wb = pi * inv_v0;
-            ax += wb * bx;
-            ay += wb * by;
-            az += wb * bz;
+            const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
+            apx[i] = inv_m * ax;
+            apy[i] = inv_m * ay;
+            apz[i] = inv_m * az;
         }
-        const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
-        apx[i] = inv_m * ax;
-        apy[i] = inv_m * ay;
-        apz[i] = inv_m * az;
     }
 }

@@ -37,6 +37,12 @@ typedef struct pfsph_solver_ops {
      * |g| + the largest pair-force acceleration (an upper bound of |g + a_pair|). Viscosity
      * smooths velocities; it compresses nothing that the solve must undo (DFSPH, docs/solvers.md). */
     int np_cap_without_viscosity;
+    /* Optional (may be NULL): the pressure from the density alone (an equation of state),
+     * written to fluid->p. Given, and without pair forces (which read last step's p), the
+     * forces stage writes p and computes the pressure acceleration in the viscosity's
+     * neighbour walk (one walk instead of two; viscosity.c) and sets ctx->pressure_done for
+     * solve, which then finds ap filled. */
+    void (*eos)(void *state, const pfsph_ctx *ctx);
     /* Solver state for the fluid of ctx; NULL state is allowed. */
     int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg,
                   pfsph_error *err);

@@ -2,7 +2,10 @@
  * the fluid's or the solid's own viscosity, or free slip). */
 #include "physics/viscosity.h"
 
+#include "core/hits.h"
 #include "core/nlist.h"
+#include "physics/pair_terms.h"
+#include "physics/pressure.h"
 #include "pfsph/thermostat.h"
 
 /* particle i as its fluid pairs see it */
@@ -82,8 +85,12 @@ static inline void wall_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
 
 /* thermo: also the thermostat's random forces (thermostat.h), fused into this pass so that the
  * neighbours within h are walked once; the same expressions as pfsph_thermostat_apply, so the
- * same bits. Specialised at compile time (two call sites with a constant). */
-static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3], const int thermo)
+ * same bits. fused: also the pressure acceleration of pfsph__pressure_accel (at the fluid's
+ * positions, with ctx->nd and p) into ap, in the same walk (grid walks only: WCSPH, whose
+ * pressure needs the density alone); each sum keeps its terms and order, so the same bits as
+ * the two passes. Specialised at compile time (call sites with constants). */
+static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3], const int thermo, const int fused,
+                               const pfsph_real *p, pfsph_real *const ap[3])
 {
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
@@ -98,6 +105,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     const int mixed = ctx->nwalls > 1;
     const pfsph_nlist *nl = ctx->nlist, *bl = ctx->nlist_b; /* the step's lists, when the solver built them */
     const pfsph_real wall_nu_max = ctx->wall_nu_max;
+    const pfsph_real *nd = ctx->nd, inv_v0 = (pfsph_real)1 / ctx->V0;
+    const pfsph_hits_fn hits = pfsph_hits_select();
     double amp = 0, ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     uint64_t key = 0, wkey = 0;
     if (thermo) {
@@ -108,90 +117,167 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
         key = pfsph_thermo_step_key(ctx->seed, ctx->step, 0);
         wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
     }
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-        const pfsph_real vxi = f->vx[i], vyi = f->vy[i], vzi = f->vz[i];
-        const int pa = f->phase[i];
-        const pfsph_real nui = ctx->nu[pa];
-        const double mi = (double)ctx->mass[pa], ndi = thermo ? (double)ctx->nd[i] : 0;
-        const uint32_t idi = f->id[i];
-        double fx = 0, fy = 0, fz = 0; /* thermostat */
-        pfsph_real ax = 0, ay = 0, az = 0;
-        pfsph_ranges r;
-        /* the same terms in the same order from a list or a grid walk: the same bits */
-        const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
-        visc_acc acc = {0, 0, 0, 0, 0, 0};
-        if (nl) {
-            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-                const uint32_t j = nl->idx[e];
-                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                visc_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, nl->dw[e], eps, thermo, amp, ts, key,
-                          &acc);
-            }
-        } else {
-            pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
-            for (int q = 0; q < r.n; q++)
-                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
+#pragma omp parallel
+    {
+        pfsph_hits H;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+            const pfsph_real vxi = f->vx[i], vyi = f->vy[i], vzi = f->vz[i];
+            const int pa = f->phase[i];
+            const pfsph_real nui = ctx->nu[pa];
+            const double mi = (double)ctx->mass[pa], ndi = thermo ? (double)ctx->nd[i] : 0;
+            const uint32_t idi = f->id[i];
+            const pfsph_real pi = fused ? p[i] / (nd[i] * nd[i]) : 0;
+            pfsph_real pax = 0, pay = 0, paz = 0; /* pressure (fused) */
+            double fx = 0, fy = 0, fz = 0; /* thermostat */
+            pfsph_real ax = 0, ay = 0, az = 0;
+            pfsph_ranges r;
+            /* the same terms in the same order from a list or a grid walk: the same bits */
+            const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
+            visc_acc acc = {0, 0, 0, 0, 0, 0};
+            if (nl) {
+                for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
+                    const uint32_t j = nl->idx[e];
                     pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                    if (r2 >= h2 || j == i) continue;
-                    visc_pair(ctx, &vi, j, dx, dy, dz, r2, pfsph_kernel_dw_r(k, pfsph_sqrt(r2)), eps, thermo, amp, ts,
-                              key, &acc);
+                    visc_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, nl->dw[e], eps, thermo, amp, ts, key,
+                              &acc);
                 }
-        }
-        ax = acc.ax, ay = acc.ay, az = acc.az, fx = acc.fx, fy = acc.fy, fz = acc.fz;
-        /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
-         * says otherwise (ctx wall tables: free slip, its own viscosity); static walls rest,
-         * body particles move. With only default walls the table is skipped and the sum is
-         * the one of a single viscosity, nui times the sum. */
-        if (b->n && (nui > 0 || (mixed && wall_nu_max > 0))) {
-            /* the same terms in the same order from the step's boundary list or a grid walk */
-            visc_acc w = {0, 0, 0, fx, fy, fz};
-            const double ampw = thermo ? amp * ts[pa][pa] : 0;
-            if (bl) {
+            } else {
+                pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
+                /* the pairs within h of the grid walk, in its order */
+                if (thermo) {
+                    PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, for (int e = 0; e < H.n; e++) {
+                        const uint32_t j = H.j[e];
+                        const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                        visc_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, amp, ts, key, &acc);
+                        if (fused) {
+                            const pfsph_real sp = (pi + p[j] / (nd[j] * nd[j])) * dwr;
+                            pax += sp * H.dx[e];
+                            pay += sp * H.dy[e];
+                            paz += sp * H.dz[e];
+                        }
+                    });
+                } else {
+                    /* the factors of visc_pair and of the pressure term in vector code
+                     * (pair_terms.c), added in order: the same bits */
+                    const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
+                    PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
+                        for (int e = 0; e < H.n; e++) H.t3[e] = ctx->nu[f->phase[H.j[e]]];
+                        pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);
+                        for (int e = 0; e < H.n; e++) {
+                            acc.ax += H.t1[e] * H.dx[e];
+                            acc.ay += H.t1[e] * H.dy[e];
+                            acc.az += H.t1[e] * H.dz[e];
+                        }
+                        if (fused)
+                            for (int e = 0; e < H.n; e++) {
+                                pax += H.t2[e] * H.dx[e];
+                                pay += H.t2[e] * H.dy[e];
+                                paz += H.t2[e] * H.dz[e];
+                            }
+                    });
+                }
+            }
+            ax = acc.ax, ay = acc.ay, az = acc.az, fx = acc.fx, fy = acc.fy, fz = acc.fz;
+            /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
+             * says otherwise (ctx wall tables: free slip, its own viscosity); static walls rest,
+             * body particles move. With only default walls the table is skipped and the sum is
+             * the one of a single viscosity, nui times the sum. */
+            const int wall_visc = b->n && (nui > 0 || (mixed && wall_nu_max > 0));
+            if (wall_visc && bl) {
+                /* the same terms in the same order from the step's boundary list */
+                visc_acc w = {0, 0, 0, fx, fy, fz};
+                const double ampw = thermo ? amp * ts[pa][pa] : 0;
                 for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
                     const uint32_t j = bl->idx[e];
                     pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                    wall_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, bl->dw[e], eps, thermo, ampw, wkey,
-                              &w);
+                    wall_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, bl->dw[e], eps, thermo, ampw, wkey, &w);
                 }
-            } else {
+                fx = w.fx, fy = w.fy, fz = w.fz;
+                const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
+                ax += nub * w.ax;
+                ay += nub * w.ay;
+                az += nub * w.az;
+            } else if (wall_visc || (fused && b->n && pi > 0)) {
+                /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
+                 * says otherwise (ctx wall tables: free slip, its own viscosity); static walls
+                 * rest, body particles move. With only default walls the table is skipped and the
+                 * sum is the one of a single viscosity, nui times the sum. Fused: the wall's
+                 * pressure term (pfsph__pressure_accel) in the same walk. */
+                visc_acc w = {0, 0, 0, fx, fy, fz};
+                pfsph_real bx = 0, by = 0, bz = 0;
+                const double ampw = thermo ? amp * ts[pa][pa] : 0;
+                const int wall_p = fused && pi > 0;
                 pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-                for (int q = 0; q < r.n; q++)
-                    for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                        pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                        pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                        if (r2 >= h2) continue;
-                        wall_pair(ctx, &vi, j, dx, dy, dz, r2, pfsph_kernel_dw_r(k, pfsph_sqrt(r2)), eps, thermo, ampw,
-                                  wkey, &w);
+                PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX, for (int e = 0; e < H.n; e++) {
+                    const uint32_t j = H.j[e];
+                    const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                    if (wall_visc)
+                        wall_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, ampw, wkey, &w);
+                    if (wall_p) {
+                        const pfsph_real sb = b->aux[j] * dwr;
+                        bx += sb * H.dx[e];
+                        by += sb * H.dy[e];
+                        bz += sb * H.dz[e];
                     }
+                });
+                if (wall_visc) {
+                    fx = w.fx, fy = w.fy, fz = w.fz;
+                    const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
+                    ax += nub * w.ax;
+                    ay += nub * w.ay;
+                    az += nub * w.az;
+                }
+                if (wall_p) {
+                    /* Akinci 2012: the wall pushes with p_i alone (pressure.c) */
+                    const pfsph_real wb = pi * inv_v0;
+                    pax += wb * bx;
+                    pay += wb * by;
+                    paz += wb * bz;
+                }
             }
-            fx = w.fx, fy = w.fy, fz = w.fz;
-            const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
-            ax += nub * w.ax;
-            ay += nub * w.ay;
-            az += nub * w.az;
-        }
-        ctx->ax[i] = gx + visc_c * ax;
-        ctx->ay[i] = gy + visc_c * ay;
-        ctx->az[i] = gz + visc_c * az;
-        if (thermo) {
-            const pfsph_real nx = (pfsph_real)(fx / mi), ny = (pfsph_real)(fy / mi), nz = (pfsph_real)(fz / mi);
-            noise[0][i] = nx;
-            noise[1][i] = ny;
-            noise[2][i] = nz;
-            ctx->ax[i] += nx;
-            ctx->ay[i] += ny;
-            ctx->az[i] += nz;
+            if (fused) {
+                const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[pa];
+                ap[0][i] = inv_m * pax;
+                ap[1][i] = inv_m * pay;
+                ap[2][i] = inv_m * paz;
+            }
+            ctx->ax[i] = gx + visc_c * ax;
+            ctx->ay[i] = gy + visc_c * ay;
+            ctx->az[i] = gz + visc_c * az;
+            if (thermo) {
+                const pfsph_real nx = (pfsph_real)(fx / mi), ny = (pfsph_real)(fy / mi), nz = (pfsph_real)(fz / mi);
+                noise[0][i] = nx;
+                noise[1][i] = ny;
+                noise[2][i] = nz;
+                ctx->ax[i] += nx;
+                ctx->ay[i] += ny;
+                ctx->az[i] += nz;
+            }
         }
     }
 }
 
-void pfsph__nonpressure(const pfsph_ctx *ctx) { nonpressure(ctx, NULL, 0); }
+void pfsph__nonpressure(const pfsph_ctx *ctx) { nonpressure(ctx, NULL, 0, 0, NULL, NULL); }
 
 void pfsph__nonpressure_thermo(const pfsph_ctx *ctx, pfsph_real *const noise[3])
 {
-    if (pfsph_thermostat_kT(ctx) > 0 && ctx->dt > 0) nonpressure(ctx, noise, 1);
-    else nonpressure(ctx, NULL, 0);
+    if (pfsph_thermostat_kT(ctx) > 0 && ctx->dt > 0) nonpressure(ctx, noise, 1, 0, NULL, NULL);
+    else nonpressure(ctx, NULL, 0, 0, NULL, NULL);
+}
+
+void pfsph__forces_and_pressure(const pfsph_ctx *ctx, pfsph_real *const noise[3], const pfsph_real *p,
+                                pfsph_real *const ap[3])
+{
+    const int thermo = noise && pfsph_thermostat_kT(ctx) > 0 && ctx->dt > 0;
+    if (ctx->nlist) { /* lists are walked pass by pass */
+        if (thermo) nonpressure(ctx, noise, 1, 0, NULL, NULL);
+        else nonpressure(ctx, NULL, 0, 0, NULL, NULL);
+        pfsph__pressure_accel(ctx, ctx->fluid->x, ctx->fluid->y, ctx->fluid->z, ctx->nd, p, ap[0], ap[1], ap[2]);
+    } else if (thermo) {
+        nonpressure(ctx, noise, 1, 1, p, ap);
+    } else {
+        nonpressure(ctx, NULL, 0, 1, p, ap);
+    }
 }

@@ -30,14 +30,21 @@ static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config 
 
 static void destroy(void *state) { free(state); }
 
+static void eos(void *state, const pfsph_ctx *c)
+{
+    const wcsph *w = state;
+    pfsph__tait(c, c->nd, w->B, w->gamma, w->rho_common, c->fluid->p);
+}
+
 static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsph_real *const *scr,
                   pfsph_solve_stats *out)
 {
-    const wcsph *w = state;
     pfsph_particles *f = c->fluid;
     const size_t n = f->n;
-    pfsph__tait(c, c->nd, w->B, w->gamma, w->rho_common, f->p);
-    pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, f->p, ap[0], ap[1], ap[2]);
+    if (!c->pressure_done) { /* else the forces stage did both in one walk */
+        eos(state, c);
+        pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, f->p, ap[0], ap[1], ap[2]);
+    }
     pfsph_real *er = scr[0];
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
@@ -75,6 +82,7 @@ static const char *hint(const void *state, const pfsph_ctx *ctx)
 const pfsph_solver_ops pfsph_solver_wcsph = {
     .name = "wcsph",
     .nscratch = 1,
+    .eos = eos,
     .create = create,
     .destroy = destroy,
     .solve = solve,
