@@ -9,7 +9,7 @@
  * The blocks start jittered by 0.1 d: a perfect lattice cube collapses symmetrically and drives
  * each corner particle head-on into its diagonal neighbour (0.002 d apart at 0.12 s), where the
  * cubic spline's gradient vanishes; docs/pairwise.md, "Shape relaxation". Elongated blocks
- * lock instead (tests/pending, the yield stress of the pair-force liquid). */
+ * at temperature: tests/validation/test_pf_square_to_circle.c and test_pf_cube_to_sphere.c. */
 #include <math.h>
 #include <omp.h>
 #include <stdbool.h>
