@@ -21,11 +21,11 @@
  *    resting bubble reads 0.994, not 1; the minimum is taken from 0.5 s on (the lattice disc's
  *    staircase relaxes over the first ~0.3 s);
  *  - aspect: sqrt of the smaller / larger eigenvalue of the gas positions' second moments, and
- *    h/w = sqrt(<dy^2> / <dx^2>) for the orientation;
+ *    h/w = sqrt(<dy^2> / <dx^2>) for the orientation (16 d: down to 0.84, the bubble flattens);
  *  - the noise floor: the same bubble without gravity, D = 16 d, 0.2-1 s.
  *
  * Measured (2026-12-02, one core):
- *   at rest (D 16 d): circularity 0.9936 +- 0.0009 (sd), aspect 0.974 +- 0.006
+ *   at rest (D 16 d): circularity 0.9936 +- 0.0008 (sd), aspect 0.974 +- 0.006
  *   | D    | U (1-3 s) | U (0.5-1.5 s) | vmax (at)        | yc(3)  | circularity min (at) | aspect min |
  *   | 16 d | 0.1971    | 0.1868        | 0.2121 (2.05 s)  | 1.0278 | 0.9720 (2.95 s)      | 0.832      |
  *   | 20 d | 0.1788    | 0.1716        | 0.1900 (1.90 s)  | 1.0011 | 0.9795 (2.95 s)      | 0.877      |
@@ -37,7 +37,8 @@
  *  - refinement, the issue's criterion: U at the two spacings within 10 % of each other. It
  *    holds (0.907) by a small margin, and the finer spacing is the slower one at every measure
  *    (~9 % for a 20 % finer spacing, U ~ d^0.44): the rise has not converged; a third spacing
- *    would probably leave the 10 %.
+ *    would probably leave the 10 %. A study run at D = 24 d (outside the test, ~280 s) continues
+ *    the trend: U (0.5-1.5 s) 0.187 / 0.172 / 0.156 at 16 / 20 / 24 d.
  *  - Hysing: vmax and the rise yc(3) - 0.5 within 25 % of the benchmark, at both spacings. This
  *    is a bound on the measured deficit (vmax -12 % / -21 %, rise -9 % / -14 %), not agreement:
  *    the particle bubble accelerates more slowly (peak at ~2 s, not 0.92 s) and rises slower.
@@ -311,7 +312,7 @@ static double mean_over(const run_result *r, const double *q, double ta, double 
     return c ? m / c : 0;
 }
 
-/* Hysing et al. 2009, test case 1, Table (finest grids): */
+/* Hysing et al. 2009, test case 1, the benchmark values (TP2D, finest grid): */
 #define H_VMAX 0.2417 /* maximal rise velocity, at t = 0.921 */
 #define H_CMIN 0.9013 /* minimal circularity, at t = 1.904 */
 #define H_YC3 1.0813  /* centroid height at t = 3 */
