@@ -30,10 +30,12 @@ double pfsph_pairwise_lambda(int dim, double R)
  * lattice discs of radius 10, 15 and 20 d, sigma target 4 N/m, k 1.7, h = 2 d, nu 1e-3,
  * WCSPH; the slope of the interior mechanical pressure against 1 / R_e (Laplace:
  * dp = sigma / R), averaged over 1-6 s: 1.014 +- 0.06 at theta 0.01, 0.893 +- 0.05 at 0.02
- * (intercepts +0.1 and +3.6 Pa). At 0.005 one radius (10 d): 1.004 +- 0.022. Checked on other
- * radii and with PCISPH by test_pf_laplace. Beyond 0.02 not measured: held at its last value. */
-static const double sigma_theta[] = {0.005, 0.01, 0.02};
-static const double sigma_ratio[] = {1.004, 1.014, 0.893};
+ * (intercepts +0.1 and +3.6 Pa); 0.764 +- 0.079 at 0.04 and 0.819 +- 0.103 at 0.08 (intercepts +10.9
+ * and +11.6 Pa; radii 10, 15, 20 d, 1-6 s, weighted fit). At 0.005 one radius (10 d): 1.004 +- 0.022.
+ * Checked on other radii and with PCISPH by test_pf_laplace (at 0.01). Beyond 0.08 not measured:
+ * held at its last value. */
+static const double sigma_theta[] = {0.005, 0.01, 0.02, 0.04, 0.08};
+static const double sigma_ratio[] = {1.004, 1.014, 0.893, 0.764, 0.819};
 #define NSIGMA (sizeof sigma_theta / sizeof sigma_theta[0])
 
 double pfsph_pairwise_sigma_factor(int dim, double theta)

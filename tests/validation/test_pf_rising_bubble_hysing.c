@@ -1,0 +1,378 @@
+/* Rising bubble after Hysing et al. 2009 (Int. J. Numer. Meth. Fluids 60, 1259), test case 1, 2D,
+ * at two particle spacings: rise velocity, centroid, circularity and aspect ratio (issue 11).
+ *
+ * Setup (Hysing's): a 1 x 2 box of liquid (rho 1000, mu 10) with a gas bubble (rho 100, mu 1) of
+ * radius 0.25 centred at (0.5, 0.5); nu = 0.01 in both; g = 0.98; sigma = 24.5; Eotvos number
+ * rho g D^2 / sigma = 10, Reynolds number rho sqrt(g D) D / mu = 35. Side walls free slip, top and
+ * bottom no slip (3 layers each). PCISPH, pair forces k 1.7, default thermostat (theta 0.01).
+ * The tension: water against the unsimulated air 24.5 N/m, gas cohesion 0.245 N/m (1 %), and the
+ * water-gas pair given its own target, sigma_wg = 24.5 N/m (Eq. 13 solved for c_wg = 0.199, with
+ * the factor at temperature); water on the walls 90 degrees, as in test_pf_rising_bubble.
+ * Spacings: bubble diameter D = 16 d (2,048 fluid particles, 208 gas) and 20 d (3,200, 316 gas).
+ *
+ * Measured every 0.05 s to t = 3 s:
+ *  - rise velocity: the gas particles' mean vertical velocity (Hysing's definition); U = its mean
+ *    over 1-3 s; vmax = the largest 0.2 s running mean (a single sample carries the thermal
+ *    noise, 0.015 m/s sd for the resting bubble);
+ *  - centroid: the gas particles' mean position;
+ *  - circularity: 2 sqrt(pi A) / P of the outline, the 0.5 contour of the Shepard colour field
+ *    c = sum_gas W / sum W (Wendland, support 2 d) on a grid of d / 2, traced by marching squares;
+ *    A is the area inside that contour. The grid contour of a particle field is rough, so even the
+ *    resting bubble reads 0.994, not 1; the minimum is taken from 0.5 s on (the lattice disc's
+ *    staircase relaxes over the first ~0.3 s);
+ *  - aspect: sqrt of the smaller / larger eigenvalue of the gas positions' second moments, and
+ *    h/w = sqrt(<dy^2> / <dx^2>) for the orientation (16 d: down to 0.84, the bubble flattens);
+ *  - the noise floor: the same bubble without gravity, D = 16 d, 0.2-1 s.
+ *
+ * Measured (2026-12-02, one core):
+ *   at rest (D 16 d): circularity 0.9936 +- 0.0008 (sd), aspect 0.974 +- 0.006
+ *   | D    | U (1-3 s) | U (0.5-1.5 s) | vmax (at)        | yc(3)  | circularity min (at) | aspect min |
+ *   | 16 d | 0.1971    | 0.1868        | 0.2121 (2.05 s)  | 1.0278 | 0.9720 (2.95 s)      | 0.832      |
+ *   | 20 d | 0.1788    | 0.1717        | 0.1920 (1.90 s)  | 1.0011 | 0.9795 (2.95 s)      | 0.877      |
+ *   | 24 d | 0.1726    | 0.1564        | 0.1848 (2.60 s)  | 0.9742 | 0.9853 (2.55 s)      | 0.898      |
+ *   | Hysing |         |               | 0.2417 (0.92 s)  | 1.0813 | 0.9013 (1.90 s)      |            |
+ *   20 d / 16 d: U 0.907, U (0.5-1.5 s) 0.919, vmax 0.905, rise yc(3) - 0.5: 0.949.
+ *   (24 d is a study run outside the test: 226 s; 24 d / 20 d: U 0.965, vmax 0.963, rise 0.946.)
+ *   CPU (Release, one core): the test 185 s (19 s at rest, 57 s at 16 d with 7,178 steps, ~110 s
+ *   at 20 d with 10,272 steps).
+ *
+ * Checks and why these bounds:
+ *  - refinement, the issue's criterion: U at the two spacings within 10 % of each other. It
+ *    holds (0.907) by a small margin; the finer spacing is the slower one at every measure. The
+ *    24 d study run slows by 3.5 % more: U may converge, ~25 % below Hysing's velocities.
+ *  - Hysing: vmax and the rise yc(3) - 0.5 within 25 % of the benchmark, at both spacings. This
+ *    is a bound on the measured deficit (vmax -12 % / -21 %, rise -9 % / -14 %; 24 d: -24 % /
+ *    -18 %), not agreement: the particle bubble accelerates more slowly (peak at ~2 s, not
+ *    0.92 s) and rises slower.
+ *  - deformation: the circularity minimum and the aspect minimum lie more than 5 sd of the
+ *    resting bubble's noise below its mean (0.9891 and 0.942). They do; but the deformation is a
+ *    third (16 d: 1 - c = 0.028) to a fifth (20 d: 0.021; 24 d: 0.015, rounder still) of
+ *    Hysing's (0.099), and it appears late (circularity 0.985 at 1.9 s, where Hysing's is at its
+ *    minimum): an Eo 10 bubble here is measurably not a circle, but far rounder than the
+ *    benchmark's.
+ *  Study (one run each, D 16 d, to 1.5 s): nu halved to 0.005 raises U (0.5-1.5 s) to 0.205 and
+ *  deepens the circularity to 0.971 by 1.45 s; theta 0.04 lowers U to 0.176. The particle liquid
+ *  behaves as if more viscous than its nu (docs/thermostat.md: rectangles relax ~30x slower than
+ *  nu says), which fits both the slow rise and the round bubble.
+ * Under AddressSanitizer: D 16 d only, 0.3 s at rest and rising, no physics checks.
+ * Study knobs: PF_N1, PF_N2 (particles per diameter), PF_T, PF_TR (rest run), PF_NU, PF_SOLVER,
+ * PF_PW (text inserted in the pairwise block). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pfsph/sim.h"
+#include "testutil.h"
+
+enum { WATER = 0, GAS = 1 };
+#define PI 3.14159265358979323846
+
+/* Hysing test case 1: 1 x 2 box, bubble of radius 0.25 centred at (0.5, 0.5); rho 1000 / 100,
+ * mu 10 / 1 (nu 0.01 in both), g 0.98, sigma 24.5. Side walls free slip, top and bottom no slip. */
+static const char *SCENE =
+    "{\"dimension\": 2, \"particle_radius\": %.10g, \"gravity\": [0, %g],"
+    " \"domain\": {\"min\": [%.10g, %.10g], \"max\": [%.10g, %.10g]},"
+    " \"solver\": {\"type\": \"%s\"}, \"time\": {\"end\": 3, \"fps\": 20},"
+    " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": %g},"
+    "   {\"name\": \"gas\", \"kind\": \"gas\", \"rest_density\": 100, \"viscosity\": %g},"
+    "   {\"name\": \"wall\", \"kind\": \"solid\"}],"
+    " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [1, 2], \"phase\": \"water\"},"
+    "   {\"shape\": \"sphere\", \"center\": [0.5, 0.5], \"radius\": 0.25, \"phase\": \"gas\"}],"
+    " \"solids\": [{\"shape\": \"box\", \"min\": [%.10g, %.10g], \"max\": [%.10g, 0], \"layers\": 3},"
+    "   {\"shape\": \"box\", \"min\": [%.10g, 2], \"max\": [%.10g, %.10g], \"layers\": 3},"
+    "   {\"shape\": \"box\", \"min\": [%.10g, 0], \"max\": [0, 2], \"layers\": 3, \"slip\": \"free-slip\"},"
+    "   {\"shape\": \"box\", \"min\": [1, 0], \"max\": [%.10g, 2], \"layers\": 3, \"slip\": \"free-slip\"}],"
+    " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": ["
+    "   {\"phases\": [\"water\", \"water\"], \"sigma\": 24.5},"
+    "   {\"phases\": [\"gas\", \"gas\"], \"sigma\": 0.245},"
+    "   {\"phases\": [\"water\", \"gas\"], \"sigma\": 24.5},"
+    "   {\"phases\": [\"water\", \"wall\"], \"contact_angle\": 90}]}}";
+
+typedef struct shape {
+    double cx, cy, vy;  /* gas centroid and mean vertical velocity */
+    double aspect;      /* sqrt(smaller / larger eigenvalue of the gas second moments) */
+    double hw;          /* sqrt(<dy^2> / <dx^2>): height over width, < 1 for a flattened bubble */
+    double circ;        /* circularity: 2 sqrt(pi A) / perimeter of the 0.5 contour */
+    double perim, area; /* that contour's length and enclosed area (marching squares) */
+    int ngas;
+} shape;
+
+/* Wendland C2 (2D), support H; only ratios of it are used */
+static double wk(double r2, double H)
+{
+    double q = sqrt(r2) / H;
+    if (q >= 1) return 0;
+    double a = 1 - q;
+    return a * a * a * a * (1 + 4 * q);
+}
+
+static double lerp0(double a, double b) { return a / (a - b); } /* where a + t (b - a) = 0 */
+
+/* The bubble's outline: the 0.5 level of the Shepard colour field c = sum_gas W / sum W (support
+ * 2 d) on a grid of spacing d / 2, traced by marching squares; the area is that of the cells'
+ * sub-0.5 polygons summed exactly (each cell's polygon from the same interpolated crossings). */
+static void measure(const pfsph_ctx *c, shape *s)
+{
+    const pfsph_particles *f = c->fluid;
+    const double d = c->spacing, H = 2 * d, g = 0.5 * d;
+    double sx = 0, sy = 0, sv = 0;
+    double x0 = 1e30, y0 = 1e30, x1 = -1e30, y1 = -1e30;
+    int ng = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->phase[i] != GAS) continue;
+        double x = f->x[i], y = f->y[i];
+        sx += x;
+        sy += y;
+        sv += f->vy[i];
+        ng++;
+        if (x < x0) x0 = x;
+        if (x > x1) x1 = x;
+        if (y < y0) y0 = y;
+        if (y > y1) y1 = y;
+    }
+    s->ngas = ng;
+    s->cx = sx / ng;
+    s->cy = sy / ng;
+    s->vy = sv / ng;
+    double mxx = 0, myy = 0, mxy = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->phase[i] != GAS) continue;
+        double dx = f->x[i] - s->cx, dy = f->y[i] - s->cy;
+        mxx += dx * dx;
+        myy += dy * dy;
+        mxy += dx * dy;
+    }
+    double tr = mxx + myy, det = mxx * myy - mxy * mxy, disc = sqrt(fmax(0, 0.25 * tr * tr - det));
+    s->aspect = sqrt((0.5 * tr - disc) / (0.5 * tr + disc));
+    s->hw = sqrt(myy / mxx);
+
+    /* colour field on the grid around the gas, particles within H of it */
+    x0 -= 2 * H;
+    y0 -= 2 * H;
+    x1 += 2 * H;
+    y1 += 2 * H;
+    const int nx = (int)ceil((x1 - x0) / g) + 1, ny = (int)ceil((y1 - y0) / g) + 1;
+    double *cf = calloc((size_t)nx * ny, sizeof *cf), *wt = calloc((size_t)nx * ny, sizeof *wt);
+    if (!cf || !wt) abort();
+    for (size_t i = 0; i < f->n; i++) {
+        double x = f->x[i], y = f->y[i];
+        if (x < x0 - H || x > x1 + H || y < y0 - H || y > y1 + H) continue;
+        int ia = (int)floor((x - H - x0) / g), ib = (int)ceil((x + H - x0) / g);
+        int ja = (int)floor((y - H - y0) / g), jb = (int)ceil((y + H - y0) / g);
+        for (int jj = ja < 0 ? 0 : ja; jj <= jb && jj < ny; jj++)
+            for (int ii = ia < 0 ? 0 : ia; ii <= ib && ii < nx; ii++) {
+                double dx = x0 + ii * g - x, dy = y0 + jj * g - y, w = wk(dx * dx + dy * dy, H);
+                wt[jj * nx + ii] += w;
+                if (f->phase[i] == GAS) cf[jj * nx + ii] += w;
+            }
+    }
+    for (int k = 0; k < nx * ny; k++) cf[k] = (wt[k] > 0 ? cf[k] / wt[k] : 0) - 0.5; /* > 0: gas */
+    double P = 0, A = 0;
+    for (int jj = 0; jj + 1 < ny; jj++)
+        for (int ii = 0; ii + 1 < nx; ii++) {
+            /* corners counter-clockwise: (0,0) (1,0) (1,1) (0,1) */
+            const double v[4] = {cf[jj * nx + ii], cf[jj * nx + ii + 1], cf[(jj + 1) * nx + ii + 1],
+                                 cf[(jj + 1) * nx + ii]};
+            const double cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
+            /* polygon of the gas part of the cell (walk the corners, insert edge crossings) */
+            double px[8], py[8], ex[4], ey[4];
+            int np = 0, ne = 0;
+            for (int e = 0; e < 4; e++) {
+                int a = e, b = (e + 1) & 3;
+                if (v[a] > 0) {
+                    px[np] = cx[a];
+                    py[np++] = cy[a];
+                }
+                if ((v[a] > 0) != (v[b] > 0)) {
+                    double t = lerp0(v[a], v[b]);
+                    px[np] = cx[a] + t * (cx[b] - cx[a]);
+                    py[np++] = cy[a] + t * (cy[b] - cy[a]);
+                    ex[ne] = px[np - 1];
+                    ey[ne++] = py[np - 1];
+                }
+            }
+            for (int k = 0; k < np; k++) A += 0.5 * (px[k] * py[(k + 1) % np] - px[(k + 1) % np] * py[k]);
+            /* contour segments: crossings in walk order pair up (0-1, 2-3); for a saddle this
+             * joins the crossings of one corner region, either pairing has nearly the same length */
+            for (int k = 0; k + 1 < ne; k += 2) P += hypot(ex[k + 1] - ex[k], ey[k + 1] - ey[k]);
+        }
+    free(cf);
+    free(wt);
+    s->perim = P * g;
+    s->area = A * g * g;
+    s->circ = 2 * sqrt(PI * s->area) / s->perim;
+}
+
+enum { NMAX = 128, SMOOTH = 5 };
+
+typedef struct run_result {
+    int n, nk, ngas;
+    double t[NMAX], yc[NMAX], vy[NMAX], circ[NMAX], aspect[NMAX], hw[NMAX];
+    double vmax, t_vmax;      /* largest 0.2 s running mean of the gas's mean vertical velocity */
+    double circ_min, t_circ_min, hw_min, asp_min; /* after 0.5 s */
+    double circ_mean, circ_sd, asp_mean, asp_sd; /* over the samples after 0.2 s */
+    unsigned long long steps;
+} run_result;
+
+static void run(int n, double t_end, int rest, run_result *r)
+{
+    const double d = 0.5 / n, w = 3 * d;
+    const double nu = getenv("PF_NU") ? atof(getenv("PF_NU")) : 0.01;
+    char json[8192];
+    snprintf(json, sizeof json, SCENE, 0.5 * d, rest ? 0.0 : -0.98, -w - d, -w - d, 1 + w + d, 2 + w + d,
+             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", nu, nu, -w, -w, 1 + w, -w, 1 + w, 2 + w,
+             -w, 1 + w, getenv("PF_PW") ? getenv("PF_PW") : "");
+    static pfsph_scene sc;
+    pfsph_error err = {0};
+    int rc = pfsph_scene_parse(&sc, json, "hysing bubble", &err);
+    if (rc) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim;
+    rc = pfsph_sim_create(&sim, &sc, &err);
+    if (rc) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    memset(r, 0, sizeof *r);
+    r->n = n;
+    const double dt_s = 0.05;
+    r->nk = (int)lround(t_end / dt_s);
+    assert_true(r->nk < NMAX);
+    shape s;
+    measure(c, &s);
+    r->ngas = s.ngas;
+    printf("n=%d%s: %d gas particles (area %.4f, pi/16 = %.4f), outline area %.4f, circularity %.4f at t=0\n", n,
+           rest ? " at rest" : "", s.ngas, s.ngas * d * d, PI / 16, s.area, s.circ);
+    for (int k = 1; k <= r->nk; k++) {
+        const double t = k * dt_s;
+        rc = pfsph_sim_advance(sim, t, &err);
+        if (rc) fprintf(stderr, "%s\n", err.msg);
+        assert_int_equal(rc, PFSPH_OK);
+        measure(c, &s);
+        assert_int_equal(s.ngas, r->ngas);
+        r->t[k] = t;
+        r->yc[k] = s.cy;
+        r->vy[k] = s.vy;
+        r->circ[k] = s.circ;
+        r->aspect[k] = s.aspect;
+        r->hw[k] = s.hw;
+        printf("n=%d%s t=%.2f: yc %.4f vy %.4f circ %.4f aspect %.4f h/w %.4f perim %.4f area %.4f\n", n,
+               rest ? " rest" : "", t, s.cy, s.vy, s.circ, s.aspect, s.hw, s.perim, s.area);
+        fflush(stdout);
+    }
+    r->vmax = -1e9;
+    r->circ_min = r->hw_min = r->asp_min = 1e9;
+    double s1 = 0, s2 = 0, a1 = 0, a2 = 0;
+    int ns = 0;
+    for (int k = 1; k <= r->nk; k++) {
+        if (k + SMOOTH - 1 <= r->nk) {
+            double m = 0;
+            for (int q = 0; q < SMOOTH; q++) m += r->vy[k + q];
+            m /= SMOOTH;
+            if (m > r->vmax) {
+                r->vmax = m;
+                r->t_vmax = r->t[k + SMOOTH / 2];
+            }
+        }
+        if (r->t[k] > 0.2 + 1e-9) {
+            s1 += r->circ[k];
+            s2 += r->circ[k] * r->circ[k];
+            a1 += r->aspect[k];
+            a2 += r->aspect[k] * r->aspect[k];
+            ns++;
+        }
+        if (r->t[k] < 0.5 - 1e-9) continue; /* the lattice disc's staircase relaxes over the first ~0.3 s */
+        if (r->circ[k] < r->circ_min) {
+            r->circ_min = r->circ[k];
+            r->t_circ_min = r->t[k];
+        }
+        if (r->hw[k] < r->hw_min) r->hw_min = r->hw[k];
+        if (r->aspect[k] < r->asp_min) r->asp_min = r->aspect[k];
+    }
+    r->circ_mean = s1 / ns;
+    r->circ_sd = sqrt(fmax(0, s2 / ns - r->circ_mean * r->circ_mean));
+    r->asp_mean = a1 / ns;
+    r->asp_sd = sqrt(fmax(0, a2 / ns - r->asp_mean * r->asp_mean));
+    r->steps = (unsigned long long)pfsph_sim_steps(sim);
+    printf("n=%d%s: vmax (0.2 s mean) %.4f at %.2f s, circularity min %.4f at %.2f s, mean %.4f sd %.4f; aspect "
+           "mean %.4f sd %.4f, min %.4f; h/w min %.4f; yc(end) %.4f; steps %llu\n",
+           n, rest ? " at rest" : "", r->vmax, r->t_vmax, r->circ_min, r->t_circ_min, r->circ_mean, r->circ_sd,
+           r->asp_mean, r->asp_sd, r->asp_min, r->hw_min, r->yc[r->nk], r->steps);
+    fflush(stdout);
+    pfsph_sim_destroy(sim);
+}
+
+/* mean of a sampled quantity over [ta, tb] */
+static double mean_over(const run_result *r, const double *q, double ta, double tb)
+{
+    double m = 0;
+    int c = 0;
+    for (int k = 1; k <= r->nk; k++)
+        if (r->t[k] >= ta - 1e-9 && r->t[k] <= tb + 1e-9) {
+            m += q[k];
+            c++;
+        }
+    return c ? m / c : 0;
+}
+
+/* Hysing et al. 2009, test case 1, the benchmark values (TP2D, finest grid): */
+#define H_VMAX 0.2417 /* maximal rise velocity, at t = 0.921 */
+#define H_CMIN 0.9013 /* minimal circularity, at t = 1.904 */
+#define H_YC3 1.0813  /* centroid height at t = 3 */
+
+static void test_hysing(void **state)
+{
+    (void)state;
+    static run_result rest, a, b;
+#ifdef __SANITIZE_ADDRESS__
+    /* the sanitizer build runs the code paths only: the coarse bubble for 0.3 s, the resting one 0.3 s */
+    run(16, 0.3, 1, &rest);
+    run(16, 0.3, 0, &a);
+    (void)b;
+    (void)mean_over;
+#else
+    const int n1 = getenv("PF_N1") ? atoi(getenv("PF_N1")) : 16, n2 = getenv("PF_N2") ? atoi(getenv("PF_N2")) : 20;
+    const double T = getenv("PF_T") ? atof(getenv("PF_T")) : 3.0;
+    run(n1, getenv("PF_TR") ? atof(getenv("PF_TR")) : 1.0, 1, &rest);
+    run(n1, T, 0, &a);
+    run(n2, T, 0, &b);
+    /* rise velocity: the gas's mean velocity averaged over 1-3 s (41 samples: its sampling noise,
+     * 0.015 m/s per sample at rest, averages to ~0.3 %; the maximum of a 0.2 s mean is reported
+     * but carries ~3 %) */
+    const double ua = mean_over(&a, a.vy, 1.0, 3.0), ub = mean_over(&b, b.vy, 1.0, 3.0);
+    const double ua1 = mean_over(&a, a.vy, 0.5, 1.5), ub1 = mean_over(&b, b.vy, 0.5, 1.5);
+    printf("summary: at rest (D = %d d, 0.2-1 s) circularity %.4f +- %.4f (sd), aspect %.4f +- %.4f\n", n1,
+           rest.circ_mean, rest.circ_sd, rest.asp_mean, rest.asp_sd);
+    const run_result *rr[2] = {&a, &b};
+    for (int i = 0; i < 2; i++)
+        printf("summary D = %d d: vmax %.4f at %.2f s (Hysing %.4f at 0.92 s: %.3f), yc(3) %.4f (Hysing %.4f; rise "
+               "%.3f of Hysing's), circularity min %.4f at %.2f s (Hysing %.4f at 1.9 s), aspect min %.4f, h/w min "
+               "%.4f, steps %llu\n",
+               rr[i]->n, rr[i]->vmax, rr[i]->t_vmax, H_VMAX, rr[i]->vmax / H_VMAX, rr[i]->yc[rr[i]->nk], H_YC3,
+               (rr[i]->yc[rr[i]->nk] - 0.5) / (H_YC3 - 0.5), rr[i]->circ_min, rr[i]->t_circ_min, H_CMIN,
+               rr[i]->asp_min, rr[i]->hw_min, rr[i]->steps);
+    printf("summary: rise velocity 1-3 s %.4f / %.4f (ratio %.3f), 0.5-1.5 s %.4f / %.4f (ratio %.3f), vmax ratio "
+           "%.3f\n",
+           ua, ub, ub / ua, ua1, ub1, ub1 / ua1, b.vmax / a.vmax);
+    fflush(stdout);
+    if (T < 3) return; /* study runs */
+    /* refinement (the issue): the two spacings' rise velocities within 10 % of each other */
+    assert_true(fabs(ub / ua - 1) <= 0.10);
+    for (int i = 0; i < 2; i++) {
+        const run_result *r = rr[i];
+        /* against Hysing: a bound on the measured deficit (12-21 %), not agreement; see the header */
+        assert_true(fabs(r->vmax / H_VMAX - 1) <= 0.25);
+        assert_true(fabs((r->yc[r->nk] - 0.5) / (H_YC3 - 0.5) - 1) <= 0.25);
+        /* deformation: the rising bubble leaves the range of the resting one's thermal noise */
+        assert_true(r->circ_min < rest.circ_mean - 5 * rest.circ_sd);
+        assert_true(r->asp_min < rest.asp_mean - 5 * rest.asp_sd);
+    }
+#endif
+}
+
+int main(int argc, char **argv)
+{
+    tu_init(argc, argv);
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_hysing)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
