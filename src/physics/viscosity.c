@@ -29,7 +29,6 @@ static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
                              visc_acc *acc)
 {
     const pfsph_particles *f = ctx->fluid;
-    const pfsph_kernel *k = &ctx->kern;
     pfsph_real nu = (pfsph_real)0.5 * (I->nu + ctx->nu[f->phase[j]]);
     pfsph_real vdx = (I->vx - f->vx[j]) * dx + (I->vy - f->vy[j]) * dy + (I->vz - f->vz[j]) * dz;
     pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
@@ -41,9 +40,9 @@ static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
         const double nud = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
         if (nud > 0 && r2 > 0) {
             const double rd = sqrt((double)r2);
+            /* dwr, not dw_r((real) rd): (real) sqrt((double) r2) is pfsph_sqrt(r2), so the same bits */
             const double t = pfsph__thermo_fluid(amp * ts[I->phase][pb], nud, I->m, (double)ctx->mass[pb], I->nd,
-                                                 (double)ctx->nd[j], (double)r2,
-                                                 (double)pfsph_kernel_dw_r(k, (pfsph_real)rd), (double)eps, rd,
+                                                 (double)ctx->nd[j], (double)r2, (double)dwr, (double)eps, rd,
                                                  pfsph_thermo_theta(key, I->id, f->id[j]));
             acc->fx += t * (double)dx;
             acc->fy += t * (double)dy;
@@ -61,7 +60,6 @@ static inline void wall_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
                              uint64_t wkey, visc_acc *acc)
 {
     const pfsph_particles *b = ctx->boundary;
-    const pfsph_kernel *k = &ctx->kern;
     const int mixed = ctx->nwalls > 1;
     pfsph_real vdx = (I->vx - b->vx[j]) * dx + (I->vy - b->vy[j]) * dy + (I->vz - b->vz[j]) * dz;
     /* the boundary particle's volume V_b plays the role of m_j / rho_j */
@@ -74,8 +72,8 @@ static inline void wall_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
         const double rd = sqrt((double)r2);
         const double nuw = mixed ? (double)ctx->wall_scale[b->wall[j]] * (double)I->nu + (double)ctx->wall_nu[b->wall[j]]
                                  : (double)I->nu;
-        const double t = pfsph__thermo_wall(ampw, nuw, I->m, (double)b->aux[j], (double)r2,
-                                            (double)pfsph_kernel_dw_r(k, (pfsph_real)rd), (double)eps, rd,
+        /* dwr, not dw_r((real) rd): (real) sqrt((double) r2) is pfsph_sqrt(r2), so the same bits */
+        const double t = pfsph__thermo_wall(ampw, nuw, I->m, (double)b->aux[j], (double)r2, (double)dwr, (double)eps, rd,
                                             pfsph_thermo_theta(wkey, I->id, b->id[j]));
         acc->fx += t * (double)dx;
         acc->fy += t * (double)dy;
