@@ -5,7 +5,10 @@
 #
 # usage: bench/peer_side_by_side.sh SPHSimulator KIT_DIR PFSPH [case ...]
 #   KIT_DIR holds the kit's sp_*.json (with @SPL@ replaced) and pf_*.json.
-#   cases: step7k step59k step493k tts7k tts59k  (default: all); REPS (default 2), THREADS (2).
+#   cases: step7k step59k step493k tts7k tts59k  (default: all); REPS (default 2), THREADS (2),
+#   WAIT=passive (default, the kit's setting: OMP_WAIT_POLICY=passive for both codes) or
+#   WAIT=default (each program's own: libgomp's spinning for SPlisHSPlasH, pfsph's
+#   GOMP_SPINCOUNT=1000).
 # Per step (WCSPH, fixed dt): (wall of N steps - wall of 1 step) / (N - 1) for both codes, so
 # set-up (sampling walls, SPlisHSPlasH's volume maps) is not counted.
 # Time to solution: 3 s of dam break, pfsph DFSPH (its defaults) against SPlisHSPlasH DFSPH
@@ -15,7 +18,7 @@ SPL=$1 KIT=$2 PF=$3
 shift 3
 cases=${*:-step7k step59k step493k tts7k tts59k}
 REPS=${REPS:-2}
-export OMP_WAIT_POLICY=passive
+if [ "${WAIT:-passive}" = passive ]; then export OMP_WAIT_POLICY=passive; else unset OMP_WAIT_POLICY GOMP_SPINCOUNT; fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
