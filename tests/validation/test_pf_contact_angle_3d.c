@@ -15,7 +15,7 @@
  * averaged over samples every 0.02 s from 1 s to 2 s (the drops settle within about 0.6 s; one
  * sample scatters by about 2 degrees) and must lie within 10 degrees of the target; each drop's
  * lowest particle must stay within a spacing of the plate.
- * Measured: 57.5 (sd 1.8), 90.6 (sd 2.5), 121.7 (sd 2.1) degrees for 60, 90, 120; 82 s of CPU
+ * Measured: 56.5 (sd 1.8), 91.3 (sd 2.3), 121.4 (sd 2.7) degrees for 60, 90, 120; 76 s of CPU
  * time on one core (label validation). 2 s, not the 6 s of the 2D test: a 3D step costs ~20 us
  * per particle (support 3.4 d), and the angles are steady from 0.5 s on. Under AddressSanitizer
  * the drops run 0.04 s and only the code paths are checked.
