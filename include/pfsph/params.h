@@ -107,21 +107,23 @@ double pfsph_pairwise_lambda(int dim, double R);
 
 /* Surface tension at temperature: the measured tension of the pair-force liquid divided by
  * Eq. 13's lambda c rho^2, at reduced temperature theta = kT / (lambda c rho^2 d^(dim-1))
- * (docs/thermostat.md, "Surface tension at temperature"). A table measured in 2D, interpolated
- * linearly, held at its ends; 1 in 3D (not calibrated) and for theta <= 0 (thermostat off). */
+ * (docs/thermostat.md, "Surface tension at temperature"). A table measured in 2D and one in 3D,
+ * interpolated linearly, held at their ends; 1 for theta <= 0 (thermostat off). */
 double pfsph_pairwise_sigma_factor(int dim, double theta);
 /* Contact angle -> Eq. 21's adhesion ratio r = c_wa rho_w / (c_aa rho_a) at reduced
- * temperature theta: a table measured in 2D at the default temperature (docs/pairwise.md,
- * "Contact angles at temperature"); Eq. 21, r = (1 + cos angle) / 2, in 3D and with the
- * thermostat off (theta <= 0). Angles more wetting than the table reaches extend its last
+ * temperature theta: tables measured in 2D and in 3D at the default temperature
+ * (docs/pairwise.md, "Contact angles at temperature"); Eq. 21, r = (1 + cos angle) / 2, with the
+ * thermostat off (theta <= 0). Angles more wetting than a table reaches extend its last
  * segment. */
 double pfsph_pairwise_angle_ratio(int dim, double theta, double angle_deg);
 /* The inverse: the static angle [deg] expected for ratio r. */
 double pfsph_pairwise_angle_expected(int dim, double theta, double r);
-/* The largest ratio the table measured. */
-double pfsph_pairwise_angle_ratio_max(void);
+/* The largest ratio the table of dimension dim measured (1 where there is none). */
+double pfsph_pairwise_angle_ratio_max(int dim);
+/* Whether a measured angle table applies (dimension dim at theta), rather than Eq. 21. */
+bool pfsph_pairwise_angle_measured(int dim, double theta);
 /* The largest theta of that table: beyond it the factor is extrapolated as a constant. */
-double pfsph_pairwise_sigma_theta_max(void);
+double pfsph_pairwise_sigma_theta_max(int dim);
 
 /* ---- bubbles in air: two-phase film particles (physics/film.c, include/pfsph/film.h) ---- */
 

@@ -400,7 +400,8 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
             if (pp->angle_set[a][b])
                 fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (%s)\n",
                         s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b],
-                        s->dim == 2 && pp->theta > 0 ? "table at temperature" : "Eq. 21");
+                        pfsph_pairwise_angle_measured(s->dim, pp->theta) ? "table at temperature"
+                                                                          : "Eq. 21");
         }
     if (!pp->resolved) return;
     /* what the liquid is expected to do at its temperature: Eq. 13's tension times the
@@ -409,13 +410,10 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
     if (!s->pairwise.thermo.enabled)
         fprintf(out, "  expected tensions: Eq. 13 (thermostat off: the liquid freezes, and a frozen "
                 "drop's Laplace pressure reads 0.76-0.88 of it)\n");
-    else if (s->dim != 2)
-        fprintf(out, "  expected tensions at theta = %.4g: Eq. 13 (3D: the factor at temperature is "
-                "not calibrated)\n", pp->theta);
     else
-        fprintf(out, "  expected tensions at theta = %.4g: Eq. 13 x %.3f (measured factor at "
-                "temperature, docs/thermostat.md)%s\n", pp->theta, pp->sigma_factor,
-                pp->theta > pfsph_pairwise_sigma_theta_max() ? "; theta beyond the measured table: "
+        fprintf(out, "  expected tensions at theta = %.4g: Eq. 13 x %.3f (measured %dD factor at "
+                "temperature, docs/thermostat.md)%s\n", pp->theta, pp->sigma_factor, s->dim,
+                pp->theta > pfsph_pairwise_sigma_theta_max(s->dim) ? "; theta beyond the measured table: "
                 "its last value is used" : "");
     for (int a = 0; a < np; a++) {
         if (s->phases[a].kind == PFSPH_PHASE_SOLID) continue;
@@ -428,10 +426,10 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
             if (s->phases[b].kind == PFSPH_PHASE_SOLID) {
                 if (!(pp->c[a][a] > 0) || !(rb > 0)) continue;
                 const double r = pp->c[a][b] * rb / (pp->c[a][a] * ra);
-                const bool table = s->dim == 2 && pp->theta > 0;
+                const bool table = pfsph_pairwise_angle_measured(s->dim, pp->theta);
                 const double ang = pfsph_pairwise_angle_expected(s->dim, pp->theta, r);
                 const char *note = !table && r > 1 ? " (complete wetting)"
-                                   : table && r > pfsph_pairwise_angle_ratio_max()
+                                   : table && r > pfsph_pairwise_angle_ratio_max(s->dim)
                                        ? " (beyond the measured table: extrapolated)" : "";
                 fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (%s)\n",
                         s->phases[a].name, s->phases[b].name, ang, note,

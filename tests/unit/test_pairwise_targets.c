@@ -113,22 +113,22 @@ static void test_resolve(void **state)
         assert_true(pp->resolved);
         assert_true(fabs(pp->radius - pp->k * h) < 1e-15 * h);
         /* the thermostat is on at its default temperature: tensions are Eq. 13 times the
-         * measured factor at temperature (1 in 3D) */
+         * measured factor at temperature of its dimension */
         assert_true(fabs(pp->theta - PFSPH_THERMO_REDUCED_DEFAULT) < 1e-15);
         const double fs = pfsph_pairwise_sigma_factor(dim, pp->theta);
         assert_true(fabs(pp->sigma_factor - fs) < 1e-15);
-        if (dim == 3) assert_true(fs == 1.0);
+        assert_true(fs > 0.5 && fs < 1.5 && fs != 1.0);
         /* Eq. 13 with c_air = 0: sigma = f lambda c rho^2 */
         assert_true(fabs(fs * lam * pp->c[0][0] * 1e6 - 0.0728) < 1e-12);
         /* Eq. 13 for the pair: recompute sigma from the coefficients */
         double sg = fs * lam * (pp->c[0][0] * 1e6 + pp->c[1][1] * 640000.0 - 2 * pp->c[0][1] * 800000.0);
         assert_true(fabs(sg - 0.05) < 1e-12);
         assert_true(pp->c[1][0] == pp->c[0][1] && pp->c[0][1] > 0);
-        /* the adhesion ratio r = c_wa rho_wall / (c_aa rho_water): Eq. 21 (cos 60 = 2 r - 1) in
-         * 3D, the measured table at temperature in 2D */
+        /* the adhesion ratio r = c_wa rho_wall / (c_aa rho_water): the measured table at
+         * temperature of the dimension (Eq. 21, cos 60 = 2 r - 1, where there is none) */
         const double r = pp->c[0][2] * 2500.0 / (pp->c[0][0] * 1000.0);
         assert_true(fabs(r - pfsph_pairwise_angle_ratio(dim, pp->theta, 60.0)) < 1e-12);
-        if (dim == 3) assert_true(fabs(2 * r - 1 - 0.5) < 1e-12);
+        if (!pfsph_pairwise_angle_measured(dim, pp->theta)) assert_true(fabs(2 * r - 1 - 0.5) < 1e-12);
         assert_true(pp->c[2][0] == pp->c[0][2]);
         assert_true(fabs(pp->c[1][2]) < 1e-12 * pp->c[1][1]); /* 180 degrees: no adhesion */
         /* idempotent */
@@ -149,30 +149,36 @@ static void test_resolve(void **state)
     }
 }
 
-/* The tables at temperature: Eq. 21 and Eq. 13 where they are not calibrated (3D, thermostat
- * off), a continuous, monotonic angle table whose inverse is its inverse, 180 degrees without
- * adhesion. */
+/* The tables at temperature: Eq. 21 and Eq. 13 where they are not calibrated (thermostat off),
+ * measured factors in 2D and 3D, continuous, monotonic angle tables whose inverse is their
+ * inverse, 180 degrees without adhesion. */
 static void test_temperature_tables(void **state)
 {
     (void)state;
     assert_true(pfsph_pairwise_sigma_factor(2, 0.0) == 1.0);
-    assert_true(pfsph_pairwise_sigma_factor(3, 0.01) == 1.0);
-    for (double th = 0.001; th < 0.2; th *= 1.3) {
-        const double f = pfsph_pairwise_sigma_factor(2, th);
-        assert_true(f > 0.5 && f < 1.5);
-    }
-    for (double a = 0; a <= 180; a += 15) {
-        assert_true(fabs(pfsph_pairwise_angle_ratio(3, 0.01, a) - 0.5 * (1 + cos(a * 3.14159265358979323846 / 180))) < 1e-15);
-        assert_true(fabs(pfsph_pairwise_angle_ratio(2, 0.0, a) - 0.5 * (1 + cos(a * 3.14159265358979323846 / 180))) < 1e-15);
-    }
-    assert_true(pfsph_pairwise_angle_ratio(2, 0.01, 180.0) == 0.0);
-    double prev = -1;
-    for (double a = 179; a >= 20; a -= 1) {
-        const double r = pfsph_pairwise_angle_ratio(2, 0.01, a);
-        assert_true(r > prev); /* more wetting needs more adhesion */
-        prev = r;
-        assert_true(fabs(pfsph_pairwise_angle_expected(2, 0.01, r) - a) < 1e-9);
-        assert_true(fabs(pfsph_pairwise_angle_expected(3, 0.01, pfsph_pairwise_angle_ratio(3, 0.01, a)) - a) < 1e-9);
+    assert_true(pfsph_pairwise_sigma_factor(3, 0.0) == 1.0);
+    for (int dim = 2; dim <= 3; dim++)
+        for (double th = 0.001; th < 0.2; th *= 1.3) {
+            const double f = pfsph_pairwise_sigma_factor(dim, th);
+            assert_true(f > 0.5 && f < 1.5);
+        }
+    assert_true(pfsph_pairwise_angle_measured(2, 0.01) && !pfsph_pairwise_angle_measured(2, 0.0));
+    for (int dim = 2; dim <= 3; dim++) {
+        for (double a = 0; a <= 180; a += 15) {
+            const double eq21 = 0.5 * (1 + cos(a * 3.14159265358979323846 / 180));
+            assert_true(fabs(pfsph_pairwise_angle_ratio(dim, 0.0, a) - eq21) < 1e-15);
+            if (!pfsph_pairwise_angle_measured(dim, 0.01))
+                assert_true(fabs(pfsph_pairwise_angle_ratio(dim, 0.01, a) - eq21) < 1e-15);
+        }
+        if (pfsph_pairwise_angle_measured(dim, 0.01))
+            assert_true(pfsph_pairwise_angle_ratio(dim, 0.01, 180.0) == 0.0);
+        double prev = -1;
+        for (double a = 179; a >= 20; a -= 1) {
+            const double r = pfsph_pairwise_angle_ratio(dim, 0.01, a);
+            assert_true(r > prev); /* more wetting needs more adhesion */
+            prev = r;
+            assert_true(fabs(pfsph_pairwise_angle_expected(dim, 0.01, r) - a) < 1e-9);
+        }
     }
 }
 
