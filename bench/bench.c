@@ -150,6 +150,9 @@ int main(int argc, char **argv)
         usage();
         return 2;
     }
+    /* the scene's "threads" key below is read by the pfsph program, not by the library: the
+     * count must be set here (before 2026-12-02 --threads changed nothing) */
+    if (threads > 0) omp_set_num_threads(threads);
 
     /* The block is 3 x 4 x 3 lattice units per unit k (0.45 x 0.6 x 0.45 m as in
      * scenes/dam_break_3d.json), so n = 36 k^3; the spacing follows from the 0.6 m height.
