@@ -52,8 +52,9 @@
  *    benchmark's.
  *  Study (one run each, D 16 d, to 1.5 s): nu halved to 0.005 raises U (0.5-1.5 s) to 0.205 and
  *  deepens the circularity to 0.971 by 1.45 s; theta 0.04 lowers U to 0.176. The particle liquid
- *  behaves as if more viscous than its nu (docs/thermostat.md: rectangles relax ~30x slower than
- *  nu says), which fits both the slow rise and the round bubble.
+ *  behaves as if more viscous than its nu (docs/thermostat.md, "Elongated drops: how they
+ *  relax": the n = 2 swing of a 2:1 drop decays at ~1/s whatever nu is, an own viscosity of about
+ *  3.6e-3 m^2/s in those drops), which fits both the slow rise and the round bubble.
  * Under AddressSanitizer: D 16 d only, 0.3 s at rest and rising, no physics checks.
  * Study knobs: PF_N1, PF_N2 (particles per diameter), PF_T, PF_TR (rest run), PF_NU, PF_SOLVER,
  * PF_PW (text inserted in the pairwise block). */
