@@ -198,11 +198,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 ay += nub * w.ay;
                 az += nub * w.az;
             } else if (wall_visc || (fused && b->n && pi > 0)) {
-                /* Akinci 2012 boundary friction, with the fluid's own viscosity unless the solid
-                 * says otherwise (ctx wall tables: free slip, its own viscosity); static walls
-                 * rest, body particles move. With only default walls the table is skipped and the
-                 * sum is the one of a single viscosity, nui times the sum. Fused: the wall's
-                 * pressure term (pfsph__pressure_accel) in the same walk. */
+                /* the same friction over a grid walk; fused: the wall's pressure term
+                 * (pfsph__pressure_accel) in the same walk */
                 visc_acc w = {0, 0, 0, fx, fy, fz};
                 pfsph_real bx = 0, by = 0, bz = 0;
                 const double ampw = thermo ? amp * ts[pa][pa] : 0;
