@@ -41,6 +41,13 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
  * receives its size. */
 int pfsph_checkpoint_save(const char *path, const pfsph_sim *sim, int frame, size_t *bytes,
                           pfsph_error *err);
+/* As pfsph_checkpoint_save without the fsyncs: a scratch copy that this process may need again
+ * (the last good frame that pfsph_run keeps for a blow-up). Like every checkpoint file it is
+ * written from the simulation's arrays through a small buffer, with no copy of the state in
+ * memory. */
+int pfsph_checkpoint_stash(const char *path, const pfsph_sim *sim, int frame, pfsph_error *err);
+/* Make a stashed checkpoint durable under dest (fsync, rename). */
+int pfsph_checkpoint_keep(const char *stash, const char *dest, pfsph_error *err);
 /* Read and restore a checkpoint file; messages name the file. A file named ckpt_NNNNN.bin must
  * hold frame NNNNN. */
 int pfsph_checkpoint_load(const char *path, pfsph_sim *sim, pfsph_checkpoint_info *info,

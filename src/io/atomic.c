@@ -97,7 +97,9 @@ static void sync_parent_dir(const char *path)
     free(d);
 }
 
-int pfsph__afile_commit(pfsph__afile *a, pfsph_error *err)
+int pfsph__afile_commit(pfsph__afile *a, pfsph_error *err) { return pfsph__afile_finish(a, 1, err); }
+
+int pfsph__afile_finish(pfsph__afile *a, int durable, pfsph_error *err)
 {
     if (!a->f) {
         pfsph__afile_abort(a);
@@ -106,7 +108,7 @@ int pfsph__afile_commit(pfsph__afile *a, pfsph_error *err)
     const char *what = NULL;
     int e = 0;
     if (fflush(a->f) != 0) what = "write failed", e = errno;
-    else if (fsync(fileno(a->f)) != 0) what = "fsync failed", e = errno;
+    else if (durable && fsync(fileno(a->f)) != 0) what = "fsync failed", e = errno;
     int rc = fclose(a->f);
     a->f = NULL;
     if (!what && rc != 0) what = "close failed", e = errno;
@@ -116,8 +118,22 @@ int pfsph__afile_commit(pfsph__afile *a, pfsph_error *err)
         pfsph__afile_abort(a);
         return PFSPH_EIO;
     }
-    sync_parent_dir(a->path);
+    if (durable) sync_parent_dir(a->path);
     afile_release(a);
+    return PFSPH_OK;
+}
+
+int pfsph__rename_durable(const char *src, const char *dest, pfsph_error *err)
+{
+    int fd = open(src, O_RDONLY);
+    if (fd < 0) return pfsph_fail(err, PFSPH_EIO, "%s: %s", src, strerror(errno));
+    int bad = fsync(fd) != 0;
+    int e = errno;
+    close(fd);
+    if (bad) return pfsph_fail(err, PFSPH_EIO, "%s: fsync failed: %s", src, strerror(e));
+    if (rename(src, dest) != 0)
+        return pfsph_fail(err, PFSPH_EIO, "%s: cannot rename to %s: %s", src, dest, strerror(errno));
+    sync_parent_dir(dest);
     return PFSPH_OK;
 }
 

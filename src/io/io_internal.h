@@ -23,6 +23,11 @@ int pfsph__afile_open(pfsph__afile *a, const char *path, pfsph_error *err);
 int pfsph__afile_write(pfsph__afile *a, const void *data, size_t len, pfsph_error *err);
 /* Flush, fsync, close, rename. Aborts (removes the temporary file) on any failure. */
 int pfsph__afile_commit(pfsph__afile *a, pfsph_error *err);
+/* As pfsph__afile_commit; durable 0 skips the fsyncs: the file survives this process, not a
+ * power cut (a scratch copy). */
+int pfsph__afile_finish(pfsph__afile *a, int durable, pfsph_error *err);
+/* fsync src, rename it to dest and make the rename durable. */
+int pfsph__rename_durable(const char *src, const char *dest, pfsph_error *err);
 /* Close and remove the temporary file; safe to call twice. */
 void pfsph__afile_abort(pfsph__afile *a);
 

@@ -43,6 +43,10 @@ static void test_blowup_diagnosis(void **state)
     pfsph_checkpoint_path(cp, sizeof cp, run, frame);
     struct stat sb;
     assert_int_equal(stat(cp, &sb), 0);
+    /* it was the run's stash of the last good frame (on disk, not in memory), moved into place */
+    char stash[1024];
+    snprintf(stash, sizeof stash, "%s/.last_good.bin", run);
+    assert_int_equal(stat(stash, &sb), -1);
     static pfsph_scene s;
     pfsph_error err = {0};
     assert_int_equal(pfsph_scene_parse(&s, SCENE, "explode", &err), PFSPH_OK);

@@ -276,7 +276,10 @@ static void test_checkpoint_at_last_frame(void **state)
     assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.12", g_scene, dir), 0);
     assert_true(exists(dir, "checkpoints/ckpt_00002.bin"));
     assert_true(exists(dir, "checkpoints/ckpt_00003.bin"));
+    /* the stash of the last good frame (kept on disk for a blow-up) goes when the run ends well */
+    assert_false(exists(dir, ".last_good.bin"));
     assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.16", dir), 0);
+    assert_false(exists(dir, ".last_good.bin"));
     char p[1400], sum[4096];
     snprintf(p, sizeof p, "%s/summary.json", dir);
     FILE *f = fopen(p, "r");

@@ -179,6 +179,22 @@ static void test_corrupt_and_truncated(void **st)
     size_t len;
     unsigned char *b = slurp(path, &len);
     assert_int_equal(len, bytes);
+    /* the file is written from the arrays through a staging buffer, the buffer in one piece:
+     * the same bytes, and a stash (no fsync) too */
+    void *mem;
+    size_t mlen;
+    assert_int_equal(pfsph_checkpoint_encode(a, 2, &mem, &mlen, &err), PFSPH_OK);
+    assert_int_equal(mlen, len);
+    assert_memory_equal(mem, b, len);
+    free(mem);
+    char stash[512];
+    snprintf(stash, sizeof stash, "%s/stash.bin", tu_tmpdir());
+    assert_int_equal(pfsph_checkpoint_stash(stash, a, 2, &err), PFSPH_OK);
+    size_t slen;
+    unsigned char *sb = slurp(stash, &slen);
+    assert_int_equal(slen, len);
+    assert_memory_equal(sb, b, len);
+    free(sb);
 
     /* payload byte flipped (in the middle of the particle arrays) */
     snprintf(bad, sizeof bad, "%s/flipped.bin", tu_tmpdir());
