@@ -38,4 +38,21 @@ typedef struct tu_bubble {
 } tu_bubble;
 void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, double R, tu_bubble *b);
 
+/* Shape of a free drop (docs/thermostat.md, "The shape tests"): ratio is the smallest / largest
+ * principal second moment about the centroid, close the fraction of kernel-neighbour pairs
+ * (r < 2 d) closer than d/2. */
+typedef struct tu_shape {
+    double ratio, close;
+} tu_shape;
+tu_shape tu_shape_measure(const struct pfsph_ctx *c);
+/* A lattice block of nl x ns (x ns) particles of pair-force liquid (d = 1 cm, sigma 4 N/m, nu
+ * 3e-3, theta 0.01, k 1.7 in 2D and Eq. 5's 1.3867 in 3D, DFSPH, no gravity) runs to t_end,
+ * sampled every dt_s (the sample times are part of the scene: the step is an equal division of
+ * the interval to the next one); ratio and close are averaged over the samples after
+ * t_end - t_win, cpu is the run's CPU seconds. */
+typedef struct tu_relax {
+    double ratio, close, cpu;
+} tu_relax;
+tu_relax tu_shape_relax(int dim, int nl, int ns, int seed, double t_end, double t_win, double dt_s);
+
 #endif
