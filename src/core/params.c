@@ -82,7 +82,9 @@ double pfsph_pairwise_sigma_theta_max(int dim)
  * (0.1 m/s); nu_eff from the decay of its amplitude. At theta 0.01 the intercept of nu_eff against
  * the set nu (0, 3e-4, 1e-3 x 3 seeds, 3e-3, 1e-2; slope 2.0); at the other temperatures
  * nu_eff(1e-3) - 2e-3. The same intercept at sigma 24.5, d 3.125 cm (0.545, slope 2.2). Seed to
- * seed scatter of one nu_eff: +-0.5e-3 m^2/s (+-0.08 in these units). */
+ * seed scatter of one nu_eff: 0.7e-3 m^2/s sd (0.11 in these units). A box calibration: boxes of
+ * 15 and 60 d read 3.77e-3 and 8.28e-3 at set 1e-3, so most of the intercept is a wall/size term
+ * and the bulk liquid's own part is only about 0.1 (docs/thermostat.md). */
 static const double visc_theta2[] = {0.005, 0.01, 0.02, 0.04, 0.08};
 static const double visc_struct2[] = {0.82, 0.51, 0.62, 0.53, 0.71};
 
