@@ -332,9 +332,11 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
         pp->nu_morris[a] = nu;
         pp->nu_struct[a] = pp->nu_floor[a] = 0;
         if (is_solid(s, a) || !(tp->kT_resolved > 0) || !(pp->c[a][a] > 0) || !(rho[a] > 0)) continue;
-        const double sg = f * lam * pp->c[a][a] * rho[a] * rho[a];
+        /* theta as the thermostat counts it (Eq. 13's tension); nu_0 from the tension at
+         * temperature (the bench's sigma target) */
+        const double s13 = lam * pp->c[a][a] * rho[a] * rho[a], sg = f * s13;
         const double kTa = tp->kT_resolved * (tp->rho_ref > 0 ? rho[a] / tp->rho_ref : 1.0);
-        const double g = pfsph_pairwise_visc_struct(s->dim, kTa / (sg * dd));
+        const double g = pfsph_pairwise_visc_struct(s->dim, kTa / (s13 * dd));
         if (!(g > 0)) continue;
         const double nu0 = sqrt(sg * (double)spacing / rho[a]);
         pp->nu_struct[a] = g * nu0;
