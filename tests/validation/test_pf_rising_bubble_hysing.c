@@ -38,7 +38,7 @@
  *   | Hysing |         |               | 0.2417 (0.92 s)  | 1.0813 | 0.9013 (1.90 s)      |            |
  *   20 d / 16 d: U 0.977, U (0.5-1.5 s) 1.012, vmax 1.046. Against Hysing: vmax -8.9 % / -4.7 %,
  *   rise yc(3) - 0.5 -3.4 % / -3.2 %, 1 - circularity 0.079 / 0.083 against 0.099, both at
- *   Hysing's times. CPU (Release, one core): 6,207 and 8,626 steps.
+ *   Hysing's times. CPU (Release, one core): 171 s for the test; 6,207 and 8,626 steps.
  * Before it (set nu 0.01 applied as is):
  *   | 16 d | 0.1971    | 0.1868        | 0.2121 (2.05 s)  | 1.0278 | 0.9720 (2.95 s)      | 0.832      |
  *   | 20 d | 0.1788    | 0.1717        | 0.1920 (1.90 s)  | 1.0011 | 0.9795 (2.95 s)      | 0.877      |
