@@ -442,6 +442,15 @@ void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s)
     c->film = &s->film;
 }
 
+/* The viscosity each phase's step applies: the scene's, or with pair forces resolved the Morris
+ * viscosity of the viscosity correction (params.h, docs/thermostat.md). */
+static void apply_viscosity(pfsph_ctx *c, const pfsph_scene *s)
+{
+    for (int p = 0; p < s->nphases; p++)
+        c->nu[p] = (pfsph_real)(s->pairwise.enabled && s->pairwise.resolved ? s->pairwise.nu_morris[p]
+                                                                            : s->phases[p].viscosity);
+}
+
 int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err)
 {
     *out = NULL;
@@ -483,6 +492,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     }
     if (s->pairwise.enabled && (rc = pfsph_pairwise_resolve(s, c->spacing, c->h, err)) != PFSPH_OK)
         goto fail;
+    apply_viscosity(c, s);
 
     if ((rc = pfsph_particles_init(&sim->fluid, 1024)) || (rc = pfsph_particles_init(&sim->boundary, 1024))) {
         pfsph_fail(err, rc, "out of memory");
@@ -1242,6 +1252,7 @@ static int set_pair(pfsph_sim *sim, int a, int b, int kind, double v, pfsph_erro
     if (kind == 2) pp->angle_deg[a][b] = pp->angle_deg[b][a] = v;
     int rc = pfsph_pairwise_resolve(&sim->scene, sim->ctx.spacing, sim->ctx.h, err);
     if (rc) *pp = old;
+    apply_viscosity(&sim->ctx, &sim->scene);
     return rc;
 }
 

@@ -92,6 +92,15 @@ typedef struct pfsph_pairwise_params {
     double lambda;    /* Eq. 13 constant for the cosine force [m^(dim+2)] */
     double theta;     /* reduced temperature kT / (sigma_ref d^(dim-1)); 0: thermostat off */
     double sigma_factor; /* measured tension / Eq. 13 at theta (pfsph_pairwise_sigma_factor) */
+    /* Viscosity correction (docs/thermostat.md, "The viscosity of the hot liquid"): the hot
+     * pair-force liquid has a structural viscosity of its own and multiplies the Morris
+     * viscosity it is given, nu_eff = nu_struct + gain nu_morris. With the scene key
+     * `viscosity_correction` on, each pair-force phase's Morris viscosity becomes
+     * max((nu - nu_struct) / gain, nu_floor), so that nu_eff is the phase's `viscosity`. */
+    bool visc_correct;                      /* scene key; default off */
+    double nu_morris[PFSPH_MAX_PHASES];     /* the viscosity the step applies [m^2/s] */
+    double nu_struct[PFSPH_MAX_PHASES];     /* estimated structural viscosity (0: no table) */
+    double nu_floor[PFSPH_MAX_PHASES];      /* smallest Morris viscosity applied */
 } pfsph_pairwise_params;
 
 void pfsph_pairwise_defaults(pfsph_pairwise_params *p);
@@ -124,6 +133,19 @@ double pfsph_pairwise_angle_ratio_max(int dim);
 bool pfsph_pairwise_angle_measured(int dim, double theta);
 /* The largest theta of that table: beyond it the factor is extrapolated as a constant. */
 double pfsph_pairwise_sigma_theta_max(int dim);
+/* Structural viscosity of the hot pair-force liquid in units of sqrt(sigma d / rho) (sigma the
+ * phase's own tension at temperature, d the spacing, rho its rest density), at its reduced
+ * temperature theta; measured in 2D with bench/pf_visc.c (docs/thermostat.md, "The viscosity of
+ * the hot liquid"). 0 where no table applies (3D, theta <= 0). Held at the table's ends. */
+double pfsph_pairwise_visc_struct(int dim, double theta);
+/* What the Morris viscosity counts for in the hot liquid: nu_eff = nu_struct + GAIN nu_morris
+ * (measured 2.0 and 2.2 for rho 1000 at sigma 4 and 24.5; 1.5-7.4 over the other liquids
+ * measured, docs/thermostat.md). */
+#define PFSPH_VISC_GAIN 2.0
+/* The smallest Morris viscosity the correction applies, in units of sqrt(sigma d / rho): the
+ * thermostat's noise is the fluctuation-dissipation partner of that friction, and at 0.047 of
+ * the unit the kinetic temperature already reads 0.89 of its value at 0.16 (docs/thermostat.md). */
+#define PFSPH_VISC_FLOOR 0.05
 
 /* ---- bubbles in air: two-phase film particles (physics/film.c, include/pfsph/film.h) ---- */
 

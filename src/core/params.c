@@ -76,6 +76,31 @@ double pfsph_pairwise_sigma_theta_max(int dim)
     return dim == 2 || dim == 3 ? sigma_tables[dim - 2].theta[sigma_tables[dim - 2].n - 1] : 0.0;
 }
 
+/* Structural viscosity / sqrt(sigma d / rho) in 2D (docs/thermostat.md, "The viscosity of the hot
+ * liquid"): bench/pf_visc.c, a 30 x 30 box of one liquid between free-slip walls, sigma 4 N/m,
+ * d = 1 cm, rho 1000, k 1.7, DFSPH, melted 0.5 s at rest, then the lowest Taylor-Green mode
+ * (0.1 m/s); nu_eff from the decay of its amplitude. At theta 0.01 the intercept of nu_eff against
+ * the set nu (0, 3e-4, 1e-3 x 3 seeds, 3e-3, 1e-2; slope 2.0); at the other temperatures
+ * nu_eff(1e-3) - 2e-3. The same intercept at sigma 24.5, d 3.125 cm (0.545, slope 2.2). Seed to
+ * seed scatter of one nu_eff: 0.7e-3 m^2/s sd (0.11 in these units). A box calibration: boxes of
+ * 15 and 60 d read 3.77e-3 and 8.28e-3 at set 1e-3, so most of the intercept is a wall/size term
+ * and the bulk liquid's own part is only about 0.1 (docs/thermostat.md). */
+static const double visc_theta2[] = {0.005, 0.01, 0.02, 0.04, 0.08};
+static const double visc_struct2[] = {0.82, 0.51, 0.62, 0.53, 0.71};
+
+double pfsph_pairwise_visc_struct(int dim, double theta)
+{
+    const size_t n = sizeof visc_theta2 / sizeof visc_theta2[0];
+    if (dim != 2 || !(theta > 0)) return 0.0;
+    if (theta <= visc_theta2[0]) return visc_struct2[0];
+    for (size_t i = 1; i < n; i++)
+        if (theta <= visc_theta2[i]) {
+            double u = (theta - visc_theta2[i - 1]) / (visc_theta2[i] - visc_theta2[i - 1]);
+            return visc_struct2[i - 1] + u * (visc_struct2[i] - visc_struct2[i - 1]);
+        }
+    return visc_struct2[n - 1];
+}
+
 /* Contact angles at temperature (docs/pairwise.md, "Contact angles at temperature"), by
  * dimension. 2D (tests/physics/test_pf_contact_angle.c with PF_RATIO, PF_HALF=0.07, PF_SEED=5): the static angle
  * of 2D drops of 196 particles (14 x 14 d squares at the start) on 3-layer plates, no gravity,

@@ -148,6 +148,7 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
         /* the thermostat (on by default since issue 11): a checkpoint written before it
          * existed belongs to a different model and is refused */
         h_int(h, pw->thermo.enabled);
+        if (pw->visc_correct) h_int(h, 1); /* only then: older checkpoints stay resumable */
         h_f64(h, pw->thermo.kT);
         h_f64(h, pw->thermo.reduced);
         for (int a = 0; a < s->nphases && a < PFSPH_MAX_PHASES; a++)

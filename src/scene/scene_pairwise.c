@@ -96,13 +96,15 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
                                 pfsph_jctx *ctx)
 {
     static const char *const keys[] = {"enabled", "k", "filter", "eta", "eps_min", "center",
-                                       "shifting", "thermostat", "coefficients", "comment", NULL};
+                                       "shifting", "thermostat", "viscosity_correction", "coefficients",
+                                       "comment", NULL};
     pfsph_pairwise_params *pp = &s->pairwise;
     int rc = pfsph__json_check_keys(node, path, keys, ctx);
     if (rc) return rc;
     /* Writing the block turns the forces on unless it says "enabled": false. */
     pp->enabled = true;
     if ((rc = pfsph__json_bool(node, path, "enabled", &pp->enabled, ctx))) return rc;
+    if ((rc = pfsph__json_bool(node, path, "viscosity_correction", &pp->visc_correct, ctx))) return rc;
     if ((rc = pfsph__json_number(node, path, "k", 1.0, 4.0, &pp->k, ctx))) return rc;
     if ((rc = pfsph__json_bool(node, path, "filter", &pp->filter, ctx))) return rc;
     if ((rc = pfsph__json_number(node, path, "eta", 0.0, 1.0, &pp->eta, ctx))) return rc;
@@ -322,6 +324,26 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
     tp->kT_resolved = 0;
     if (tp->enabled)
         tp->kT_resolved = tp->kT >= 0 ? tp->kT : tp->reduced * tp->sigma_ref * dd;
+    /* The hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid"):
+     * nu_eff = nu_struct + gain nu_morris, nu_struct = g(theta_a) sqrt(sigma_a d / rho_a) with
+     * sigma_a the phase's own tension at temperature and theta_a its reduced temperature. */
+    for (int a = 0; a < np; a++) {
+        const double nu = s->phases[a].viscosity;
+        pp->nu_morris[a] = nu;
+        pp->nu_struct[a] = pp->nu_floor[a] = 0;
+        if (is_solid(s, a) || !(tp->kT_resolved > 0) || !(pp->c[a][a] > 0) || !(rho[a] > 0)) continue;
+        /* theta as the thermostat counts it (Eq. 13's tension); nu_0 from the tension at
+         * temperature (the bench's sigma target) */
+        const double s13 = lam * pp->c[a][a] * rho[a] * rho[a], sg = f * s13;
+        const double kTa = tp->kT_resolved * (tp->rho_ref > 0 ? rho[a] / tp->rho_ref : 1.0);
+        const double g = pfsph_pairwise_visc_struct(s->dim, kTa / (s13 * dd));
+        if (!(g > 0)) continue;
+        const double nu0 = sqrt(sg * (double)spacing / rho[a]);
+        pp->nu_struct[a] = g * nu0;
+        pp->nu_floor[a] = PFSPH_VISC_FLOOR * nu0;
+        if (pp->visc_correct)
+            pp->nu_morris[a] = fmax((nu - pp->nu_struct[a]) / PFSPH_VISC_GAIN, pp->nu_floor[a]);
+    }
     pp->resolved = true;
     return PFSPH_OK;
 }
@@ -355,10 +377,32 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
                 ts, sqrt(ts * tp->kT_resolved / m));
         /* relaxation time of a particle's velocity against its neighbours' friction, about
          * h^2 / (2 (d + 2) nu) for the cubic spline (docs/thermostat.md) */
-        if (nu > 0)
-            fprintf(out, ", velocity relaxation ~%.3g s\n", h * h / (2.0 * (s->dim + 2) * nu));
+        const pfsph_pairwise_params *pp = &s->pairwise;
+        const double num = pp->nu_morris[a];
+        if (num > 0)
+            fprintf(out, ", velocity relaxation ~%.3g s\n", h * h / (2.0 * (s->dim + 2) * num));
         else
             fprintf(out, "; viscosity 0: no friction, so no noise either (set a viscosity)\n");
+        /* the hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid") */
+        if (!(pp->nu_struct[a] > 0)) {
+            if (pp->visc_correct)
+                fprintf(out, "      viscosity_correction: no measured table for %dD at this temperature; "
+                        "the viscosity is applied as set\n", s->dim);
+            continue;
+        }
+        const double reach = pp->nu_struct[a] + PFSPH_VISC_GAIN * pp->nu_floor[a];
+        if (!pp->visc_correct) {
+            fprintf(out, "      viscosity %.4g m^2/s set; the hot liquid is expected to flow as ~%.3g "
+                    "(structural %.3g + %.3g x the set one; `viscosity_correction` makes it the set one)\n",
+                    nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
+            continue;
+        }
+        fprintf(out, "      viscosity %.4g m^2/s set: Morris viscosity %.4g applied (structural %.3g, "
+                "gain %.3g, floor %.3g)\n", nu, num, pp->nu_struct[a], PFSPH_VISC_GAIN, pp->nu_floor[a]);
+        if (nu < reach)
+            fprintf(out, "      warning: %s's viscosity %.4g m^2/s is below what the hot liquid reaches "
+                    "(~%.3g m^2/s at this temperature, spacing and tension); it will flow as ~%.3g\n",
+                    s->phases[a].name, nu, reach, reach);
     }
 }
 

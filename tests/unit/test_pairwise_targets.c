@@ -295,6 +295,34 @@ static void test_parse(void **state)
 }
 
 /* Every shipped scene with a pairwise block loads and its targets resolve. */
+/* viscosity_correction: nu_morris = max((nu - g(theta) nu_0) / gain, floor nu_0) for the
+ * reference liquid (its theta is the scene's reduced temperature, its tension the target) */
+static void test_viscosity_correction(void **state)
+{
+    (void)state;
+    pfsph_scene *s = calloc(1, sizeof(*s));
+    pfsph_error err = {0};
+    for (int on = 0; on <= 1; on++) {
+        const char *pw = on ? "{\"viscosity_correction\": true, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}"
+                            : "{\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}";
+        for (int k = 0; k < 2; k++) {
+            assert_int_equal(parse(pw, s, &err), PFSPH_OK);
+            s->phases[0].viscosity = k ? 1e-2 : 1e-3; /* above and below what the liquid reaches */
+            assert_int_equal(pfsph_pairwise_resolve(s, 0.01, (pfsph_real)(s->support_factor * 0.01), &err), PFSPH_OK);
+            const pfsph_pairwise_params *pp = &s->pairwise;
+            const double nu0 = sqrt(4 * 0.01 / 1000.0), nu = s->phases[0].viscosity;
+            assert_true(pp->visc_correct == (on == 1));
+            assert_true(fabs(pp->nu_struct[0] - pfsph_pairwise_visc_struct(2, 0.01) * nu0) < 1e-6 * nu0);
+            assert_true(fabs(pp->nu_floor[0] - PFSPH_VISC_FLOOR * nu0) < 1e-6 * nu0);
+            const double want = on ? fmax((nu - pp->nu_struct[0]) / PFSPH_VISC_GAIN, PFSPH_VISC_FLOOR * nu0) : nu;
+            assert_true(fabs(pp->nu_morris[0] - want) < 1e-6 * want);
+            assert_true(pp->nu_morris[2] == s->phases[2].viscosity); /* the wall: as set */
+        }
+    }
+    assert_true(pfsph_pairwise_visc_struct(3, 0.01) == 0.0 && pfsph_pairwise_visc_struct(2, 0.0) == 0.0);
+    free(s);
+}
+
 static void test_scenes(void **state)
 {
     (void)state;
@@ -328,6 +356,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_resolve),
         cmocka_unit_test(test_resolve_errors),
         cmocka_unit_test(test_temperature_tables),
+        cmocka_unit_test(test_viscosity_correction),
         cmocka_unit_test(test_parse),
         cmocka_unit_test(test_scenes),
     };
