@@ -8,6 +8,8 @@
  * evaluated and selected), none of which changes a value. */
 #include "physics/pair_terms.h"
 
+#include "pfsph/thermostat.h"
+
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PFSPH_SANITIZED)
 #define PFSPH__CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
@@ -48,5 +50,18 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
         sv[e] = nu / nd[j] * vdx / (r2[e] + eps) * dwr;
         /* pressure.c: (p_i / delta_i^2 + p_j / delta_j^2) dW/r */
         sp[e] = (pi + p[j] / (nd[j] * nd[j])) * dwr;
+    }
+}
+
+PFSPH__CLONES
+void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_real *restrict r2,
+                         const pfsph_real *restrict dw, const double *restrict amp_ts, const double *restrict nu,
+                         const double *restrict mj, const double *restrict ndj, const double *restrict theta,
+                         double *restrict t)
+{
+    for (int e = 0; e < n; e++) {
+        const double r2d = (double)r2[e];
+        t[e] = pfsph__thermo_fluid(amp_ts[e], nu[e], mi, mj[e], ndi, ndj[e], r2d, (double)dw[e], eps,
+                                   __builtin_sqrt(r2d), theta[e]);
     }
 }

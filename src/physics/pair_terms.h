@@ -26,4 +26,12 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
                                 const pfsph_real *restrict dz, const pfsph_real *restrict r2,
                                 pfsph_real *restrict dw, pfsph_real *restrict sv, pfsph_real *restrict sp);
 
+/* Per fluid hit e of the thermostat (thermostat.h): t[e] = pfsph__thermo_fluid(amp_ts[e], nu[e],
+ * mi, mj[e], ndi, ndj[e], r2[e], dw[e], eps, sqrt(r2[e]), theta[e]), the noise force over r,
+ * for hits with r2 > 0 (others: not finite). */
+void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_real *restrict r2,
+                         const pfsph_real *restrict dw, const double *restrict amp_ts, const double *restrict nu,
+                         const double *restrict mj, const double *restrict ndj, const double *restrict theta,
+                         double *restrict t);
+
 #endif
