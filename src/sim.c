@@ -109,7 +109,7 @@ static pfsph_real grid_cell(const pfsph_scene *s, pfsph_real h, int *reach, int 
         return h;
     }
     pfsph_real R = pfsph_pairwise_radius(s, h);
-    pfsph_real cell = h / 2 > R / 3 ? h / 2 : R / 3;
+    pfsph_real cell = h > R / 3 ? h : R / 3;
     *reach = (int)ceil((double)h / (double)cell - 1e-6);
     *reach_far = (int)ceil((double)R / (double)cell - 1e-6);
     if (*reach < 1) *reach = 1;

@@ -35,8 +35,10 @@ void pfsph_pairwise_destroy(pfsph_pairwise *pw); /* NULL is a no-op */
 /* ADD F_i^int / m_i to ctx->ax, ay, az for every fluid particle: fluid-fluid pairs within k*h
  * found through ctx->grid, fluid-solid pairs through ctx->boundary/ctx->bgrid (boundary
  * particles are static and receive nothing). Eq. 3 with the sign of NOTES item 1, then Eq. 12
- * when the filter is on and eta > 0. Grid cells must be >= k*h; fluid arrays in grid order.
- * Deterministic for any thread count. This is also the function the benchmark times. */
+ * when the filter is on and eta > 0. The grid's far reach (reach_far cells) must cover k*h;
+ * fluid and boundary particles at the positions they were sorted at (the walk visits only the
+ * cells the k h ball touches; with shifting configured it walks the whole reach). Deterministic
+ * for any thread count and CPU. This is also the function the benchmark times. */
 void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx);
 /* The largest pair-force acceleration |F_i^int / m_i| of the last apply [m/s^2] (0 for NULL). */
 double pfsph_pairwise_amax(const pfsph_pairwise *pw);

@@ -8,6 +8,8 @@
  * evaluated and selected), none of which changes a value. */
 #include "physics/pair_terms.h"
 
+#include "pfsph/thermostat.h"
+
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PFSPH_SANITIZED)
 #define PFSPH__CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
@@ -49,4 +51,68 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
         /* pressure.c: (p_i / delta_i^2 + p_j / delta_j^2) dW/r */
         sp[e] = (pi + p[j] / (nd[j] * nd[j])) * dwr;
     }
+}
+
+PFSPH__CLONES
+void pfsph__terms_pair_cos(double U_R, int n, const pfsph_real *restrict r2, double *restrict cr)
+{
+    for (int e = 0; e < n; e++) {
+        const double r = __builtin_sqrt((double)r2[e]);
+        cr[e] = (double)pfsph__cos_pair((float)(U_R * r)) / r;
+    }
+}
+
+PFSPH__CLONES
+void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_real *restrict r2,
+                         const pfsph_real *restrict dw, const double *restrict amp_ts, const double *restrict nu,
+                         const double *restrict mj, const double *restrict ndj, const double *restrict theta,
+                         double *restrict t)
+{
+    for (int e = 0; e < n; e++) {
+        const double r2d = (double)r2[e];
+        t[e] = pfsph__thermo_fluid(amp_ts[e], nu[e], mi, mj[e], ndi, ndj[e], r2d, (double)dw[e], eps,
+                                   __builtin_sqrt(r2d), theta[e]);
+    }
+}
+
+PFSPH__CLONES
+void pfsph__sums_pair(int n, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                      const pfsph_real *restrict dz, const double *restrict sc, const pfsph_real *restrict w,
+                      int filter, int vir, pfsph_pair_sums *restrict P)
+{
+    pfsph_pair_sums L = *P;
+    for (int e = 0; e < n; e += 4)
+        for (int l = 0; l < 4; l++) {
+            const double x = (double)dx[e + l], y = (double)dy[e + l], z = (double)dz[e + l], s = sc[e + l];
+            L.acc[0][l] += s * x;
+            L.acc[1][l] += s * y;
+            L.acc[2][l] += s * z;
+        }
+    if (vir)
+        for (int e = 0; e < n; e += 4)
+            for (int l = 0; l < 4; l++) {
+                const double x = (double)dx[e + l], y = (double)dy[e + l], z = (double)dz[e + l], s = sc[e + l];
+                L.S[0][l] += s * x * x;
+                L.S[1][l] += s * x * y;
+                L.S[2][l] += s * x * z;
+                L.S[3][l] += s * y * y;
+                L.S[4][l] += s * y * z;
+                L.S[5][l] += s * z * z;
+            }
+    if (filter)
+        for (int e = 0; e < n; e += 4)
+            for (int l = 0; l < 4; l++) {
+                const double x = (double)dx[e + l], y = (double)dy[e + l], z = (double)dz[e + l], v = (double)w[e + l];
+                L.sw[l] += v;
+                L.sx[0][l] += v * x;
+                L.sx[1][l] += v * y;
+                L.sx[2][l] += v * z;
+                L.sxx[0][l] += v * x * x;
+                L.sxx[1][l] += v * x * y;
+                L.sxx[2][l] += v * x * z;
+                L.sxx[3][l] += v * y * y;
+                L.sxx[4][l] += v * y * z;
+                L.sxx[5][l] += v * z * z;
+            }
+    *P = L;
 }

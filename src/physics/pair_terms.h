@@ -26,4 +26,50 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
                                 const pfsph_real *restrict dz, const pfsph_real *restrict r2,
                                 pfsph_real *restrict dw, pfsph_real *restrict sv, pfsph_real *restrict sp);
 
+/* Per fluid hit e of the thermostat (thermostat.h): t[e] = pfsph__thermo_fluid(amp_ts[e], nu[e],
+ * mi, mj[e], ndi, ndj[e], r2[e], dw[e], eps, sqrt(r2[e]), theta[e]), the noise force over r,
+ * for hits with r2 > 0 (others: not finite). */
+void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_real *restrict r2,
+                         const pfsph_real *restrict dw, const double *restrict amp_ts, const double *restrict nu,
+                         const double *restrict mj, const double *restrict ndj, const double *restrict theta,
+                         double *restrict t);
+
+/* Four-lane sums of the pair pass (pairwise.c): hit e goes to lane e % 4 of each sum, lanes
+ * are added at the end in a fixed order, so the result is the same bits on every CPU and
+ * thread count (the association is fixed by the source, not by the vector width). */
+typedef struct pfsph_pair_sums {
+    double acc[3][4]; /* sum sc x_ij */
+    double S[6][4];   /* sum sc x_ij x_ij^T (xx, xy, xz, yy, yz, zz) */
+    double sw[4];     /* sum w */
+    double sx[3][4];  /* sum w x_ij */
+    double sxx[6][4]; /* sum w x_ij x_ij^T */
+} pfsph_pair_sums;
+
+/* Adds hits e < n (n a multiple of 4; padding entries have sc = w = 0) to the sums: sc[e] x_ij
+ * always, S if vir, the w sums if filter. */
+void pfsph__sums_pair(int n, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                      const pfsph_real *restrict dz, const double *restrict sc, const pfsph_real *restrict w,
+                      int filter, int vir, pfsph_pair_sums *restrict P);
+
+/* cos x for 0 <= x <= 2 pi in float arithmetic, absolute error below 2e-7 (test_hits): the
+ * quadrant q = round(x / (pi/2)), x - q pi/2 in [-pi/4, pi/4] with pi/2 in two parts (q times the first exact), and the
+ * Taylor series of cos and sin to the 8th and 9th power (truncation error < 3e-8 there).
+ * Plain arithmetic and selects, so it vectorises and rounds alike in every clone of
+ * pair_terms.c (compiled with -ffp-contract=off) and in scalar code compiled the same way. */
+static inline float pfsph__cos_pair(float x)
+{
+    const float q = __builtin_floorf(x * 0.636619772f + 0.5f);
+    const float y = (x - q * 1.5703125f) - q * 4.83826795e-4f;
+    const float y2 = y * y;
+    const float c = 1.0f + y2 * (-0.5f + y2 * (4.16666667e-2f + y2 * (-1.38888889e-3f + y2 * 2.48015873e-5f)));
+    const float s = y + y * y2 * (-1.66666667e-1f + y2 * (8.33333333e-3f + y2 * (-1.98412698e-4f + y2 * 2.75573192e-6f)));
+    const float v = q == 1.0f || q == 3.0f ? s : c;
+    return q == 1.0f || q == 2.0f ? -v : v;
+}
+
+/* For the pair forces (pairwise.c): per hit e with r2[e] > 0, cr[e] = cos(U_R r) / r with
+ * r = sqrt((double) r2[e]) (the cosine of Eq. 5 over r: times c m_j x_ij it is the pair
+ * acceleration); entries with r2[e] = 0 are not finite and must be skipped. */
+void pfsph__terms_pair_cos(double U_R, int n, const pfsph_real *restrict r2, double *restrict cr);
+
 #endif

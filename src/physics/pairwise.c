@@ -8,8 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/hits.h"
 #include "pfsph/eigen.h"
 #include "pfsph/film.h"
+#include "physics/pair_terms.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -124,9 +126,11 @@ typedef struct pw_job {
     bool filter;
     double eta, eps_min;
     int center;
+    bool trim; /* walk only the cells the k h ball touches (positions as sorted) */
+    pfsph_hits_fn hits;
 } pw_job;
 
-static void job_init(pw_job *J, const pfsph_ctx *ctx)
+static void job_init(pw_job *J, const pfsph_ctx *ctx, bool sorted)
 {
     const pfsph_pairwise_params *pp = ctx->pairwise;
     J->ctx = ctx;
@@ -146,91 +150,101 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx)
     J->eta = pp->eta;
     J->eps_min = pp->eps_min;
     J->center = pp->center;
+    /* shifting moves the fluid after the sort: then the whole reach, whose slack covers it */
+    J->trim = sorted && !(pp->shift.D > 0 || pp->shift.A > 0);
+    J->hits = pfsph_hits_select();
 }
 
-/* Sums over one particle set for fluid particle i at (xi, yi, zi) of phase pa. acc gets
- * sum_j c m_j f(r) r_ij / r (Eq. 3 divided by m_i); S (if want_vir) gets sum_j of the same
- * scalar times r_ij r_ij^T; the covariance sums (if J->filter) get w, w d, w d d^T with
- * d = x_j - x_i (Eq. 7). */
-static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g,
-                           size_t self, pfsph_real xi, pfsph_real yi, pfsph_real zi, int pa,
-                           double ai, int bi, double acc[3], bool want_vir, double S[6], double *sw, double sx[3],
-                           double sxx[6])
+/* One thread's buffers: the hits of a walk, their cos(U_R r) / r and their pair scalars. */
+typedef struct pw_scratch {
+    pfsph_hits H;
+    double cr[PFSPH_HITS_CAP + PFSPH_HITS_PAD], sc[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
+} pw_scratch;
+
+/* Adds the pairs in W->H (targets in ps) to P's four-lane sums (pair_terms.h): sc = c m_j f(r) / r
+ * (Eq. 3 divided by m_i, times x_ij) and, if J->filter, the kernel w of Eq. 7 (NOTES item 2). */
+static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scratch *W, int pa, double ai, int bi,
+                            bool want_vir, pfsph_pair_sums *P)
+{
+    pfsph_hits *H = &W->H;
+    const double *coef = J->coef[pa];
+    const int n = H->n;
+    /* the per-pair cosine and kernel in vector code (pair_terms.c) */
+    pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
+    if (J->filter) pfsph__terms_w(&J->kk, n, H->r2, H->t0);
+    for (int e = 0; e < n; e++) {
+        const uint32_t j = H->j[e];
+        double cf;
+        if (J->two_phase) { /* Eq. 24 where a film particle takes part */
+            const int pb = ps->phase[j];
+            const double aj = (double)ps->film[j];
+            const int bj = ps->bubble[j];
+            const bool apart = bi && bj && bi != bj;
+            cf = ai > 0 || aj > 0 || apart ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
+                                           : coef[pb];
+        } else {
+            cf = coef[ps->phase[j]];
+        }
+        /* r = 0: no direction, no force, and not in Eq. 7's sum (as before the lanes) */
+        const bool live = H->r2[e] > 0;
+        /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0). The cosine
+         * in float (pfsph__cos_pair, error < 2e-7): the force is summed in double, its shape
+         * needs 1e-7. */
+        W->sc[e] = live && cf != 0.0 ? cf * W->cr[e] : 0.0;
+        if (!live) H->t0[e] = 0;
+    }
+    const int m = (n + 3) & ~3; /* padding entries add zeros */
+    for (int e = n; e < m; e++) {
+        W->sc[e] = 0;
+        H->t0[e] = H->dx[e] = H->dy[e] = H->dz[e] = 0;
+    }
+    pfsph__sums_pair(m, H->dx, H->dy, H->dz, W->sc, H->t0, J->filter, want_vir, P);
+}
+
+/* lanes 0 + 1 + 2 + 3 in a fixed order */
+static inline double lanes(const double l[4]) { return (l[0] + l[1]) + (l[2] + l[3]); }
+
+/* Sums over one particle set for fluid particle i at (xi, yi, zi) of phase pa: the pairs within
+ * k h of a grid walk, filtered in SIMD (core/hits.h), in the walk's order. */
+static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g, size_t self,
+                           pfsph_real xi, pfsph_real yi, pfsph_real zi, int pa, double ai, int bi, bool want_vir,
+                           pfsph_pair_sums *P, pw_scratch *W)
 {
     pfsph_ranges rg;
-    pfsph_grid_ranges_far(g, xi, yi, zi, &rg);
-    const double *coef = J->coef[pa];
-    for (int q = 0; q < rg.n; q++)
-        for (uint32_t j = rg.b[q]; j < rg.e[q]; j++) {
-            if ((size_t)j == self) continue;
-            pfsph_real dx = xi - ps->x[j], dy = yi - ps->y[j], dz = zi - ps->z[j];
-            pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-            if (r2 >= J->R2 || r2 <= 0) continue; /* r = 0: no direction, no force */
-            double r = sqrt((double)r2);
-            double cf;
-            if (J->two_phase) { /* Eq. 24 where a film particle takes part */
-                const int pb = ps->phase[j];
-                const double aj = (double)ps->film[j];
-                const int bj = ps->bubble[j];
-                const bool apart = bi && bj && bi != bj;
-                cf = ai > 0 || aj > 0 || apart ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
-                                               : coef[pb];
-            } else {
-                cf = coef[ps->phase[j]];
-            }
-            if (cf != 0.0) {
-                /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0). */
-                /* float cosine: the force is accumulated in double, its shape needs 1e-7, and
-                 * the double cos() was 17% of a PCISPH step with pair forces (perf) */
-                double s = cf * (double)cosf((float)(J->U_R * r)) / r;
-                acc[0] += s * dx;
-                acc[1] += s * dy;
-                acc[2] += s * dz;
-                if (want_vir) {
-                    S[0] += s * dx * dx;
-                    S[1] += s * dx * dy;
-                    S[2] += s * dx * dz;
-                    S[3] += s * dy * dy;
-                    S[4] += s * dy * dz;
-                    S[5] += s * dz * dz;
-                }
-            }
-            if (J->filter) {
-                double w = (double)pfsph_kernel_w(&J->kk, (pfsph_real)r);
-                double d0 = -(double)dx, d1 = -(double)dy, d2 = -(double)dz;
-                *sw += w;
-                sx[0] += w * d0;
-                sx[1] += w * d1;
-                sx[2] += w * d2;
-                sxx[0] += w * d0 * d0;
-                sxx[1] += w * d0 * d1;
-                sxx[2] += w * d0 * d2;
-                sxx[3] += w * d1 * d1;
-                sxx[4] += w * d1 * d2;
-                sxx[5] += w * d2 * d2;
-            }
-        }
+    if (J->trim) pfsph_grid_ranges_radius(g, xi, yi, zi, J->R, &rg);
+    else pfsph_grid_ranges_far(g, xi, yi, zi, &rg);
+    PFSPH_HITS_WALK(J->hits, &W->H, rg, ps->x, ps->y, ps->z, xi, yi, zi, J->R2, (uint32_t)self,
+                    sum_hits(J, ps, W, pa, ai, bi, want_vir, P));
 }
 
 /* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial and
  * T_i itself. */
 static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir,
-                            double *vir, double Tout[9], double Wout[9])
+                            double *vir, double Tout[9], double Wout[9], pw_scratch *W)
 {
     const pfsph_ctx *ctx = J->ctx;
     const pfsph_particles *f = ctx->fluid;
     pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
     int pa = f->phase[i];
-    double S[6] = {0, 0, 0, 0, 0, 0};
-    double sw = (double)pfsph_kernel_w0(&J->kk); /* the sum of Eq. 7 includes j = i */
-    double sx[3] = {0, 0, 0}, sxx[6] = {0, 0, 0, 0, 0, 0};
-    acc[0] = acc[1] = acc[2] = 0;
+    pfsph_pair_sums P;
+    memset(&P, 0, sizeof P);
     const double ai = J->two_phase ? (double)f->film[i] : 0.0;
     const int bi = J->two_phase ? f->bubble[i] : 0;
-    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, acc, want_vir, S, &sw, sx, sxx);
+    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, want_vir, &P, W);
     if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0)
-        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)-1, xi, yi, zi, pa, ai, bi, acc, want_vir, S, &sw,
-                sx, sxx);
+        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)UINT32_MAX, xi, yi, zi, pa, ai, bi, want_vir, &P, W);
+    /* the lanes' totals; the filter's d = x_j - x_i = -x_ij */
+    double S[6], sx[3], sxx[6];
+    for (int a = 0; a < 3; a++) {
+        acc[a] = lanes(P.acc[a]);
+        sx[a] = -lanes(P.sx[a]);
+    }
+    for (int a = 0; a < 6; a++) {
+        S[a] = lanes(P.S[a]);
+        sxx[a] = lanes(P.sxx[a]);
+    }
+    /* the sum of Eq. 7 includes j = i */
+    const double sw = (double)pfsph_kernel_w0(&J->kk) + lanes(P.sw);
     double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     if (J->filter) {
         double inv = 1.0 / sw;
@@ -275,19 +289,23 @@ void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
     pw->amax = 0;
     if (!ctx->pairwise->enabled) return;
     pw_job J;
-    job_init(&J, ctx);
+    job_init(&J, ctx, true);
     const size_t n = ctx->fluid->n;
     pfsph_real *ax = ctx->ax, *ay = ctx->ay, *az = ctx->az;
     double a2max = 0; /* a max is the same for any thread count and order */
-#pragma omp parallel for schedule(dynamic, 256) reduction(max : a2max)
-    for (size_t i = 0; i < n; i++) {
-        double acc[3];
-        particle(&J, i, acc, false, NULL, NULL, NULL);
-        ax[i] += (pfsph_real)acc[0];
-        ay[i] += (pfsph_real)acc[1];
-        az[i] += (pfsph_real)acc[2];
-        const double a2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
-        if (a2 > a2max) a2max = a2;
+#pragma omp parallel
+    {
+        pw_scratch W;
+#pragma omp for schedule(dynamic, 256) reduction(max : a2max)
+        for (size_t i = 0; i < n; i++) {
+            double acc[3];
+            particle(&J, i, acc, false, NULL, NULL, NULL, &W);
+            ax[i] += (pfsph_real)acc[0];
+            ay[i] += (pfsph_real)acc[1];
+            az[i] += (pfsph_real)acc[2];
+            const double a2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+            if (a2 > a2max) a2max = a2;
+        }
     }
     pw->amax = sqrt(a2max);
 }
@@ -304,16 +322,21 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
 {
     (void)pw;
     pw_job J;
-    job_init(&J, ctx);
+    /* called between steps too, on positions moved since the sort: the whole reach */
+    job_init(&J, ctx, false);
     if (!ctx->pairwise->enabled)
         for (int a = 0; a < PFSPH_MAX_PHASES; a++)
             for (int b = 0; b < PFSPH_MAX_PHASES; b++) J.coef[a][b] = 0;
     const size_t n = ctx->fluid->n;
-#pragma omp parallel for schedule(dynamic, 256)
-    for (size_t i = 0; i < n; i++) {
-        double acc[3], v = 0;
-        particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL);
-        if (vir) vir[i] = v;
+#pragma omp parallel
+    {
+        pw_scratch Ws;
+#pragma omp for schedule(dynamic, 256)
+        for (size_t i = 0; i < n; i++) {
+            double acc[3], v = 0;
+            particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws);
+            if (vir) vir[i] = v;
+        }
     }
 }
 

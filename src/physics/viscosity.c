@@ -81,6 +81,54 @@ static inline void wall_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
     }
 }
 
+/* Per-hit inputs of the thermostat's vector terms (pfsph__terms_thermo), one thread's. */
+typedef struct thermo_buf {
+    double amp_ts[PFSPH_HITS_CAP + PFSPH_HITS_PAD], nu[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
+        mj[PFSPH_HITS_CAP + PFSPH_HITS_PAD], ndj[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
+        theta[PFSPH_HITS_CAP + PFSPH_HITS_PAD], t[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
+} thermo_buf;
+
+/* The fluid hits in H of particle I with the thermostat: viscosity (and fused, pressure) factors
+ * and the noise force in vector code, added in the hits' order to their sums; the same terms
+ * and order as visc_pair over the hits, so the same bits. */
+static inline void thermo_hits(const pfsph_ctx *ctx, const visc_i *I, pfsph_hits *H, thermo_buf *X,
+                               const pfsph_pair_in *in, pfsph_real eps, double amp,
+                               const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, const int fused,
+                               visc_acc *acc, pfsph_real pa3[3])
+{
+    const pfsph_particles *f = ctx->fluid;
+    const int n = H->n;
+    for (int e = 0; e < n; e++) {
+        const uint32_t j = H->j[e];
+        const int pb = f->phase[j];
+        H->t3[e] = ctx->nu[pb];
+        X->amp_ts[e] = amp * ts[I->phase][pb];
+        X->nu[e] = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
+        X->mj[e] = (double)ctx->mass[pb];
+        X->ndj[e] = (double)ctx->nd[j];
+        X->theta[e] = pfsph_thermo_theta(key, I->id, f->id[j]);
+    }
+    pfsph__terms_visc_pressure(in, n, H->j, H->dx, H->dy, H->dz, H->r2, H->t0, H->t1, H->t2);
+    pfsph__terms_thermo(I->m, I->nd, (double)eps, n, H->r2, H->t0, X->amp_ts, X->nu, X->mj, X->ndj, X->theta, X->t);
+    for (int e = 0; e < n; e++) {
+        acc->ax += H->t1[e] * H->dx[e];
+        acc->ay += H->t1[e] * H->dy[e];
+        acc->az += H->t1[e] * H->dz[e];
+    }
+    for (int e = 0; e < n; e++)
+        if (X->nu[e] > 0 && H->r2[e] > 0) {
+            acc->fx += X->t[e] * (double)H->dx[e];
+            acc->fy += X->t[e] * (double)H->dy[e];
+            acc->fz += X->t[e] * (double)H->dz[e];
+        }
+    if (fused)
+        for (int e = 0; e < n; e++) {
+            pa3[0] += H->t2[e] * H->dx[e];
+            pa3[1] += H->t2[e] * H->dy[e];
+            pa3[2] += H->t2[e] * H->dz[e];
+        }
+}
+
 /* thermo: also the thermostat's random forces (thermostat.h), fused into this pass so that the
  * neighbours within h are walked once; the same expressions as pfsph_thermostat_apply, so the
  * same bits. fused: also the pressure acceleration of pfsph__pressure_accel (at the fluid's
@@ -118,6 +166,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
 #pragma omp parallel
     {
         pfsph_hits H;
+        thermo_buf Xb, *X = thermo ? &Xb : NULL;
+        (void)X;
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
@@ -145,17 +195,11 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
                 /* the pairs within h of the grid walk, in its order */
                 if (thermo) {
-                    PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, for (int e = 0; e < H.n; e++) {
-                        const uint32_t j = H.j[e];
-                        const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
-                        visc_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, amp, ts, key, &acc);
-                        if (fused) {
-                            const pfsph_real sp = (pi + p[j] / (nd[j] * nd[j])) * dwr;
-                            pax += sp * H.dx[e];
-                            pay += sp * H.dy[e];
-                            paz += sp * H.dz[e];
-                        }
-                    });
+                    const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
+                    pfsph_real pa3[3] = {0, 0, 0};
+                    PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i,
+                                    thermo_hits(ctx, &vi, &H, X, &in, eps, amp, ts, key, fused, &acc, pa3));
+                    pax = pa3[0], pay = pa3[1], paz = pa3[2];
                 } else {
                     /* the factors of visc_pair and of the pressure term in vector code
                      * (pair_terms.c), added in order: the same bits */

@@ -90,11 +90,16 @@ static void check_dim(int dim, size_t n, int fine)
     size_t n_outside;
     make_set(&ps, dim, n, 1000 + (uint64_t)dim, in_flag, &n_outside);
     pfsph_grid g;
-    const pfsph_real cell = fine ? (H / 2 > KH * H / 3 ? H / 2 : KH * H / 3) : KH * H;
+    /* fine 0: cells of k h; 1: of h / 2 (reaches 2 and 3); 2: of h (reaches 1 and 2, the
+     * pair forces' grid) */
+    const pfsph_real cell = fine == 1 ? (H / 2 > KH * H / 3 ? H / 2 : KH * H / 3) : fine == 2 ? H : KH * H;
     assert_int_equal(pfsph_grid_init(&g, dim, LO, HI, cell), PFSPH_OK);
-    if (fine) {
+    if (fine == 1) {
         g.reach = 2;
         g.reach_far = 3;
+    } else if (fine == 2) {
+        g.reach = 1;
+        g.reach_far = 2;
     }
     size_t removed = 0;
     assert_int_equal(pfsph_grid_sort(&g, &ps, &removed), PFSPH_OK);
@@ -127,7 +132,7 @@ static void check_dim(int dim, size_t n, int fine)
     const pfsph_real radii[2] = {H, KH * H};
     for (int ri = 0; ri < 2; ri++) {
         double r2 = (double)radii[ri] * (double)radii[ri];
-        size_t total = 0, max_nb = 0, max_range = 0;
+        size_t total = 0, max_nb = 0, max_range = 0, trimmed = 0;
         for (size_t i = 0; i < ps.n; i++) {
             size_t nb = pfsph_neighbors_brute(&ps, i, radii[ri], brute, ps.n);
             pfsph_ranges rg;
@@ -152,12 +157,28 @@ static void check_dim(int dim, size_t n, int fine)
                 fail_msg("%dD radius %.4f particle %zu at (%.9g, %.9g, %.9g): grid %zu, brute %zu",
                          dim, (double)radii[ri], i, (double)ps.x[i], (double)ps.y[i],
                          (double)ps.z[i], cnt, nb);
+            /* the band of cells the ball touches (pfsph_grid_ranges_radius): the same set */
+            pfsph_grid_ranges_radius(&g, ps.x[i], ps.y[i], ps.z[i], radii[ri], &rg);
+            cnt = 0;
+            for (int s = 0; s < rg.n; s++)
+                for (uint32_t j = rg.b[s]; j < rg.e[s]; j++) {
+                    if (j == i) continue;
+                    double dx = (double)ps.x[i] - ps.x[j], dy = (double)ps.y[i] - ps.y[j],
+                           dz = (double)ps.z[i] - ps.z[j];
+                    if (dx * dx + dy * dy + dz * dz < r2) got[cnt++] = j;
+                }
+            qsort(got, cnt, sizeof(uint32_t), cmp_u32);
+            if (cnt != nb || memcmp(got, brute, nb * sizeof(uint32_t)) != 0)
+                fail_msg("%dD radius %.4f particle %zu, trimmed walk: grid %zu, brute %zu", dim,
+                         (double)radii[ri], i, cnt, nb);
+            trimmed += rg.n;
             total += nb;
             if (nb > max_nb) max_nb = nb;
             if (span > max_range) max_range = span;
         }
-        printf("%dD radius %.4f: mean %.2f neighbours (max %zu), largest candidate set %zu\n", dim,
-               (double)radii[ri], (double)total / (double)ps.n, max_nb, max_range);
+        printf("%dD radius %.4f: mean %.2f neighbours (max %zu), largest candidate set %zu, trimmed walk "
+               "%.2f rows\n", dim, (double)radii[ri], (double)total / (double)ps.n, max_nb, max_range,
+               (double)trimmed / (double)ps.n);
     }
     free(brute);
     free(got);
@@ -167,8 +188,8 @@ static void check_dim(int dim, size_t n, int fine)
     pfsph_particles_free(&ps);
 }
 
-static void test_neighbours_2d(void **state) { (void)state; check_dim(2, 3000, 0); check_dim(2, 3000, 1); }
-static void test_neighbours_3d(void **state) { (void)state; check_dim(3, 8000, 0); check_dim(3, 8000, 1); }
+static void test_neighbours_2d(void **state) { (void)state; check_dim(2, 3000, 0); check_dim(2, 3000, 1); check_dim(2, 3000, 2); }
+static void test_neighbours_3d(void **state) { (void)state; check_dim(3, 8000, 0); check_dim(3, 8000, 1); check_dim(3, 8000, 2); }
 
 /* Sorting the same input with 1 and 2 threads, and twice in a row, gives the same order; a
  * second sort of an already sorted set is the identity (stable). */
