@@ -19,12 +19,14 @@
  * unsteadily (0.246 then 0.304 m/s, gas compressed 4.4 %); at 0.004: 0.309, 0.307 m/s, 1.4 %. */
 #define EPS_STEP 0.004
 
-/* scratch: PV the wall pressure for bodies (after the solve); XQ and V4 packed, 4 values per
+/* scratch: PV the wall pressure for bodies (after the solve) doubles as ERR (each particle's
+ * compression, during the solves); XQ and V4 packed, 4 values per
  * particle (solver.h, nscratch4): XQ = (x, y, z, p / delta^2), V4 = the corrected (vx, vy, vz).
  * A list entry then loads one 16-byte vector per neighbour and array instead of three or four
  * scalars (4 loads a pair instead of 8 in the rate pass), and the three sums run as the lanes
  * of one vector: lane by lane the scalar expressions in the same order, the same bits. */
-enum { FAC, RATE, ERR, PV, AX, AY, AZ, BX, BY, BZ, BC, XQ, V4, NSCR };
+enum { FAC, RATE, PV, BX, BY, BZ, BC, XQ, V4, NSCR };
+#define ERR PV
 #define NSCR4 2
 
 typedef pfsph_real v4r __attribute__((vector_size(4 * sizeof(pfsph_real))));
@@ -159,7 +161,7 @@ static inline pfsph_real updated(const pfsph_ctx *c, int divergence, const pfsph
 static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, const pfsph_real *rate,
                                const pfsph_real *fac, pfsph_real *p, const pfsph_real *ex,
                                const pfsph_real *ey, const pfsph_real *ez, pfsph_real *const bsum[4],
-                               pfsph_real *xq, pfsph_real *const a[3], pfsph_real *v4)
+                               pfsph_real *xq, pfsph_real *const *a, pfsph_real *v4)
 {
     const pfsph_particles *f = c->fluid;
     const pfsph_nlist *nl = c->nlist;
@@ -192,12 +194,15 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
                 az += wb * bsum[2][i];
             }
             const pfsph_real inv_m = -(pfsph_real)1 / c->mass[f->phase[i]];
-            a[0][i] = inv_m * ax;
-            a[1][i] = inv_m * ay;
-            a[2][i] = inv_m * az;
-            v4[4 * i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a[0][i]);
-            v4[4 * i + 1] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a[1][i]);
-            v4[4 * i + 2] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a[2][i]);
+            const pfsph_real a0 = inv_m * ax, a1 = inv_m * ay, a2 = inv_m * az;
+            if (a) { /* the divergence solve keeps only the velocities */
+                a[0][i] = a0;
+                a[1][i] = a1;
+                a[2][i] = a2;
+            }
+            v4[4 * i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a0);
+            v4[4 * i + 1] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a1);
+            v4[4 * i + 2] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a2);
         }
     }
 }
@@ -235,9 +240,9 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *xq, const pfsph_r
 
 /* Jacobi iterations on p (density mode: velocities v + dt (a_np + a_p); divergence mode: v +
  * dt a_p) until the mean residual is within tol after at least min_it updates, or max_it
- * updates were made. On return ap and (vx, vy, vz) belong to the final p. Returns the updates
+ * updates were made. On return ap (when not NULL) and v4 belong to the final p. Returns the updates
  * made; *avg the last mean residual. */
-static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const ap[3],
+static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const *ap,
                    pfsph_real *const *scr, double tol, int min_it, int max_it, double *avg)
 {
     const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay,
@@ -266,10 +271,9 @@ static void pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const *scr, 
     out->div_iterations = 0;
     if (D->div_max_iter <= 0 || !n) return;
     pfsph_real *pv = f->aux;
-    pfsph_real *const a[3] = {scr[AX], scr[AY], scr[AZ]};
     for (size_t i = 0; i < n; i++) pv[i] *= (pfsph_real)0.5;
     double avg;
-    int it = iterate(c, 1, pv, a, scr, D->div_tol, 0, D->div_max_iter, &avg);
+    int it = iterate(c, 1, pv, NULL, scr, D->div_tol, 0, D->div_max_iter, &avg);
     const pfsph_real *v4 = scr[V4];
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
