@@ -210,8 +210,8 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
 /* D delta_i / Dt for the velocities v (PF Eq. 23 differentiated): sum_j (v_i - v_j) . grad
  * W_ij over the lists, plus the wall's (1/V0) (v_i . B_i - C_i) from the sums of factors();
  * and err_i, the relative compression over the step that the residual stands for. */
-static void density_rate(const pfsph_ctx *c, const pfsph_real *xq, const pfsph_real *v4, pfsph_real *const bsum[4], pfsph_real *rate, int divergence, const pfsph_real *fac,
-                         pfsph_real *err)
+static void density_rate(const pfsph_ctx *c, const pfsph_real *xq, const pfsph_real *v4, pfsph_real *const bsum[4],
+                         pfsph_real *rate, int divergence, const pfsph_real *fac, pfsph_real *err)
 {
     const double nd0 = c->nd0;
     const pfsph_particles *f = c->fluid;
