@@ -30,12 +30,10 @@ enum { FAC, RATE, PV, BX, BY, BZ, BC, XQ, V4, NSCR };
 #define NSCR4 2
 
 typedef pfsph_real v4r __attribute__((vector_size(4 * sizeof(pfsph_real))));
-static inline v4r ld4(const pfsph_real *p)
-{
-    v4r v;
-    memcpy(&v, p, sizeof v);
-    return v;
-}
+/* a load of 4 values at any alignment of pfsph_real (GCC's idiom of __m128_u); a macro, not a
+ * function: a double build's 32-byte vector returned by value would change the ABI */
+typedef pfsph_real v4r_u __attribute__((vector_size(4 * sizeof(pfsph_real)), aligned(sizeof(pfsph_real)), may_alias));
+#define ld4(p) (*(const v4r_u *)(p))
 
 typedef struct dfsph {
     double tol, div_tol, cfl, c;
