@@ -339,8 +339,8 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const double nlist = ops && ops->neighbour_lists ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) +
                                                            pfsph_nlist_bytes_per_particle(0.5 * full, 1)
                                                      : 0;
-    const double per_fluid = 2 * P + (SCR_COMMON + (ops ? ops->nscratch : 0) + nthermo) * sizeof(pfsph_real) + sort +
-                             2 * P + nlist;
+    const int nscr = SCR_COMMON + (ops ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
+    const double per_fluid = 2 * P + nscr * sizeof(pfsph_real) + sort + 2 * P + nlist;
     const double per_boundary = 2 * P + sort;
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
     const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary;
@@ -363,10 +363,12 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
 static int alloc_scratch(pfsph_sim *sim, size_t n)
 {
     if (!n) n = 1;
+    const int w0 = SCR_COMMON + sim->solver->nscratch - sim->solver->nscratch4, w1 = SCR_COMMON + sim->solver->nscratch;
     for (int k = 0; k < sim->nscr; k++) {
-        pfsph_real *q = realloc(sim->scr[k], n * sizeof(pfsph_real));
+        const size_t m = k >= w0 && k < w1 ? 4 * n : n; /* the solver's packed arrays */
+        pfsph_real *q = realloc(sim->scr[k], m * sizeof(pfsph_real));
         if (!q) return PFSPH_ENOMEM;
-        memset(q, 0, n * sizeof(pfsph_real));
+        memset(q, 0, m * sizeof(pfsph_real));
         sim->scr[k] = q;
     }
     sim->scr_cap = n;

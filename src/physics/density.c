@@ -3,15 +3,6 @@
 
 #include <omp.h>
 
-/* SSE (every x86-64 has it; the build targets x86-64-v2) for the candidate test of the one
- * grid walk a step makes with lists; single precision only. Elsewhere: the scalar loop. */
-#if defined(__SSE2__) && !defined(PFSPH_DOUBLE) && defined(__GNUC__)
-#include <immintrin.h>
-#define PFSPH__SSE 1
-#else
-#define PFSPH__SSE 0
-#endif
-
 #include "core/hits.h"
 #include "core/nlist.h"
 #include "physics/pair_terms.h"
@@ -52,7 +43,9 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
 
 /* One thread's particles [i0, i1) of the one-walk build: densities (the terms of
  * pfsph__number_density in its order: the same bits), counts, and the entries while they fit in
- * [*pos, re) / [*bpos, bre) (fluid, boundary). */
+ * [*pos, re) / [*bpos, bre) (fluid, boundary). The candidates are filtered and the kernel
+ * values and derivatives computed in SIMD over each buffer of hits (core/hits.h,
+ * physics/pair_terms.h), lane by lane the scalar expressions: the same bits as a scalar walk. */
 static void density_list_block(const pfsph_ctx *ctx, pfsph_real *nd, pfsph_nlist *l, pfsph_nlist *lb, size_t i0,
                                size_t i1, size_t *pos_io, size_t re, size_t *bpos_io, size_t bre)
 {
@@ -60,76 +53,45 @@ static void density_list_block(const pfsph_ctx *ctx, pfsph_real *nd, pfsph_nlist
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_real h2 = k->h * k->h, inv_v0 = (pfsph_real)1 / ctx->V0;
     uint32_t *cnt = l->start + 1, *bcnt = lb->start + 1;
+    uint32_t *restrict idx = l->idx, *restrict bidx = lb->idx;
+    pfsph_real *restrict dw = l->dw, *restrict bdw = lb->dw;
     size_t pos = *pos_io, bpos = *bpos_io;
+    const pfsph_hits_fn hits = pfsph_hits_select();
+    pfsph_hits H;
     for (size_t i = i0; i < i1; i++) {
         pfsph_ranges r;
         const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
         pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
-#if PFSPH__SSE
-        const __m128 X = _mm_set1_ps(xi), Y = _mm_set1_ps(yi), Z = _mm_set1_ps(zi), H2 = _mm_set1_ps(h2);
-#endif
         pfsph_real s = 0;
         const size_t p0 = pos;
-#define PFSPH__HIT(j_, r2_)                                                                    \
-    do {                                                                                       \
-        const uint32_t jh = (j_);                                                              \
-        const pfsph_real rr = pfsph_sqrt(r2_);                                                 \
-        s += pfsph_kernel_w(k, rr);                                                            \
-        if (jh != i) {                                                                         \
-            if (pos < re) {                                                                    \
-                l->idx[pos] = jh;                                                              \
-                l->dw[pos] = pfsph_kernel_dw_r(k, rr);                                         \
-            }                                                                                  \
-            pos++;                                                                             \
-        }                                                                                      \
-    } while (0)
-        for (int q = 0; q < r.n; q++) {
-            uint32_t j = r.b[q];
-#if PFSPH__SSE
-            /* four candidates at a time: ~85 % of them lie beyond h (docs/benchmarks.md), and
-             * the scalar loop's branch on r2 < h2 mispredicts often. r2 is rounded as the
-             * scalar expression rounds it, so the hits are the same. */
-            for (; j + 4 <= r.e[q]; j += 4) {
-                const __m128 dx = _mm_sub_ps(X, _mm_loadu_ps(f->x + j));
-                const __m128 dy = _mm_sub_ps(Y, _mm_loadu_ps(f->y + j));
-                const __m128 dz = _mm_sub_ps(Z, _mm_loadu_ps(f->z + j));
-                const __m128 r2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
-                unsigned m = (unsigned)_mm_movemask_ps(_mm_cmplt_ps(r2, H2));
-                if (!m) continue;
-                float r2s[4];
-                _mm_storeu_ps(r2s, r2);
-                for (; m; m &= m - 1) {
-                    const unsigned bit = (unsigned)__builtin_ctz(m);
-                    PFSPH__HIT(j + bit, r2s[bit]);
-                }
-            }
-#endif
-            for (; j < r.e[q]; j++) {
-                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                if (r2 < h2) PFSPH__HIT(j, r2);
-            }
-        }
-#undef PFSPH__HIT
+        /* i itself is a hit (W(0) counts in delta_i) but no entry */
+        PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, UINT32_MAX,
+                        pfsph__terms_w(k, H.n, H.r2, H.t0); pfsph__terms_dwr(k, H.n, H.r2, H.t1);
+                        for (int e = 0; e < H.n; e++) {
+                            s += H.t0[e];
+                            if (H.j[e] != i) {
+                                if (pos < re) {
+                                    idx[pos] = H.j[e];
+                                    dw[pos] = H.t1[e];
+                                }
+                                pos++;
+                            }
+                        });
         cnt[i] = (uint32_t)(pos - p0);
         const size_t b0 = bpos;
         if (b->n) {
             pfsph_real sb = 0;
             pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-            for (int q = 0; q < r.n; q++)
-                for (uint32_t j = r.b[q]; j < r.e[q]; j++) {
-                    pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                    pfsph_real r2 = dx * dx + dy * dy + dz * dz;
-                    if (r2 < h2) {
-                        const pfsph_real rr = pfsph_sqrt(r2);
-                        sb += b->aux[j] * pfsph_kernel_w(k, rr);
-                        if (bpos < bre) {
-                            lb->idx[bpos] = j;
-                            lb->dw[bpos] = pfsph_kernel_dw_r(k, rr);
-                        }
-                        bpos++;
-                    }
-                }
+            PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX,
+                            pfsph__terms_w(k, H.n, H.r2, H.t0); pfsph__terms_dwr(k, H.n, H.r2, H.t1);
+                            for (int e = 0; e < H.n; e++) {
+                                sb += b->aux[H.j[e]] * H.t0[e];
+                                if (bpos < bre) {
+                                    bidx[bpos] = H.j[e];
+                                    bdw[bpos] = H.t1[e];
+                                }
+                                bpos++;
+                            });
             s += sb * inv_v0;
         }
         bcnt[i] = (uint32_t)(bpos - b0);

@@ -19,10 +19,21 @@
  * unsteadily (0.246 then 0.304 m/s, gas compressed 4.4 %); at 0.004: 0.309, 0.307 m/s, 1.4 %. */
 #define EPS_STEP 0.004
 
-/* scratch: PV (the wall pressure for bodies, after the solve) doubles as PQ (p / delta^2,
- * during the solves) */
-enum { FAC, VX, VY, VZ, RATE, ERR, PV, AX, AY, AZ, BX, BY, BZ, BC, NSCR };
-#define PQ PV
+/* scratch: PV the wall pressure for bodies (after the solve) doubles as ERR (each particle's
+ * compression, during the solves); XQ and V4 packed, 4 values per
+ * particle (solver.h, nscratch4): XQ = (x, y, z, p / delta^2), V4 = the corrected (vx, vy, vz).
+ * A list entry then loads one 16-byte vector per neighbour and array instead of three or four
+ * scalars (4 loads a pair instead of 8 in the rate pass), and the three sums run as the lanes
+ * of one vector: lane by lane the scalar expressions in the same order, the same bits. */
+enum { FAC, RATE, PV, BX, BY, BZ, BC, XQ, V4, NSCR };
+#define ERR PV
+#define NSCR4 2
+
+typedef pfsph_real v4r __attribute__((vector_size(4 * sizeof(pfsph_real))));
+/* a load of 4 values at any alignment of pfsph_real (GCC's idiom of __m128_u); a macro, not a
+ * function: a double build's 32-byte vector returned by value would change the ABI */
+typedef pfsph_real v4r_u __attribute__((vector_size(4 * sizeof(pfsph_real)), aligned(sizeof(pfsph_real)), may_alias));
+#define ld4(p) (*(const v4r_u *)(p))
 
 typedef struct dfsph {
     double tol, div_tol, cfl, c;
@@ -58,7 +69,7 @@ static void destroy(void *state) { free(state); }
  * The same walk stores the boundary sums that stay fixed during the step (walls and bodies do
  * not move until the integration), so that the solver's passes need no boundary walk:
  * B_i = sum_b V_b grad W_ib (bx, by, bz) and C_i = sum_b V_b v_b . grad W_ib (bc). */
-static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph_real *const bsum[4])
+static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph_real *const bsum[4], pfsph_real *xq)
 {
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
     const pfsph_nlist *nl = ctx->nlist, *bl = ctx->nlist_b;
@@ -68,6 +79,9 @@ static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+        xq[4 * i] = xi; /* the positions stay put until the integration */
+        xq[4 * i + 1] = yi;
+        xq[4 * i + 2] = zi;
         double gx = 0, gy = 0, gz = 0, s2 = 0;
         int nn = (int)(nl->start[i + 1] - nl->start[i]);
         for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
@@ -139,14 +153,13 @@ static inline pfsph_real updated(const pfsph_ctx *c, int divergence, const pfsph
 
 /* With upd, first the Jacobi update of p from the last residual (rate, fac); then a = a_p(p)
  * (PF Eq. 4 in the number-density form with the Akinci wall term, as pfsph__pressure_accel
- * computes it, over the lists, with p_j / delta_j^2 computed once per particle into pq) and
- * v_out = v + dt (a_extra + a). One parallel region: a barrier fewer per iteration matters on
+ * computes it, over the lists, with p_j / delta_j^2 computed once per particle into lane 3 of
+ * xq) and v4 = v + dt (a_extra + a). One parallel region: a barrier fewer per iteration matters on
  * a loaded machine. */
 static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, const pfsph_real *rate,
                                const pfsph_real *fac, pfsph_real *p, const pfsph_real *ex,
                                const pfsph_real *ey, const pfsph_real *ez, pfsph_real *const bsum[4],
-                               pfsph_real *pq, pfsph_real *const a[3], pfsph_real *vx, pfsph_real *vy,
-                               pfsph_real *vz)
+                               pfsph_real *xq, pfsph_real *const *a, pfsph_real *v4)
 {
     const pfsph_particles *f = c->fluid;
     const pfsph_nlist *nl = c->nlist;
@@ -159,21 +172,19 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             if (upd) p[i] = updated(c, divergence, rate, fac, p, i);
-            pq[i] = p[i] / (nd[i] * nd[i]);
+            xq[4 * i + 3] = p[i] / (nd[i] * nd[i]);
         }
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
-            const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-            const pfsph_real pi = pq[i];
-            pfsph_real ax = 0, ay = 0, az = 0;
+            const v4r Xi = ld4(xq + 4 * i);
+            const pfsph_real pi = Xi[3];
+            v4r A = {0, 0, 0, 0};
             for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-                const uint32_t j = nl->idx[e];
-                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                pfsph_real s = (pi + pq[j]) * nl->dw[e];
-                ax += s * dx;
-                ay += s * dy;
-                az += s * dz;
+                const v4r Xj = ld4(xq + 4 * (size_t)nl->idx[e]);
+                const pfsph_real s = (pi + Xj[3]) * nl->dw[e];
+                A += s * (Xi - Xj); /* lanes 0-2: a += s x_ij (lane 3 unused) */
             }
+            pfsph_real ax = A[0], ay = A[1], az = A[2];
             if (pi > 0) { /* Akinci 2012: the wall pushes with p_i alone (pressure.c) */
                 const pfsph_real wb = pi * inv_v0;
                 ax += wb * bsum[0][i];
@@ -181,12 +192,15 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
                 az += wb * bsum[2][i];
             }
             const pfsph_real inv_m = -(pfsph_real)1 / c->mass[f->phase[i]];
-            a[0][i] = inv_m * ax;
-            a[1][i] = inv_m * ay;
-            a[2][i] = inv_m * az;
-            vx[i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a[0][i]);
-            vy[i] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a[1][i]);
-            vz[i] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a[2][i]);
+            const pfsph_real a0 = inv_m * ax, a1 = inv_m * ay, a2 = inv_m * az;
+            if (a) { /* the divergence solve keeps only the velocities */
+                a[0][i] = a0;
+                a[1][i] = a1;
+                a[2][i] = a2;
+            }
+            v4[4 * i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a0);
+            v4[4 * i + 1] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a1);
+            v4[4 * i + 2] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a2);
         }
     }
 }
@@ -194,9 +208,8 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
 /* D delta_i / Dt for the velocities v (PF Eq. 23 differentiated): sum_j (v_i - v_j) . grad
  * W_ij over the lists, plus the wall's (1/V0) (v_i . B_i - C_i) from the sums of factors();
  * and err_i, the relative compression over the step that the residual stands for. */
-static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_real *vy, const pfsph_real *vz,
-                         pfsph_real *const bsum[4], pfsph_real *rate, int divergence, const pfsph_real *fac,
-                         pfsph_real *err)
+static void density_rate(const pfsph_ctx *c, const pfsph_real *xq, const pfsph_real *v4, pfsph_real *const bsum[4],
+                         pfsph_real *rate, int divergence, const pfsph_real *fac, pfsph_real *err)
 {
     const double nd0 = c->nd0;
     const pfsph_particles *f = c->fluid;
@@ -205,13 +218,14 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_r
     const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
-        const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-        const pfsph_real vxi = vx[i], vyi = vy[i], vzi = vz[i];
+        const v4r Xi = ld4(xq + 4 * i), Vi = ld4(v4 + 4 * i);
+        const pfsph_real vxi = Vi[0], vyi = Vi[1], vzi = Vi[2];
         pfsph_real s = 0;
         for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-            const uint32_t j = nl->idx[e];
-            pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-            pfsph_real vd = (vxi - vx[j]) * dx + (vyi - vy[j]) * dy + (vzi - vz[j]) * dz;
+            const size_t j4 = 4 * (size_t)nl->idx[e];
+            /* (v_i - v_j) . x_ij, summed x + y, then + z as the scalar expression */
+            const v4r P = (Vi - ld4(v4 + j4)) * (Xi - ld4(xq + j4));
+            const pfsph_real vd = P[0] + P[1] + P[2];
             s += vd * nl->dw[e];
         }
         const pfsph_real sb = vxi * bsum[0][i] + vyi * bsum[1][i] + vzi * bsum[2][i] - bsum[3][i];
@@ -224,9 +238,9 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *vx, const pfsph_r
 
 /* Jacobi iterations on p (density mode: velocities v + dt (a_np + a_p); divergence mode: v +
  * dt a_p) until the mean residual is within tol after at least min_it updates, or max_it
- * updates were made. On return ap and (vx, vy, vz) belong to the final p. Returns the updates
+ * updates were made. On return ap (when not NULL) and v4 belong to the final p. Returns the updates
  * made; *avg the last mean residual. */
-static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const ap[3],
+static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const *ap,
                    pfsph_real *const *scr, double tol, int min_it, int max_it, double *avg)
 {
     const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay,
@@ -235,9 +249,8 @@ static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real
     pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
     for (int it = 0;; it++) {
         /* from the second pass on, the update of the last residual comes first */
-        corrected_velocity(c, it > 0, divergence, scr[RATE], scr[FAC], p, ex, ey, ez, bsum, scr[PQ], ap, scr[VX],
-                           scr[VY], scr[VZ]);
-        density_rate(c, scr[VX], scr[VY], scr[VZ], bsum, scr[RATE], divergence, scr[FAC], scr[ERR]);
+        corrected_velocity(c, it > 0, divergence, scr[RATE], scr[FAC], p, ex, ey, ez, bsum, scr[XQ], ap, scr[V4]);
+        density_rate(c, scr[XQ], scr[V4], bsum, scr[RATE], divergence, scr[FAC], scr[ERR]);
         *avg = n ? pfsph__sum(scr[ERR], n) / (double)n : 0;
         if (it >= max_it || (it >= min_it && *avg <= tol)) return it;
     }
@@ -252,17 +265,20 @@ static void pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const *scr, 
     pfsph_particles *f = c->fluid;
     const size_t n = f->n;
     pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
-    factors(D, c, scr[FAC], bsum);
+    factors(D, c, scr[FAC], bsum, scr[XQ]);
     out->div_iterations = 0;
     if (D->div_max_iter <= 0 || !n) return;
     pfsph_real *pv = f->aux;
-    pfsph_real *const a[3] = {scr[AX], scr[AY], scr[AZ]};
     for (size_t i = 0; i < n; i++) pv[i] *= (pfsph_real)0.5;
     double avg;
-    int it = iterate(c, 1, pv, a, scr, D->div_tol, 0, D->div_max_iter, &avg);
-    memcpy(f->vx, scr[VX], n * sizeof(pfsph_real));
-    memcpy(f->vy, scr[VY], n * sizeof(pfsph_real));
-    memcpy(f->vz, scr[VZ], n * sizeof(pfsph_real));
+    int it = iterate(c, 1, pv, NULL, scr, D->div_tol, 0, D->div_max_iter, &avg);
+    const pfsph_real *v4 = scr[V4];
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        f->vx[i] = v4[4 * i];
+        f->vy[i] = v4[4 * i + 1];
+        f->vz[i] = v4[4 * i + 2];
+    }
     out->div_iterations = it;
 }
 
@@ -327,6 +343,7 @@ static const char *hint(const void *state, const pfsph_ctx *ctx)
 const pfsph_solver_ops pfsph_solver_dfsph = {
     .name = "dfsph",
     .nscratch = NSCR,
+    .nscratch4 = NSCR4,
     .neighbour_lists = 1,
     .np_cap_without_viscosity = 1,
     .create = create,

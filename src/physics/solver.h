@@ -30,6 +30,7 @@ typedef struct pfsph_solve_stats {
 typedef struct pfsph_solver_ops {
     const char *name;      /* as in the scene's solver.type */
     int nscratch;          /* per-fluid-particle scratch arrays the solver needs */
+    int nscratch4;         /* the last nscratch4 of them hold 4 values per particle (packed x, y, z, w) */
     /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
      * solver that walks the neighbours many times per step (memory: src/core/nlist.h). */
     int neighbour_lists;
