@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pfsph/pairwise.h"
 #include "pfsph/sim.h"
 #include "testutil.h"
 
@@ -47,12 +48,12 @@ static drop_result run_drop(double Rs, double t0, double t_end)
     snprintf(json, sizeof json,
              "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0, 0],"
              " \"domain\": {\"min\": [-1, -1, -1], \"max\": [1, 1, 1]},"
-             " \"solver\": {\"type\": \"%s\"}, \"time\": {\"dt_max\": 0.002},"
+             " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": 0.002},"
              " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.001}],"
              " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0, 0], \"radius\": %g}],"
              " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
              " \"sigma\": %g}]}}",
-             getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d, getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", Rs * d, thermo, SIGMA);
+             getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d, getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", getenv("PF_SOLVER_KEYS") ? getenv("PF_SOLVER_KEYS") : "", Rs * d, thermo, SIGMA);
     pfsph_scene *s = malloc(sizeof *s);
     assert_non_null(s);
     pfsph_error err = {0};
@@ -69,6 +70,8 @@ static drop_result run_drop(double Rs, double t0, double t_end)
     drop_result r = {cbrt(3.0 * (double)n * d * d * d / (4.0 * PI)), 0, 0};
     pfsph_real *pm = malloc(n * sizeof *pm);
     size_t cap = 1 << 16, m = 0;
+    double prof[16] = {0}, rg = 0;
+    long pcnt[16] = {0};
     double *smp = malloc(cap * sizeof *smp);
     assert_true(pm && smp);
     rc = pfsph_sim_advance(sim, t0, &err);
@@ -96,6 +99,31 @@ static drop_result run_drop(double Rs, double t0, double t_end)
             assert_non_null(smp);
         }
         smp[m++] = sum / cnt;
+        if (getenv("PF_PROFILE")) { /* radial profile of the mechanical pressure, shells of 1 d; gyration radius */
+            double g2 = 0;
+            for (size_t i = 0; i < n; i++) {
+                const double rr = hypot(hypot(f->x[i] - cx, f->y[i] - cy), f->z[i] - cz);
+                g2 += rr * rr;
+                const int k = (int)(rr / d);
+                if (k < 16) prof[k] += pm[i], pcnt[k]++;
+            }
+            rg += sqrt(5.0 / 3.0 * g2 / (double)n);
+        }
+        if (getenv("PF_DIAG") && m % atoi(getenv("PF_DIAG")) == 0) {
+            /* the parts of the core's mechanical pressure: pressure-force virial, pair virial, kinetic */
+            static pfsph_real *z, *q;
+            static double *vir;
+            z = realloc(z, n * sizeof *z), q = realloc(q, n * sizeof *q), vir = realloc(vir, n * sizeof *vir);
+            memset(z, 0, n * sizeof *z);
+            pfsph_pairwise_mechanical_pressure(NULL, c, z, vir, q);
+            double a = 0, b = 0, pp = 0, ndm = 0;
+            for (size_t i = 0; i < n; i++)
+                if (hypot(hypot(f->x[i] - cx, f->y[i] - cy), f->z[i] - cz) < 0.5 * r.Re)
+                    a += q[i], b += c->nd[i] / 3.0 * 0.5 * vir[i], pp += f->p[i], ndm += c->nd[i] / c->nd0;
+            print_message("t %.3f total %.2f press-virial %.2f pair %.2f kin %.2f | p %.2f nd/nd0 %.4f\n",
+                          pfsph_sim_time(sim), sum / cnt, sum / cnt - a / cnt, b / cnt, (a - b) / cnt, pp / cnt,
+                          ndm / cnt);
+        }
     }
     assert_int_equal(pfsph_sim_removed(sim), 0);
     assert_true(m >= NB);
@@ -113,6 +141,13 @@ static drop_result run_drop(double Rs, double t0, double t_end)
                   "2 sigma / R_e = %.3f Pa (ratio %.3f +- %.3f); %llu steps\n",
                   Rs, n, r.Re, r.p, r.se, m, 2 * SIGMA / r.Re, r.p * r.Re / (2 * SIGMA), r.se * r.Re / (2 * SIGMA),
                   (unsigned long long)pfsph_sim_steps(sim));
+    if (getenv("PF_PROFILE")) {
+        print_message("  blocks:");
+        for (int b = 0; b < NB; b++) print_message(" %.1f", bm[b]);
+        print_message("\n  R from gyration sqrt(5/3) Rg = %.3f d (R_e %.3f d); shells [Pa]:", rg / (double)m / d, r.Re / d);
+        for (int k = 0; k < 16 && pcnt[k]; k++) print_message(" %d:%.1f", k, prof[k] / (double)pcnt[k]);
+        print_message("\n");
+    }
     free(pm);
     free(smp);
     pfsph_sim_destroy(sim);
