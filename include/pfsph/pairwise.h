@@ -60,11 +60,12 @@ void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *v
 void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx,
                                     double *vir, double *T, double *W);
 
-/* Mechanical (virial) pressure of each fluid particle [Pa; 2D: N/m]: the solver's pressure p_i
- * plus the pair-force virial n_i / (2 dim) sum_j r_ij . F_ji plus the kinetic part
- * n_i m_i |u_i|^2 / dim of its peculiar velocity u_i (docs/thermostat.md). vir is scratch of
- * n doubles. Needs ctx->nd; the pair forces may be off (virial 0). */
-void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir,
-                                        pfsph_real *out);
+/* Mechanical (virial) pressure of each fluid particle [Pa; 2D: N/m]: the virial of the solver's
+ * pressure force plus the pair-force virial n_i / (2 dim) sum_j r_ij . F_ji plus the kinetic part
+ * n_i m_i |u_i|^2 / dim of its peculiar velocity u_i (docs/thermostat.md). p is the pressure the
+ * solver pushed with this step (DFSPH: density plus divergence pressure); NULL: fluid->p. vir is
+ * scratch of n doubles. Needs ctx->nd; the pair forces may be off (virial 0). */
+void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, const pfsph_real *p,
+                                        double *vir, pfsph_real *out);
 
 #endif

@@ -341,10 +341,11 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
 }
 
 
-void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir,
-                                        pfsph_real *out)
+void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, const pfsph_real *p,
+                                        double *vir, pfsph_real *out)
 {
     const pfsph_particles *f = ctx->fluid;
+    if (!p) p = f->p;
     const size_t n = f->n;
     const int dim = ctx->dim;
     pfsph_pairwise_diagnose(pw, ctx, vir, NULL);
@@ -355,7 +356,7 @@ void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx
         /* peculiar velocity against the kernel-weighted mean of the neighbours (self excluded);
          * for uncorrelated thermal velocities E|u|^2 = <v'^2> (1 + sum w^2 / (sum w)^2) */
         double sw = 0, sw2 = 0, m[3] = {0, 0, 0}, pv = 0;
-        const double pi = (double)f->p[i] / ((double)ctx->nd[i] * (double)ctx->nd[i]);
+        const double pi = (double)p[i] / ((double)ctx->nd[i] * (double)ctx->nd[i]);
         pfsph_ranges r;
         pfsph_grid_ranges(ctx->grid, f->x[i], f->y[i], f->z[i], &r);
         for (int q = 0; q < r.n; q++)
@@ -367,7 +368,7 @@ void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx
                 pfsph_real rr = pfsph_sqrt(r2);
                 double w = (double)pfsph_kernel_w(k, rr);
                 /* r_ij . F_ij of the pressure force (pressure.c) */
-                pv -= (pi + (double)f->p[j] / ((double)ctx->nd[j] * (double)ctx->nd[j])) * (double)r2 *
+                pv -= (pi + (double)p[j] / ((double)ctx->nd[j] * (double)ctx->nd[j])) * (double)r2 *
                       (double)pfsph_kernel_dw_r(k, rr);
                 sw += w;
                 sw2 += w * w;

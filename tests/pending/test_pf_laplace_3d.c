@@ -1,31 +1,33 @@
 /* Laplace's law at temperature in 3D (issue 11; PF Eqs. 3, 6, 13; docs/thermostat.md, "Surface
- * tension at temperature", 3D). PENDING: it does not pass at a cost a test can afford.
- * Lattice balls of radius 4, 6 and 8 d (280, 912 and 2,176 particles), no gravity, sigma target
- * 4 N/m, k 1.7, h = 2 d, nu 1e-3, PCISPH, seed 7, the thermostat at its default temperature, the
- * target converted with the 3D factor (pfsph_pairwise_sigma_factor; the figures below were taken
- * with an interim 0.968, the slope of seed 1 over 4-7 d; the shipped 0.935 is the mean ratio over
- * both seeds' drops, docs/thermostat.md). The pressure inside is the frames' mechanical pressure
- * (pfsph_sim_mechanical_pressure) averaged over the particles within R_e / 2 of the centroid,
- * sampled every 2 steps from 0.15 s to 0.5 s: 0.35 s, not the issue's 5 s. Why: a 3D step costs
- * about 21 us per particle on one core (the pair forces' support is 3.4 d: ~165 neighbours), dt
- * is 1.8e-4 s, so these three drops cost 170 s of CPU for 0.35 s of averaging; 5 s would be
- * about 1,700 s. The fit p = a + s x, x = 2 / R_e (R_e = (3 N d^3 / (4 pi))^(1/3)), must give s
- * within 15 % of sigma, |a| <= 0.25 sigma / R_max and R^2 >= 0.9.
- * Measured (169 s of CPU): p_in / (2 sigma / R_e) = 1.088 +- 0.006, 1.002 +- 0.008,
- * 0.976 +- 0.012 (block errors); slope 1.212 sigma, intercept -25.3 Pa (bound 12.4), R^2 0.9985:
- * FAILS on slope and intercept. The block errors understate the real scatter: the same drops
- * with seed 1 (factor 1) read 0.930 at 4 d against 1.053 here (both against Eq. 13), a seed to
- * seed spread of 5-13 % per drop, and it persists: the 4 d drop of seed 7 reads 1.093 +- 0.009
- * again over 0.55-1.15 s. A three-radius slope is known to about +-12 % (docs/thermostat.md). Passing needs longer averages or larger drops: several times
- * this test's budget. Under AddressSanitizer the drops are 3, 4, 5 d and run 0.02 s.
- * Knobs for studies: PF_SOLVER, PF_THETA, PF_SEED (7), PF_T0 (start of the average, 0.15 s),
- * PF_T (end, 0.5 s), PF_EVERY (steps between samples, 2), PF_RADII ("4,6,8" in spacings). */
+ * tension at temperature", 3D, and "Why 3D misses"). PENDING: it fails, for a known reason.
+ * Lattice balls of radius 4, 5 and 6 d (280, 552 and 912 particles), no gravity, sigma target
+ * 4 N/m, k 1.7, h = 2 d, nu 1e-3, DFSPH with tolerance 1e-4 (at its default 0.001 a 3D core stays
+ * 0.15 % compressed and reads ~150 Pa low), seed 7, the thermostat at its default temperature,
+ * the target converted with the shipped 3D factor 0.935. The pressure inside is the frames'
+ * mechanical pressure (pfsph_sim_mechanical_pressure) averaged over the particles within R_e / 2
+ * of the centroid, sampled every 4 steps from 0.5 s to 5.5 s (the issue's 5 s). The fit
+ * p = a + s x, x = 2 / R_e (R_e = (3 N d^3 / (4 pi))^(1/3)), must give s within 15 % of sigma,
+ * |a| <= 0.25 sigma / R_max and R^2 >= 0.9.
+ * Measured (360 s of CPU on one core): p_in / (2 sigma / R_e) = 1.134 +- 0.007, 1.039 +- 0.005,
+ * 0.992 +- 0.010 (block errors; over 5 s the seeds agree: 4 d reads 225.2 and 222.4 Pa for seeds
+ * 1 and 7 at tolerance 0.001); slope 1.44 sigma, intercept -60 Pa (bound 16.6), R^2 0.998: FAILS.
+ * Why: the radial profile of the mechanical pressure overshoots 1-2 d under the surface (+334 Pa
+ * at 4 d, +289 at 5 d, +271 at 6 d) and only the 6 d ball has a flat core (126-148 Pa against
+ * 133); the 4 and 5 d cores lie in or reach the overshoot and read high. Passing needs three
+ * drops with a bulk (R >= 6 d: 6, 8, 10 d would cost about 1,200 s of CPU) or a depth-based core.
+ * Under AddressSanitizer the drops are 3, 4, 5 d and run 0.05 s.
+ * Knobs for studies: PF_SOLVER (dfsph), PF_SOLVER_KEYS (solver keys appended, default
+ * ', "tolerance": 0.0001'), PF_THETA, PF_SEED (7), PF_T0 (start of the average, 0.5 s), PF_T
+ * (end, 5.5 s), PF_EVERY (steps between samples, 4), PF_RADII ("4,5,6" in spacings),
+ * PF_PROFILE (radial profile, gyration radius, block means), PF_DIAG=k (the core pressure's
+ * parts every k samples). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "pfsph/pairwise.h"
 #include "pfsph/sim.h"
 #include "testutil.h"
 
@@ -47,12 +49,13 @@ static drop_result run_drop(double Rs, double t0, double t_end)
     snprintf(json, sizeof json,
              "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0, 0],"
              " \"domain\": {\"min\": [-1, -1, -1], \"max\": [1, 1, 1]},"
-             " \"solver\": {\"type\": \"%s\"}, \"time\": {\"dt_max\": 0.002},"
+             " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": 0.002},"
              " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.001}],"
              " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0, 0], \"radius\": %g}],"
              " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
              " \"sigma\": %g}]}}",
-             getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d, getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", Rs * d, thermo, SIGMA);
+             getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d, getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "dfsph",
+             getenv("PF_SOLVER_KEYS") ? getenv("PF_SOLVER_KEYS") : ", \"tolerance\": 0.0001", Rs * d, thermo, SIGMA);
     pfsph_scene *s = malloc(sizeof *s);
     assert_non_null(s);
     pfsph_error err = {0};
@@ -69,12 +72,14 @@ static drop_result run_drop(double Rs, double t0, double t_end)
     drop_result r = {cbrt(3.0 * (double)n * d * d * d / (4.0 * PI)), 0, 0};
     pfsph_real *pm = malloc(n * sizeof *pm);
     size_t cap = 1 << 16, m = 0;
+    double prof[16] = {0}, rg = 0;
+    long pcnt[16] = {0};
     double *smp = malloc(cap * sizeof *smp);
     assert_true(pm && smp);
     rc = pfsph_sim_advance(sim, t0, &err);
     if (rc) print_message("%s\n", err.msg);
     assert_int_equal(rc, PFSPH_OK);
-    const int every = getenv("PF_EVERY") ? atoi(getenv("PF_EVERY")) : 2;
+    const int every = getenv("PF_EVERY") ? atoi(getenv("PF_EVERY")) : 4;
     while (pfsph_sim_time(sim) < t_end - 1e-9) {
         /* whole steps (pfsph_sim_advance would shorten the last one to land on a time) */
         for (int q = 0; q < every && pfsph_sim_time(sim) < t_end - 1e-9; q++) {
@@ -96,6 +101,31 @@ static drop_result run_drop(double Rs, double t0, double t_end)
             assert_non_null(smp);
         }
         smp[m++] = sum / cnt;
+        if (getenv("PF_PROFILE")) { /* radial profile of the mechanical pressure, shells of 1 d; gyration radius */
+            double g2 = 0;
+            for (size_t i = 0; i < n; i++) {
+                const double rr = hypot(hypot(f->x[i] - cx, f->y[i] - cy), f->z[i] - cz);
+                g2 += rr * rr;
+                const int k = (int)(rr / d);
+                if (k < 16) prof[k] += pm[i], pcnt[k]++;
+            }
+            rg += sqrt(5.0 / 3.0 * g2 / (double)n);
+        }
+        if (getenv("PF_DIAG") && m % atoi(getenv("PF_DIAG")) == 0) {
+            /* the parts of the core's mechanical pressure: pressure-force virial, pair virial, kinetic */
+            static pfsph_real *z, *q;
+            static double *vir;
+            z = realloc(z, n * sizeof *z), q = realloc(q, n * sizeof *q), vir = realloc(vir, n * sizeof *vir);
+            memset(z, 0, n * sizeof *z);
+            pfsph_pairwise_mechanical_pressure(NULL, c, z, vir, q);
+            double a = 0, b = 0, pp = 0, ndm = 0;
+            for (size_t i = 0; i < n; i++)
+                if (hypot(hypot(f->x[i] - cx, f->y[i] - cy), f->z[i] - cz) < 0.5 * r.Re)
+                    a += q[i], b += c->nd[i] / 3.0 * 0.5 * vir[i], pp += f->p[i], ndm += c->nd[i] / c->nd0;
+            print_message("t %.3f total %.2f press-virial %.2f pair %.2f kin %.2f | p %.2f nd/nd0 %.4f\n",
+                          pfsph_sim_time(sim), sum / cnt, sum / cnt - a / cnt, b / cnt, (a - b) / cnt, pp / cnt,
+                          ndm / cnt);
+        }
     }
     assert_int_equal(pfsph_sim_removed(sim), 0);
     assert_true(m >= NB);
@@ -113,6 +143,13 @@ static drop_result run_drop(double Rs, double t0, double t_end)
                   "2 sigma / R_e = %.3f Pa (ratio %.3f +- %.3f); %llu steps\n",
                   Rs, n, r.Re, r.p, r.se, m, 2 * SIGMA / r.Re, r.p * r.Re / (2 * SIGMA), r.se * r.Re / (2 * SIGMA),
                   (unsigned long long)pfsph_sim_steps(sim));
+    if (getenv("PF_PROFILE")) {
+        print_message("  blocks:");
+        for (int b = 0; b < NB; b++) print_message(" %.1f", bm[b]);
+        print_message("\n  R from gyration sqrt(5/3) Rg = %.3f d (R_e %.3f d); shells [Pa]:", rg / (double)m / d, r.Re / d);
+        for (int k = 0; k < 16 && pcnt[k]; k++) print_message(" %d:%.1f", k, prof[k] / (double)pcnt[k]);
+        print_message("\n");
+    }
     free(pm);
     free(smp);
     pfsph_sim_destroy(sim);
@@ -126,7 +163,7 @@ static void test_laplace(void **state)
 #ifdef __SANITIZE_ADDRESS__
     double radii[8] = {3, 4, 5}; /* code paths only */
 #else
-    double radii[8] = {4, 6, 8};
+    double radii[8] = {4, 5, 6};
 #endif
     int nr = 3;
     if (getenv("PF_RADII")) {
@@ -136,12 +173,12 @@ static void test_laplace(void **state)
             if (*p == ',') p++;
         }
     }
-    double t_end = getenv("PF_T") ? atof(getenv("PF_T")) : 0.5;
+    double t_end = getenv("PF_T") ? atof(getenv("PF_T")) : 5.5;
 #ifdef __SANITIZE_ADDRESS__
-    t_end = 0.02;
+    t_end = 0.05;
     const double t0 = 0.01;
 #else
-    const double t0 = getenv("PF_T0") ? atof(getenv("PF_T0")) : 0.15;
+    const double t0 = getenv("PF_T0") ? atof(getenv("PF_T0")) : 0.5;
 #endif
     drop_result res[8];
     for (int i = 0; i < nr; i++) res[i] = run_drop(radii[i], t0, t_end);
