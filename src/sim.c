@@ -325,8 +325,8 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     for (int a = 0; a < s->dim; a++)
         cells *= ceil((s->domain_max[a] - s->domain_min[a]) / cell + 8);
     /* Per particle: its set at up to twice its size (the arrays grow by doubling), the grid's
-     * sort scratch (key, perm, tmp; 1.25x), and for fluid the step scratch and two encoded
-     * states (the last good frame kept for a blow-up and the next one being encoded). Measured:
+     * sort scratch (key, perm, tmp; 1.25x), and for fluid the step scratch (checkpoints and the
+     * last good frame go to disk through a small buffer, docs/checkpoints.md). Measured:
      * tests/unit/test_estimate.c. In double: the estimate may exceed size_t, so it saturates. */
     const double P = (double)pfsph_particles_bytes_per_particle();
     const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
@@ -340,7 +340,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
                                                            pfsph_nlist_bytes_per_particle(0.5 * full, 1)
                                                      : 0;
     const int nscr = SCR_COMMON + (ops ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
-    const double per_fluid = 2 * P + nscr * sizeof(pfsph_real) + sort + 2 * P + nlist;
+    const double per_fluid = 2 * P + nscr * sizeof(pfsph_real) + sort + nlist;
     const double per_boundary = 2 * P + sort;
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
     const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary;
