@@ -9,13 +9,19 @@
  * ratio at 0.964 for 1,024 particles and 0.971 for 2,000 (R = 7.82 d). At 1,024 (16 x 8 x 8)
  * the seeds read 0.951 / 0.933 / 0.955 over the same window: too close to 0.95.
  * Criteria (issue 11): Rayleigh's omega_l^2 = l (l - 1)(l + 2) sigma / (rho R^3) gives the l = 2
- * period T = 0.767 s. Each of three seeds runs to 3 s (3.9 T), sampled every 0.025 s; over the
- * last 2 T the mean moment ratio must be >= 0.95 and the mean fraction of kernel-neighbour pairs
- * (r < h) closer than d/2 <= 0.1 % (clustering, PF Section 3.2).
- * Measured with the 3D tension factor 0.935 (issue 11, 2026-12-02): seeds 1 / 2 / 3 read
- * 0.9601 / 0.9591 / 0.9574 (floor 0.971); 0.013-0.017 % of the pairs closer than d/2; 47-51 s of
- * CPU per seed. Before that factor (Eq. 13 alone, 7 % stiffer): 0.9561 / 0.9614 / 0.9696,
- * 0.015-0.019 %; first round (ratio 0.9) at 0.53-0.57 s.
+ * period T = 0.767 s. Each of three seeds runs to 6.2 s (8.1 T), sampled every 0.025 s; over the
+ * last 4 T (the issue asks for at least two) the mean moment ratio must be >= 0.95 and the mean
+ * fraction of kernel-neighbour pairs (r < h) closer than d/2 <= 0.1 % (clustering, PF Section
+ * 3.2).
+ * Why four periods: the mode's correlation time is about a period, so a two-period mean holds
+ * few independent samples and scatters by about 0.007 here, while the drop sits 0.010-0.014
+ * below its floor. With two periods (run to 3 s) seeds 1 / 2 / 3 read 0.9601 / 0.9591 / 0.9574,
+ * then 0.9571 / 0.9450 / 0.9603 once the pair pass's rounding changed (2026-12-02, the same
+ * physics): 0.95 was one deviation away. Over four periods (3.13-6.2 s) the same runs read
+ * 0.9617 / 0.9591 / 0.9560 (bench/pf_shape gives the same bits); the last two periods alone
+ * 0.9659 / 0.9606 / 0.9556. 0.016-0.025 % of the pairs closer than d/2; about 80 s of CPU per
+ * seed. Before the 3D tension factor (Eq. 13 alone, 7 % stiffer), two periods: 0.9561 / 0.9614
+ * / 0.9696; first round (ratio 0.9) at 0.53-0.57 s.
  */
 #include <math.h>
 #include <omp.h>
@@ -44,10 +50,10 @@ static void test_box_to_sphere(void **state)
 #else
     double mean = 0;
     for (int seed = 1; seed <= 3; seed++) {
-        tu_relax r = tu_shape_relax(3, nl, ns, seed, 3.0, 2 * T, 0.025);
-        print_message("seed %d: over %.2f - %.2f s (two periods) moment ratio %.4f, %.4f %% of "
+        tu_relax r = tu_shape_relax(3, nl, ns, seed, 6.2, 4 * T, 0.025);
+        print_message("seed %d: over %.2f - %.2f s (four periods) moment ratio %.4f, %.4f %% of "
                       "pairs closer than d/2; %.1f s CPU\n",
-                      seed, 3.0 - 2 * T, 3.0, r.ratio, 100 * r.close, r.cpu);
+                      seed, 6.2 - 4 * T, 6.2, r.ratio, 100 * r.close, r.cpu);
         assert_true(r.ratio >= 0.95);
         assert_true(r.close <= 0.001);
         mean += r.ratio / 3;
