@@ -20,6 +20,7 @@ cases=${*:-step7k step59k step493k tts7k tts59k}
 REPS=${REPS:-2}
 if [ "${WAIT:-passive}" = passive ]; then export OMP_WAIT_POLICY=passive; else unset OMP_WAIT_POLICY GOMP_SPINCOUNT; fi
 work=$(mktemp -d)
+mkdir -p "$work/spl" "$work/pf"
 trap 'rm -rf "$work"' EXIT
 
 # wall seconds and peak RSS (kB) of a command, as "wall rss"
