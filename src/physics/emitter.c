@@ -162,7 +162,9 @@ size_t pfsph_emitters_max(const pfsph_emitters *em, double t)
     size_t total = 0;
     for (int i = 0; em && i < em->n; i++) {
         const nozzle *z = &em->z[i];
-        double layers = floor(z->info.layer_rate * open_for(z, 0, t)) + 1;
+        /* an upper bound, so a product a rounding error short of a whole number of layers
+         * counts that layer: float and double builds then give the same bound */
+        double layers = floor(z->info.layer_rate * open_for(z, 0, t) * (1 + 1e-6)) + 1;
         total += (size_t)layers * z->info.sites;
     }
     return total;
