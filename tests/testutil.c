@@ -181,6 +181,22 @@ void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, doubl
     free(par);
 }
 
+pfsph_sim *tu_sim_from_json(const char *json, const char *name)
+{
+    pfsph_scene *s = malloc(sizeof *s);
+    assert_non_null(s);
+    pfsph_error err = {0};
+    int rc = pfsph_scene_parse(s, json, name, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    rc = pfsph_sim_create(&sim, s, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    free(s); /* the simulation keeps its own copy */
+    return sim;
+}
+
 /* ---- shape of a free drop (the shape tests of docs/thermostat.md) ---- */
 
 tu_shape tu_shape_measure(const pfsph_ctx *c)
@@ -244,16 +260,9 @@ tu_relax tu_shape_relax(int dim, int nl, int ns, int seed, double t_end, double 
                  " \"pairwise\": {\"thermostat\": {\"reduced_temperature\": 0.01}, \"k\": 1.3867,"
                  " \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}}",
                  seed, -a, -b, -b, a, b, b);
-    pfsph_scene *s = malloc(sizeof *s);
-    assert_non_null(s);
+    pfsph_sim *sim = tu_sim_from_json(json, "block.json");
     pfsph_error err = {0};
-    int rc = pfsph_scene_parse(s, json, "block.json", &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, s, &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    int rc;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     tu_shape st = tu_shape_measure(c);
     assert_true(st.ratio < 0.3); /* 2:1 block: 0.25 */
@@ -280,6 +289,5 @@ tu_relax tu_shape_relax(int dim, int nl, int ns, int seed, double t_end, double 
     r.close /= navg;
     assert_int_equal(pfsph_sim_removed(sim), 0);
     pfsph_sim_destroy(sim);
-    free(s);
     return r;
 }

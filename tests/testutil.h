@@ -38,6 +38,11 @@ typedef struct tu_bubble {
 } tu_bubble;
 void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, double R, tu_bubble *b);
 
+/* A simulation of a scene given as JSON text (name: for messages); fails the test, printing the
+ * message, when the scene does not parse or the simulation cannot start. */
+struct pfsph_sim;
+struct pfsph_sim *tu_sim_from_json(const char *json, const char *name);
+
 /* Shape of a free drop (docs/thermostat.md, "The shape tests"): ratio is the smallest / largest
  * principal second moment about the centroid, close the fraction of kernel-neighbour pairs
  * (r < 2 d) closer than d/2. */

@@ -141,16 +141,9 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     len += snprintf(json + len, sizeof json - (size_t)len, "]}}");
     assert_true(len < (int)sizeof json);
 
-    pfsph_scene *s = malloc(sizeof *s);
-    assert_non_null(s);
+    pfsph_sim *sim = tu_sim_from_json(json, "contact.json");
     pfsph_error err = {0};
-    int rc = pfsph_scene_parse(s, json, "contact.json", &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, s, &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    int rc;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     double sum[MAXDROP] = {0}, sum2[MAXDROP] = {0}, th[MAXDROP], low[MAXDROP];
     int cnt[MAXDROP] = {0};
@@ -188,7 +181,6 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     for (int q = 0; q < nd; q++) assert_true(low[q] < 1.0);
     for (int q = 0; q < nd; q++) assert_true(fabs(th[q] - target[q]) <= tol);
     pfsph_sim_destroy(sim);
-    free(s);
 }
 
 static void test_contact_angles(void **state)

@@ -51,16 +51,9 @@ static drop_result run_drop(double Rs, double t0, double t_end)
              " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
              " \"sigma\": %g}]}}",
              0.5 * d, getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", Rs * d, thermo, SIGMA);
-    pfsph_scene *s = malloc(sizeof *s);
-    assert_non_null(s);
+    pfsph_sim *sim = tu_sim_from_json(json, "laplace.json");
     pfsph_error err = {0};
-    int rc = pfsph_scene_parse(s, json, "laplace.json", &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, s, &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    int rc;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const pfsph_particles *f = c->fluid;
     const size_t n = f->n;
@@ -113,7 +106,6 @@ static drop_result run_drop(double Rs, double t0, double t_end)
     free(pm);
     free(smp);
     pfsph_sim_destroy(sim);
-    free(s);
     return r;
 }
 
