@@ -40,7 +40,9 @@ void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, dou
         for (int a = 0; a < 2; a++)
             for (int b = 0; b < 2; b++) v[a][b] = v2[a][b];
     } else {
-        pfsph_eigen_sym3(C, w, v);
+        /* closed form: T is wanted to float precision, and Jacobi to 1e-15 was 12 % of a
+         * pair-force step (docs/benchmarks.md) */
+        pfsph_eigen_sym3_fast(C, w, v);
     }
     if (!(w[0] > 0)) return; /* no neighbours: nothing to be anisotropic about */
     /* Eqs. 8-9: eigenvalues normalised by the largest (NOTES item 4), clamped below. */
