@@ -172,28 +172,29 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
     const double *coef = J->coef[pa];
     const int n = H->n;
     /* the per-pair cosine and kernel in vector code (pair_terms.c) */
-    pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
     if (J->filter) pfsph__terms_w(&J->kk, n, H->r2, H->t0);
-    for (int e = 0; e < n; e++) {
-        const uint32_t j = H->j[e];
-        double cf;
-        if (J->two_phase) { /* Eq. 24 where a film particle takes part */
+    if (!J->two_phase) {
+        /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0); r = 0: no
+         * direction, no force, and not in Eq. 7's sum. The cosine in float (pfsph__cos_pair,
+         * error < 2e-7): the force is summed in double, its shape needs 1e-7. */
+        pfsph__terms_pair_sc(J->U_R, coef, ps->phase, n, H->j, H->r2, W->sc, J->filter ? H->t0 : NULL);
+    } else {
+        pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
+        for (int e = 0; e < n; e++) {
+            const uint32_t j = H->j[e];
+            /* Eq. 24 where a film particle takes part */
             const int pb = ps->phase[j];
             const double aj = (double)ps->film[j];
             const int bj = ps->bubble[j];
             const bool apart = bi && bj && bi != bj;
-            cf = ai > 0 || aj > 0 || apart ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
-                                           : coef[pb];
-        } else {
-            cf = coef[ps->phase[j]];
+            const double cf = ai > 0 || aj > 0 || apart
+                                  ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
+                                  : coef[pb];
+            /* as pfsph__terms_pair_sc */
+            const bool live = H->r2[e] > 0;
+            W->sc[e] = live && cf != 0.0 ? cf * W->cr[e] : 0.0;
+            if (!live) H->t0[e] = 0;
         }
-        /* r = 0: no direction, no force, and not in Eq. 7's sum (as before the lanes) */
-        const bool live = H->r2[e] > 0;
-        /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0). The cosine
-         * in float (pfsph__cos_pair, error < 2e-7): the force is summed in double, its shape
-         * needs 1e-7. */
-        W->sc[e] = live && cf != 0.0 ? cf * W->cr[e] : 0.0;
-        if (!live) H->t0[e] = 0;
     }
     const int m = (n + 3) & ~3; /* padding entries add zeros */
     for (int e = n; e < m; e++) {
