@@ -64,17 +64,18 @@ void pfsph__terms_pair_cos(double U_R, int n, const pfsph_real *restrict r2, dou
 
 PFSPH__CLONES
 void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t *restrict phase, int n,
-                          const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict sc,
-                          pfsph_real *restrict w)
+                          const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict cf,
+                          double *restrict sc, pfsph_real *restrict w)
 {
+    /* the gather apart, so that the arithmetic loop vectorises */
+    for (int e = 0; e < n; e++) cf[e] = coef[phase[jj[e]]];
     for (int e = 0; e < n; e++) {
         const double r = __builtin_sqrt((double)r2[e]);
         const double cr = (double)pfsph__cos_pair((float)(U_R * r)) / r;
-        const double cf = coef[phase[jj[e]]];
-        const int live = r2[e] > 0;
-        sc[e] = live && cf != 0.0 ? cf * cr : 0.0;
-        if (w) w[e] = live ? w[e] : 0;
+        sc[e] = r2[e] > 0 && cf[e] != 0.0 ? cf[e] * cr : 0.0;
     }
+    if (w)
+        for (int e = 0; e < n; e++) w[e] = r2[e] > 0 ? w[e] : 0;
 }
 
 PFSPH__CLONES

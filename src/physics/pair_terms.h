@@ -72,11 +72,12 @@ static inline float pfsph__cos_pair(float x)
  * acceleration); entries with r2[e] = 0 are not finite and must be skipped. */
 void pfsph__terms_pair_cos(double U_R, int n, const pfsph_real *restrict r2, double *restrict cr);
 
-/* The same times the pair's coefficient, for one coefficient per phase of j: sc[e] = coef[phase[jj[e]]]
- * cr[e] where r2[e] > 0 and the coefficient is not 0, else 0; w (if not NULL): w[e] set to 0 where
- * r2[e] = 0 (r = 0 has no direction and is not in Eq. 7's sum). */
+/* The same times the pair's coefficient, for one coefficient per phase of j: sc[e] = cf[e] cr[e]
+ * with cf[e] = coef[phase[jj[e]]] (cf: scratch of n entries) where r2[e] > 0 and cf[e] is not 0,
+ * else 0; w (if not NULL): w[e] set to 0 where r2[e] = 0 (r = 0 has no direction and is not in
+ * Eq. 7's sum). */
 void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t *restrict phase, int n,
-                          const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict sc,
-                          pfsph_real *restrict w);
+                          const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict cf,
+                          double *restrict sc, pfsph_real *restrict w);
 
 #endif

@@ -177,7 +177,7 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
         /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0); r = 0: no
          * direction, no force, and not in Eq. 7's sum. The cosine in float (pfsph__cos_pair,
          * error < 2e-7): the force is summed in double, its shape needs 1e-7. */
-        pfsph__terms_pair_sc(J->U_R, coef, ps->phase, n, H->j, H->r2, W->sc, J->filter ? H->t0 : NULL);
+        pfsph__terms_pair_sc(J->U_R, coef, ps->phase, n, H->j, H->r2, W->cr, W->sc, J->filter ? H->t0 : NULL);
     } else {
         pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
         for (int e = 0; e < n; e++) {
