@@ -79,6 +79,18 @@ void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t
 }
 
 PFSPH__CLONES
+void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta)
+{
+    /* pfsph_thermo_theta, lane by lane: 64-bit multiplies (emulated from 32-bit ones where the
+     * CPU lacks them) and the exact 53-bit integer to double conversion of pfsph__u53_double */
+    for (int e = 0; e < n; e++) {
+        const uint64_t lo = idi < idj[e] ? idi : idj[e], hi = idi < idj[e] ? idj[e] : idi;
+        const uint64_t z = pfsph__mix64(key ^ pfsph__mix64((lo << 32) | hi));
+        theta[e] = 1.7320508075688772 * (pfsph__u53_double(z >> 11) * (2.0 / 9007199254740992.0) - 1.0);
+    }
+}
+
+PFSPH__CLONES
 void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_real *restrict r2,
                          const pfsph_real *restrict dw, const double *restrict amp_ts, const double *restrict nu,
                          const double *restrict mj, const double *restrict ndj, const double *restrict theta,

@@ -34,6 +34,9 @@ void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_r
                          const double *restrict mj, const double *restrict ndj, const double *restrict theta,
                          double *restrict t);
 
+/* theta[e] = pfsph_thermo_theta(key, idi, idj[e]) (the same bits), e < n. */
+void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta);
+
 /* Four-lane sums of the pair pass (pairwise.c): hit e goes to lane e % 4 of each sum, lanes
  * are added at the end in a fixed order, so the result is the same bits on every CPU and
  * thread count (the association is fixed by the source, not by the vector width). */

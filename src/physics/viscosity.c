@@ -86,6 +86,7 @@ typedef struct thermo_buf {
     double amp_ts[PFSPH_HITS_CAP + PFSPH_HITS_PAD], nu[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
         mj[PFSPH_HITS_CAP + PFSPH_HITS_PAD], ndj[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
         theta[PFSPH_HITS_CAP + PFSPH_HITS_PAD], t[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
+    uint32_t idj[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
 } thermo_buf;
 
 /* The fluid hits in H of particle I with the thermostat: viscosity (and fused, pressure) factors
@@ -106,8 +107,10 @@ static inline void thermo_hits(const pfsph_ctx *ctx, const visc_i *I, pfsph_hits
         X->nu[e] = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
         X->mj[e] = (double)ctx->mass[pb];
         X->ndj[e] = (double)ctx->nd[j];
-        X->theta[e] = pfsph_thermo_theta(key, I->id, f->id[j]);
+        X->idj[e] = f->id[j];
     }
+    /* the pair hashes in vector code (pair_terms.c), the same bits as pfsph_thermo_theta */
+    pfsph__terms_theta(key, I->id, n, X->idj, X->theta);
     pfsph__terms_visc_pressure(in, n, H->j, H->dx, H->dy, H->dz, H->r2, H->t0, H->t1, H->t2);
     pfsph__terms_thermo(I->m, I->nd, (double)eps, n, H->r2, H->t0, X->amp_ts, X->nu, X->mj, X->ndj, X->theta, X->t);
     for (int e = 0; e < n; e++) {
