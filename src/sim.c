@@ -546,6 +546,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         goto fail;
     }
     sim->grid.reach = sim->bgrid.reach = reach;
+    sim->bgrid.want_near = 1; /* the boundary is sparse: passes skip walks that find no cell */
     sim->grid.reach_far = sim->bgrid.reach_far = reach_far;
     for (int a = 0; a < s->dim; a++) {
         sim->grid.keep_lo[a] = (pfsph_real)s->domain_min[a];
