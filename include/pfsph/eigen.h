@@ -19,4 +19,7 @@ int pfsph_eigen_sym3(const double a[3][3], double w[3], double v[3][3]);
  * gives w = 0 and v = I, a multiple of I gives v = I. For the pair filter (float precision). */
 void pfsph_eigen_sym3_fast(const double a[3][3], double w[3], double v[3][3]);
 
+/* The eigenvalues of pfsph_eigen_sym3_fast alone (the same bits), descending. */
+void pfsph_eigen_sym3_values(const double a[3][3], double w[3]);
+
 #endif

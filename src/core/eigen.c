@@ -164,33 +164,20 @@ static void evec_plane(const double m[3][3], const double u0[3], double e, doubl
     for (int a = 0; a < 3; a++) out[a] = cu * U[a] + cv * V[a];
 }
 
-void pfsph_eigen_sym3_fast(const double a[3][3], double w[3], double v[3][3])
+/* Eigenvalues (descending) of the scaled matrix m = A / s in closed form; returns 0 for a
+ * multiple of I (p = 0), else the sign of det(B) / 2 (which eigenvalue is the farther from the
+ * middle one) as 1 (the largest) or -1. D. Eberly, "A robust eigensolver for 3x3 symmetric
+ * matrices" (Geometric Tools, 2014): the trigonometric solution of the characteristic cubic of
+ * the shifted, scaled B = (m - q I) / p. */
+static int values_scaled(const double m[3][3], double e[3])
 {
-    /* D. Eberly, "A robust eigensolver for 3x3 symmetric matrices" (Geometric Tools, 2014):
-     * eigenvalues from the trigonometric solution of the characteristic cubic of the scaled,
-     * shifted matrix B = (A / s - q I) / p; the eigenvector of the eigenvalue farther from the
-     * middle one from cross products (well separated by construction), the middle one in the
-     * plane orthogonal to it, the third their cross product. */
-    double s = 0;
-    for (int i = 0; i < 3; i++)
-        for (int j = i; j < 3; j++) s = fmax(s, fabs(a[i][j]));
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) v[i][j] = i == j ? 1.0 : 0.0;
-    if (!(s > 0)) { /* zero matrix (or NaN): zero spectrum, the axes */
-        w[0] = w[1] = w[2] = 0;
-        return;
-    }
-    const double is = 1.0 / s;
-    const double m[3][3] = {{a[0][0] * is, a[0][1] * is, a[0][2] * is},
-                            {a[0][1] * is, a[1][1] * is, a[1][2] * is},
-                            {a[0][2] * is, a[1][2] * is, a[2][2] * is}};
     const double q = (m[0][0] + m[1][1] + m[2][2]) / 3.0;
     const double b00 = m[0][0] - q, b11 = m[1][1] - q, b22 = m[2][2] - q;
     const double off = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
     const double p = sqrt((b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * off) / 6.0);
-    if (!(p > 0)) { /* a multiple of I: every axis is an eigenvector */
-        w[0] = w[1] = w[2] = q * s;
-        return;
+    if (!(p > 0)) {
+        e[0] = e[1] = e[2] = q;
+        return 0;
     }
     /* det(B) / 2 = cos(3 phi), B's eigenvalues 2 cos(phi + 2 pi k / 3) */
     const double c00 = b11 * b22 - m[1][2] * m[1][2];
@@ -201,9 +188,61 @@ void pfsph_eigen_sym3_fast(const double a[3][3], double w[3], double v[3][3])
     const double phi = acos(hd) / 3.0;
     const double beta2 = 2.0 * cos(phi), beta0 = 2.0 * cos(phi + 2.0943951023931954923);
     const double beta1 = -(beta0 + beta2);
-    const double e[3] = {q + p * beta2, q + p * beta1, q + p * beta0}; /* descending */
+    e[0] = q + p * beta2;
+    e[1] = q + p * beta1;
+    e[2] = q + p * beta0;
+    return hd >= 0 ? 1 : -1;
+}
+
+/* the largest |a_ij| of the upper triangle (0 for a zero matrix, NaN-free: fmax drops NaN) */
+static double max_abs(const double a[3][3])
+{
+    double s = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = i; j < 3; j++) s = fmax(s, fabs(a[i][j]));
+    return s;
+}
+
+void pfsph_eigen_sym3_values(const double a[3][3], double w[3])
+{
+    const double s = max_abs(a);
+    if (!(s > 0)) {
+        w[0] = w[1] = w[2] = 0;
+        return;
+    }
+    const double is = 1.0 / s;
+    const double m[3][3] = {{a[0][0] * is, a[0][1] * is, a[0][2] * is},
+                            {a[0][1] * is, a[1][1] * is, a[1][2] * is},
+                            {a[0][2] * is, a[1][2] * is, a[2][2] * is}};
+    double e[3];
+    values_scaled(m, e);
+    for (int k = 0; k < 3; k++) w[k] = e[k] * s;
+}
+
+void pfsph_eigen_sym3_fast(const double a[3][3], double w[3], double v[3][3])
+{
+    /* Eberly (values_scaled): the eigenvector of the eigenvalue farther from the middle one from
+     * cross products (well separated by construction), the middle one in the plane orthogonal
+     * to it, the third their cross product. */
+    const double s = max_abs(a);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) v[i][j] = i == j ? 1.0 : 0.0;
+    if (!(s > 0)) { /* zero matrix (or NaN): zero spectrum, the axes */
+        w[0] = w[1] = w[2] = 0;
+        return;
+    }
+    const double is = 1.0 / s;
+    const double m[3][3] = {{a[0][0] * is, a[0][1] * is, a[0][2] * is},
+                            {a[0][1] * is, a[1][1] * is, a[1][2] * is},
+                            {a[0][2] * is, a[1][2] * is, a[2][2] * is}};
+    double e[3]; /* descending */
+    const int far = values_scaled(m, e);
+    if (far == 0) { /* a multiple of I: every axis is an eigenvector */
+        w[0] = w[1] = w[2] = e[0] * s;
+        return;
+    }
     double u[3][3]; /* u[k]: unit eigenvector of e[k] */
-    if (hd >= 0) { /* the largest is the farther from the middle one */
+    if (far > 0) { /* the largest is the farther from the middle one */
         evec_simple(m, e[0], u[0]);
         evec_plane(m, u[0], e[1], u[1]);
         cross3(u[0], u[1], u[2]);

@@ -31,6 +31,26 @@ void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, dou
         for (int b = 0; b < 3; b++) T[a][b] = a == b ? 1.0 : 0.0;
     if (!(eta > 0)) return;
     double w[3] = {0, 0, 0}, v[3][3] = {{0}};
+    double floor_ = eps_min > 1e-12 ? eps_min : 1e-12;
+    if (dim == 3) {
+        /* No eigenvalue clamped (w_min / w_max >= eps_min, the bulk): e_min / e_k = w_min / w_k,
+         * so G / |G| = sum_k (w_min / w_k) v_k v_k^T = w_min C^-1 (Eqs. 8-11), and C^-1 from its
+         * adjugate (C is then no worse conditioned than 1 / eps_min): no eigenvectors needed. */
+        pfsph_eigen_sym3_values(C, w);
+        if (w[0] > 0 && w[2] >= floor_ * w[0]) {
+            const double A00 = C[1][1] * C[2][2] - C[1][2] * C[1][2], A01 = C[0][2] * C[1][2] - C[0][1] * C[2][2],
+                         A02 = C[0][1] * C[1][2] - C[0][2] * C[1][1], A11 = C[0][0] * C[2][2] - C[0][2] * C[0][2],
+                         A12 = C[0][1] * C[0][2] - C[0][0] * C[1][2], A22 = C[0][0] * C[1][1] - C[0][1] * C[0][1];
+            const double det = C[0][0] * A00 + C[0][1] * A01 + C[0][2] * A02;
+            if (det > 0) {
+                const double f = eta * w[2] / det;
+                const double adj[3][3] = {{A00, A01, A02}, {A01, A11, A12}, {A02, A12, A22}};
+                for (int a = 0; a < 3; a++)
+                    for (int b = 0; b < 3; b++) T[a][b] = (a == b ? 1.0 - eta : 0.0) + f * adj[a][b];
+                return;
+            }
+        }
+    }
     if (dim == 2) {
         const double c2[2][2] = {{C[0][0], C[0][1]}, {C[0][1], C[1][1]}};
         double w2[2], v2[2][2];
@@ -46,7 +66,6 @@ void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, dou
     }
     if (!(w[0] > 0)) return; /* no neighbours: nothing to be anisotropic about */
     /* Eqs. 8-9: eigenvalues normalised by the largest (NOTES item 4), clamped below. */
-    double floor_ = eps_min > 1e-12 ? eps_min : 1e-12;
     double e[3];
     for (int k = 0; k < dim; k++) {
         double t = w[k] / w[0];
