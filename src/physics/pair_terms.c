@@ -12,8 +12,12 @@
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PFSPH_SANITIZED)
 #define PFSPH__CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+/* AVX-512DQ adds the 64-bit multiply (vpmullq) that the thermostat's pair hash needs; integer
+ * operations only, so the clones give the same bits */
+#define PFSPH__CLONES_DQ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 #else
 #define PFSPH__CLONES
+#define PFSPH__CLONES_DQ
 #endif
 
 PFSPH__CLONES
@@ -78,7 +82,7 @@ void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t
         for (int e = 0; e < n; e++) w[e] = r2[e] > 0 ? w[e] : 0;
 }
 
-PFSPH__CLONES
+PFSPH__CLONES_DQ
 void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta)
 {
     /* pfsph_thermo_theta, lane by lane: 64-bit multiplies (emulated from 32-bit ones where the

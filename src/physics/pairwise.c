@@ -190,13 +190,14 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
     pfsph_hits *H = &W->H;
     const double *coef = J->coef[pa];
     const int n = H->n;
-    /* the per-pair cosine and kernel in vector code (pair_terms.c) */
-    if (J->filter) pfsph__terms_w(&J->kk, n, H->r2, H->t0);
+    /* the per-pair cosine and kernel in vector code (pair_terms.c), over whole vectors */
+    const int n16 = pfsph_hits_pad16(H);
+    if (J->filter) pfsph__terms_w(&J->kk, n16, H->r2, H->t0);
     if (!J->two_phase) {
         /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0); r = 0: no
          * direction, no force, and not in Eq. 7's sum. The cosine in float (pfsph__cos_pair,
          * error < 2e-7): the force is summed in double, its shape needs 1e-7. */
-        pfsph__terms_pair_sc(J->U_R, coef, ps->phase, n, H->j, H->r2, W->cr, W->sc, J->filter ? H->t0 : NULL);
+        pfsph__terms_pair_sc(J->U_R, coef, ps->phase, n16, H->j, H->r2, W->cr, W->sc, J->filter ? H->t0 : NULL);
     } else {
         pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
         for (int e = 0; e < n; e++) {

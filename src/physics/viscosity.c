@@ -99,7 +99,9 @@ static inline void thermo_hits(const pfsph_ctx *ctx, const visc_i *I, pfsph_hits
 {
     const pfsph_particles *f = ctx->fluid;
     const int n = H->n;
-    for (int e = 0; e < n; e++) {
+    /* whole vectors: padding hits (j = 0, r2 = 0) give terms that are not summed */
+    const int n16 = pfsph_hits_pad16(H);
+    for (int e = 0; e < n16; e++) {
         const uint32_t j = H->j[e];
         const int pb = f->phase[j];
         H->t3[e] = ctx->nu[pb];
@@ -110,9 +112,9 @@ static inline void thermo_hits(const pfsph_ctx *ctx, const visc_i *I, pfsph_hits
         X->idj[e] = f->id[j];
     }
     /* the pair hashes in vector code (pair_terms.c), the same bits as pfsph_thermo_theta */
-    pfsph__terms_theta(key, I->id, n, X->idj, X->theta);
-    pfsph__terms_visc_pressure(in, n, H->j, H->dx, H->dy, H->dz, H->r2, H->t0, H->t1, H->t2);
-    pfsph__terms_thermo(I->m, I->nd, (double)eps, n, H->r2, H->t0, X->amp_ts, X->nu, X->mj, X->ndj, X->theta, X->t);
+    pfsph__terms_theta(key, I->id, n16, X->idj, X->theta);
+    pfsph__terms_visc_pressure(in, n16, H->j, H->dx, H->dy, H->dz, H->r2, H->t0, H->t1, H->t2);
+    pfsph__terms_thermo(I->m, I->nd, (double)eps, n16, H->r2, H->t0, X->amp_ts, X->nu, X->mj, X->ndj, X->theta, X->t);
     for (int e = 0; e < n; e++) {
         acc->ax += H->t1[e] * H->dx[e];
         acc->ay += H->t1[e] * H->dy[e];
