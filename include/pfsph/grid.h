@@ -25,6 +25,9 @@ typedef struct pfsph_grid {
     uint32_t *key;      /* scratch, per particle */
     uint32_t *perm;     /* scratch, per particle */
     void *tmp;          /* scratch for the permutation */
+    int want_near;      /* set by the owner: pfsph_grid_sort fills near */
+    uint8_t *near;      /* ncells entries (or NULL): 0 iff no cell within reach of c holds a
+                         * particle (pfsph_grid_near) */
     size_t cap;
 } pfsph_grid;
 
@@ -79,6 +82,23 @@ static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_re
                                      pfsph_real z, pfsph_ranges *r)
 {
     pfsph_grid_ranges_reach(g, x, y, z, g->reach, r);
+}
+
+/* 0 only if pfsph_grid_ranges from (x, y, z) would return no range (no particle within reach):
+ * a pass may then skip the walk, with the same result. 1 without g->near or outside the
+ * grid. For a sparse set (the boundary) that most fluid particles are far from. */
+static inline int pfsph_grid_near(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z)
+{
+    if (!g->near) return 1;
+    const pfsph_real p[3] = {x, y, z};
+    size_t idx = 0, mul = 1;
+    for (int a = 0; a < (g->dim == 3 ? 3 : 2); a++) {
+        const pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
+        if (!(t >= 0 && t < (pfsph_real)g->nc[a])) return 1;
+        idx += (size_t)(int)t * mul;
+        mul *= (size_t)g->nc[a];
+    }
+    return g->near[idx];
 }
 
 /* Ranges covering every particle within g->reach_far * g->cell (the pair forces' k h). */

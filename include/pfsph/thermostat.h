@@ -27,6 +27,17 @@ static inline uint64_t pfsph_thermo_step_key(uint64_t seed, uint64_t step, uint6
     return pfsph__mix64(pfsph__mix64(seed + 0x9E3779B97F4A7C15ull) ^ (step * 0xD1B54A32D192ED03ull + salt));
 }
 
+/* (double) u for u < 2^53, exactly, in operations that vectorise without a 64-bit integer
+ * conversion instruction (AVX2 and AVX-512F lack one): u / 2 through the 2^52 exponent trick,
+ * doubled, plus the low bit. */
+static inline double pfsph__u53_double(uint64_t u)
+{
+    const uint64_t b = 0x4330000000000000ull | (u >> 1);
+    double d;
+    __builtin_memcpy(&d, &b, sizeof d);
+    return (d - 4503599627370496.0) * 2.0 + ((u & 1) ? 1.0 : 0.0);
+}
+
 /* theta_ab = theta_ba, uniform on [-sqrt 3, sqrt 3] (zero mean, unit variance), as Groot &
  * Warren 1997 draw it. */
 static inline double pfsph_thermo_theta(uint64_t key, uint32_t a, uint32_t b)

@@ -38,11 +38,45 @@ int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_
 void pfsph_grid_free(pfsph_grid *g)
 {
     if (!g) return;
+    free(g->near);
     free(g->start);
     free(g->key);
     free(g->perm);
     free(g->tmp);
     memset(g, 0, sizeof(*g));
+}
+
+/* g->near: the occupied cells dilated by g->reach along x, then y, then z (a box dilation is
+ * separable), so near[c] = 0 exactly when pfsph_grid_ranges from a point in c returns no
+ * range. Out of memory: near = NULL, and pfsph_grid_near answers 1 (walk). */
+static void mark_near(pfsph_grid *g)
+{
+    const size_t nc = g->ncells;
+    uint8_t *a = g->near ? g->near : malloc(nc), *t = malloc(nc);
+    if (!a || !t) {
+        free(a);
+        free(t);
+        g->near = NULL;
+        return;
+    }
+    g->near = a;
+    for (size_t c = 0; c < nc; c++) a[c] = g->start[c + 1] > g->start[c];
+    const int R = g->reach;
+    const size_t n0 = (size_t)g->nc[0], n1 = (size_t)g->nc[1], n2 = (size_t)g->nc[2];
+    const size_t stride[3] = {1, n0, n0 * n1}, len[3] = {n0, n1, n2};
+    for (int ax = 0; ax < (g->dim == 3 ? 3 : 2); ax++) {
+        uint8_t *src = ax % 2 ? t : a, *dst = ax % 2 ? a : t;
+        const size_t s = stride[ax], L = len[ax];
+        for (size_t c = 0; c < nc; c++) {
+            const size_t k = c / s % L; /* c's index along ax */
+            const size_t lo = k >= (size_t)R ? k - (size_t)R : 0, hi = k + (size_t)R < L ? k + (size_t)R : L - 1;
+            uint8_t v = 0;
+            for (size_t q = lo; q <= hi; q++) v |= src[c + q * s - k * s];
+            dst[c] = v;
+        }
+    }
+    if (g->dim == 3) memcpy(a, t, nc); /* three passes ended in t */
+    free(t);
 }
 
 static int ensure(pfsph_grid *g, size_t n)
@@ -109,6 +143,7 @@ int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
     g->start[0] = 0;
 
     if (removed) *removed += n - kept;
+    if (g->want_near) mark_near(g);
     return pfsph_particles_permute(ps, g->perm, kept, g->tmp);
 }
 

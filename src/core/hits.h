@@ -24,6 +24,20 @@ typedef struct pfsph_hits {
         t2[PFSPH_HITS_CAP + PFSPH_HITS_PAD], t3[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
 } pfsph_hits;
 
+/* Pads the hits to a multiple of 16 (the widest vector of floats) with harmless entries (j = 0,
+ * x_ij = 0, r2 = 0) and returns that count, so that the vector loops of a pass over them run
+ * whole vectors, not a scalar tail (for ~30 hits the tail was most of a loop's time); the
+ * pass still sums only the first h->n. */
+static inline int pfsph_hits_pad16(pfsph_hits *h)
+{
+    const int m = (h->n + 15) & ~15;
+    for (int e = h->n; e < m; e++) {
+        h->j[e] = 0;
+        h->dx[e] = h->dy[e] = h->dz[e] = h->r2[e] = 0;
+    }
+    return m;
+}
+
 /* Appends the targets j in [b, e) with r2 = |x - x_j|^2 < h2 and j != skip, in order, with
  * dx = x - x_j etc. computed as (x - x_j) and r2 as dx dx + dy dy + dz dz. Requires
  * h->n + (e - b) <= PFSPH_HITS_CAP. */

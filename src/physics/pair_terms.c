@@ -12,8 +12,12 @@
 
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PFSPH_SANITIZED)
 #define PFSPH__CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+/* AVX-512DQ adds the 64-bit multiply (vpmullq) that the thermostat's pair hash needs; integer
+ * operations only, so the clones give the same bits */
+#define PFSPH__CLONES_DQ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 #else
 #define PFSPH__CLONES
+#define PFSPH__CLONES_DQ
 #endif
 
 PFSPH__CLONES
@@ -63,6 +67,34 @@ void pfsph__terms_pair_cos(double U_R, int n, const pfsph_real *restrict r2, dou
 }
 
 PFSPH__CLONES
+void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t *restrict phase, int n,
+                          const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict cf,
+                          double *restrict sc, pfsph_real *restrict w)
+{
+    /* the gather apart, so that the arithmetic loop vectorises */
+    for (int e = 0; e < n; e++) cf[e] = coef[phase[jj[e]]];
+    for (int e = 0; e < n; e++) {
+        const double r = __builtin_sqrt((double)r2[e]);
+        const double cr = (double)pfsph__cos_pair((float)(U_R * r)) / r;
+        sc[e] = r2[e] > 0 && cf[e] != 0.0 ? cf[e] * cr : 0.0;
+    }
+    if (w)
+        for (int e = 0; e < n; e++) w[e] = r2[e] > 0 ? w[e] : 0;
+}
+
+PFSPH__CLONES_DQ
+void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta)
+{
+    /* pfsph_thermo_theta, lane by lane: 64-bit multiplies (emulated from 32-bit ones where the
+     * CPU lacks them) and the exact 53-bit integer to double conversion of pfsph__u53_double */
+    for (int e = 0; e < n; e++) {
+        const uint64_t lo = idi < idj[e] ? idi : idj[e], hi = idi < idj[e] ? idj[e] : idi;
+        const uint64_t z = pfsph__mix64(key ^ pfsph__mix64((lo << 32) | hi));
+        theta[e] = 1.7320508075688772 * (pfsph__u53_double(z >> 11) * (2.0 / 9007199254740992.0) - 1.0);
+    }
+}
+
+PFSPH__CLONES
 void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_real *restrict r2,
                          const pfsph_real *restrict dw, const double *restrict amp_ts, const double *restrict nu,
                          const double *restrict mj, const double *restrict ndj, const double *restrict theta,
@@ -75,44 +107,109 @@ void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_r
     }
 }
 
+/* Four doubles as one value: the lanes of the pair sums. GNU C vector extensions (gcc, clang)
+ * keep the lanes apart lane by lane, so each lane is the scalar expression in the scalar order;
+ * the compiler's own vectoriser built these vectors from scalars and shuffles (perf). */
+typedef double pf__v4d __attribute__((vector_size(32)));
+
+/* loads and stores as macros: a function returning a vector outside the clones' targets would
+ * change the ABI (-Wpsabi) */
+#define LD4D(v, p) __builtin_memcpy(&(v), (p), sizeof(pf__v4d))
+#define ST4D(p, v) __builtin_memcpy((p), &(v), sizeof(pf__v4d))
+#ifdef PFSPH_DOUBLE
+#define LD4R(v, p) LD4D(v, p)
+#else
+typedef float pf__v4f __attribute__((vector_size(16)));
+/* four floats as doubles (exact) */
+#define LD4R(v, p)                                                                                                    \
+    do {                                                                                                               \
+        pf__v4f f_;                                                                                                    \
+        __builtin_memcpy(&f_, (p), sizeof f_);                                                                         \
+        (v) = __builtin_convertvector(f_, pf__v4d);                                                                    \
+    } while (0)
+#endif
+
 PFSPH__CLONES
 void pfsph__sums_pair(int n, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
                       const pfsph_real *restrict dz, const double *restrict sc, const pfsph_real *restrict w,
                       int filter, int vir, pfsph_pair_sums *restrict P)
 {
-    pfsph_pair_sums L = *P;
-    for (int e = 0; e < n; e += 4)
-        for (int l = 0; l < 4; l++) {
-            const double x = (double)dx[e + l], y = (double)dy[e + l], z = (double)dz[e + l], s = sc[e + l];
-            L.acc[0][l] += s * x;
-            L.acc[1][l] += s * y;
-            L.acc[2][l] += s * z;
+    /* lane l of each vector is hit e + l: acc[a][l] += sc x, in e's order (pair_terms.h) */
+    pf__v4d a0, a1, a2;
+    LD4D(a0, P->acc[0]);
+    LD4D(a1, P->acc[1]);
+    LD4D(a2, P->acc[2]);
+    if (vir) {
+        pf__v4d S0, S1, S2, S3, S4, S5;
+        LD4D(S0, P->S[0]);
+        LD4D(S1, P->S[1]);
+        LD4D(S2, P->S[2]);
+        LD4D(S3, P->S[3]);
+        LD4D(S4, P->S[4]);
+        LD4D(S5, P->S[5]);
+        for (int e = 0; e < n; e += 4) {
+            pf__v4d x, y, z, s;
+            LD4R(x, dx + e);
+            LD4R(y, dy + e);
+            LD4R(z, dz + e);
+            LD4D(s, sc + e);
+            a0 += s * x;
+            a1 += s * y;
+            a2 += s * z;
+            S0 += s * x * x;
+            S1 += s * x * y;
+            S2 += s * x * z;
+            S3 += s * y * y;
+            S4 += s * y * z;
+            S5 += s * z * z;
         }
-    if (vir)
-        for (int e = 0; e < n; e += 4)
-            for (int l = 0; l < 4; l++) {
-                const double x = (double)dx[e + l], y = (double)dy[e + l], z = (double)dz[e + l], s = sc[e + l];
-                L.S[0][l] += s * x * x;
-                L.S[1][l] += s * x * y;
-                L.S[2][l] += s * x * z;
-                L.S[3][l] += s * y * y;
-                L.S[4][l] += s * y * z;
-                L.S[5][l] += s * z * z;
-            }
-    if (filter)
-        for (int e = 0; e < n; e += 4)
-            for (int l = 0; l < 4; l++) {
-                const double x = (double)dx[e + l], y = (double)dy[e + l], z = (double)dz[e + l], v = (double)w[e + l];
-                L.sw[l] += v;
-                L.sx[0][l] += v * x;
-                L.sx[1][l] += v * y;
-                L.sx[2][l] += v * z;
-                L.sxx[0][l] += v * x * x;
-                L.sxx[1][l] += v * x * y;
-                L.sxx[2][l] += v * x * z;
-                L.sxx[3][l] += v * y * y;
-                L.sxx[4][l] += v * y * z;
-                L.sxx[5][l] += v * z * z;
-            }
-    *P = L;
+        ST4D(P->S[0], S0), ST4D(P->S[1], S1), ST4D(P->S[2], S2);
+        ST4D(P->S[3], S3), ST4D(P->S[4], S4), ST4D(P->S[5], S5);
+    } else {
+        for (int e = 0; e < n; e += 4) {
+            pf__v4d x, y, z, s;
+            LD4R(x, dx + e);
+            LD4R(y, dy + e);
+            LD4R(z, dz + e);
+            LD4D(s, sc + e);
+            a0 += s * x;
+            a1 += s * y;
+            a2 += s * z;
+        }
+    }
+    ST4D(P->acc[0], a0), ST4D(P->acc[1], a1), ST4D(P->acc[2], a2);
+    if (filter) {
+        pf__v4d sw, x0, x1, x2;
+        LD4D(sw, P->sw);
+        LD4D(x0, P->sx[0]);
+        LD4D(x1, P->sx[1]);
+        LD4D(x2, P->sx[2]);
+        pf__v4d q0, q1, q2, q3, q4, q5;
+        LD4D(q0, P->sxx[0]);
+        LD4D(q1, P->sxx[1]);
+        LD4D(q2, P->sxx[2]);
+        LD4D(q3, P->sxx[3]);
+        LD4D(q4, P->sxx[4]);
+        LD4D(q5, P->sxx[5]);
+        for (int e = 0; e < n; e += 4) {
+            pf__v4d x, y, z, v;
+            LD4R(x, dx + e);
+            LD4R(y, dy + e);
+            LD4R(z, dz + e);
+            LD4R(v, w + e);
+            sw += v;
+            x0 += v * x;
+            x1 += v * y;
+            x2 += v * z;
+            q0 += v * x * x;
+            q1 += v * x * y;
+            q2 += v * x * z;
+            q3 += v * y * y;
+            q4 += v * y * z;
+            q5 += v * z * z;
+        }
+        ST4D(P->sw, sw), ST4D(P->sx[0], x0), ST4D(P->sx[1], x1), ST4D(P->sx[2], x2);
+        ST4D(P->sxx[0], q0), ST4D(P->sxx[1], q1), ST4D(P->sxx[2], q2);
+        ST4D(P->sxx[3], q3), ST4D(P->sxx[4], q4), ST4D(P->sxx[5], q5);
+    }
 }

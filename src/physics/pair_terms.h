@@ -34,6 +34,9 @@ void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_r
                          const double *restrict mj, const double *restrict ndj, const double *restrict theta,
                          double *restrict t);
 
+/* theta[e] = pfsph_thermo_theta(key, idi, idj[e]) (the same bits), e < n. */
+void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta);
+
 /* Four-lane sums of the pair pass (pairwise.c): hit e goes to lane e % 4 of each sum, lanes
  * are added at the end in a fixed order, so the result is the same bits on every CPU and
  * thread count (the association is fixed by the source, not by the vector width). */
@@ -71,5 +74,13 @@ static inline float pfsph__cos_pair(float x)
  * r = sqrt((double) r2[e]) (the cosine of Eq. 5 over r: times c m_j x_ij it is the pair
  * acceleration); entries with r2[e] = 0 are not finite and must be skipped. */
 void pfsph__terms_pair_cos(double U_R, int n, const pfsph_real *restrict r2, double *restrict cr);
+
+/* The same times the pair's coefficient, for one coefficient per phase of j: sc[e] = cf[e] cr[e]
+ * with cf[e] = coef[phase[jj[e]]] (cf: scratch of n entries) where r2[e] > 0 and cf[e] is not 0,
+ * else 0; w (if not NULL): w[e] set to 0 where r2[e] = 0 (r = 0 has no direction and is not in
+ * Eq. 7's sum). */
+void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t *restrict phase, int n,
+                          const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict cf,
+                          double *restrict sc, pfsph_real *restrict w);
 
 #endif

@@ -31,6 +31,26 @@ void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, dou
         for (int b = 0; b < 3; b++) T[a][b] = a == b ? 1.0 : 0.0;
     if (!(eta > 0)) return;
     double w[3] = {0, 0, 0}, v[3][3] = {{0}};
+    double floor_ = eps_min > 1e-12 ? eps_min : 1e-12;
+    if (dim == 3) {
+        /* No eigenvalue clamped (w_min / w_max >= eps_min, the bulk): e_min / e_k = w_min / w_k,
+         * so G / |G| = sum_k (w_min / w_k) v_k v_k^T = w_min C^-1 (Eqs. 8-11), and C^-1 from its
+         * adjugate (C is then no worse conditioned than 1 / eps_min): no eigenvectors needed. */
+        pfsph_eigen_sym3_values(C, w);
+        if (w[0] > 0 && w[2] >= floor_ * w[0]) {
+            const double A00 = C[1][1] * C[2][2] - C[1][2] * C[1][2], A01 = C[0][2] * C[1][2] - C[0][1] * C[2][2],
+                         A02 = C[0][1] * C[1][2] - C[0][2] * C[1][1], A11 = C[0][0] * C[2][2] - C[0][2] * C[0][2],
+                         A12 = C[0][1] * C[0][2] - C[0][0] * C[1][2], A22 = C[0][0] * C[1][1] - C[0][1] * C[0][1];
+            const double det = C[0][0] * A00 + C[0][1] * A01 + C[0][2] * A02;
+            if (det > 0) {
+                const double f = eta * w[2] / det;
+                const double adj[3][3] = {{A00, A01, A02}, {A01, A11, A12}, {A02, A12, A22}};
+                for (int a = 0; a < 3; a++)
+                    for (int b = 0; b < 3; b++) T[a][b] = (a == b ? 1.0 - eta : 0.0) + f * adj[a][b];
+                return;
+            }
+        }
+    }
     if (dim == 2) {
         const double c2[2][2] = {{C[0][0], C[0][1]}, {C[0][1], C[1][1]}};
         double w2[2], v2[2][2];
@@ -40,11 +60,12 @@ void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, dou
         for (int a = 0; a < 2; a++)
             for (int b = 0; b < 2; b++) v[a][b] = v2[a][b];
     } else {
-        pfsph_eigen_sym3(C, w, v);
+        /* closed form: T is wanted to float precision, and Jacobi to 1e-15 was 12 % of a
+         * pair-force step (docs/benchmarks.md) */
+        pfsph_eigen_sym3_fast(C, w, v);
     }
     if (!(w[0] > 0)) return; /* no neighbours: nothing to be anisotropic about */
     /* Eqs. 8-9: eigenvalues normalised by the largest (NOTES item 4), clamped below. */
-    double floor_ = eps_min > 1e-12 ? eps_min : 1e-12;
     double e[3];
     for (int k = 0; k < dim; k++) {
         double t = w[k] / w[0];
@@ -169,29 +190,31 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
     pfsph_hits *H = &W->H;
     const double *coef = J->coef[pa];
     const int n = H->n;
-    /* the per-pair cosine and kernel in vector code (pair_terms.c) */
-    pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
-    if (J->filter) pfsph__terms_w(&J->kk, n, H->r2, H->t0);
-    for (int e = 0; e < n; e++) {
-        const uint32_t j = H->j[e];
-        double cf;
-        if (J->two_phase) { /* Eq. 24 where a film particle takes part */
+    /* the per-pair cosine and kernel in vector code (pair_terms.c), over whole vectors */
+    const int n16 = pfsph_hits_pad16(H);
+    if (J->filter) pfsph__terms_w(&J->kk, n16, H->r2, H->t0);
+    if (!J->two_phase) {
+        /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0); r = 0: no
+         * direction, no force, and not in Eq. 7's sum. The cosine in float (pfsph__cos_pair,
+         * error < 2e-7): the force is summed in double, its shape needs 1e-7. */
+        pfsph__terms_pair_sc(J->U_R, coef, ps->phase, n16, H->j, H->r2, W->cr, W->sc, J->filter ? H->t0 : NULL);
+    } else {
+        pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
+        for (int e = 0; e < n; e++) {
+            const uint32_t j = H->j[e];
+            /* Eq. 24 where a film particle takes part */
             const int pb = ps->phase[j];
             const double aj = (double)ps->film[j];
             const int bj = ps->bubble[j];
             const bool apart = bi && bj && bi != bj;
-            cf = ai > 0 || aj > 0 || apart ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
-                                           : coef[pb];
-        } else {
-            cf = coef[ps->phase[j]];
+            const double cf = ai > 0 || aj > 0 || apart
+                                  ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
+                                  : coef[pb];
+            /* as pfsph__terms_pair_sc */
+            const bool live = H->r2[e] > 0;
+            W->sc[e] = live && cf != 0.0 ? cf * W->cr[e] : 0.0;
+            if (!live) H->t0[e] = 0;
         }
-        /* r = 0: no direction, no force, and not in Eq. 7's sum (as before the lanes) */
-        const bool live = H->r2[e] > 0;
-        /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0). The cosine
-         * in float (pfsph__cos_pair, error < 2e-7): the force is summed in double, its shape
-         * needs 1e-7. */
-        W->sc[e] = live && cf != 0.0 ? cf * W->cr[e] : 0.0;
-        if (!live) H->t0[e] = 0;
     }
     const int m = (n + 3) & ~3; /* padding entries add zeros */
     for (int e = n; e < m; e++) {

@@ -86,6 +86,7 @@ typedef struct thermo_buf {
     double amp_ts[PFSPH_HITS_CAP + PFSPH_HITS_PAD], nu[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
         mj[PFSPH_HITS_CAP + PFSPH_HITS_PAD], ndj[PFSPH_HITS_CAP + PFSPH_HITS_PAD],
         theta[PFSPH_HITS_CAP + PFSPH_HITS_PAD], t[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
+    uint32_t idj[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
 } thermo_buf;
 
 /* The fluid hits in H of particle I with the thermostat: viscosity (and fused, pressure) factors
@@ -94,22 +95,33 @@ typedef struct thermo_buf {
 static inline void thermo_hits(const pfsph_ctx *ctx, const visc_i *I, pfsph_hits *H, thermo_buf *X,
                                const pfsph_pair_in *in, pfsph_real eps, double amp,
                                const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, const int fused,
-                               visc_acc *acc, pfsph_real pa3[3])
+                               const int one_phase, visc_acc *acc, pfsph_real pa3[3])
 {
     const pfsph_particles *f = ctx->fluid;
     const int n = H->n;
-    for (int e = 0; e < n; e++) {
-        const uint32_t j = H->j[e];
-        const int pb = f->phase[j];
-        H->t3[e] = ctx->nu[pb];
-        X->amp_ts[e] = amp * ts[I->phase][pb];
-        X->nu[e] = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
-        X->mj[e] = (double)ctx->mass[pb];
-        X->ndj[e] = (double)ctx->nd[j];
-        X->theta[e] = pfsph_thermo_theta(key, I->id, f->id[j]);
-    }
-    pfsph__terms_visc_pressure(in, n, H->j, H->dx, H->dy, H->dz, H->r2, H->t0, H->t1, H->t2);
-    pfsph__terms_thermo(I->m, I->nd, (double)eps, n, H->r2, H->t0, X->amp_ts, X->nu, X->mj, X->ndj, X->theta, X->t);
+    /* whole vectors: padding hits (j = 0, r2 = 0) give terms that are not summed */
+    const int n16 = pfsph_hits_pad16(H);
+    if (one_phase) /* the per-phase inputs were filled once (thermo_fill_phase) */
+        for (int e = 0; e < n16; e++) {
+            const uint32_t j = H->j[e];
+            X->ndj[e] = (double)ctx->nd[j];
+            X->idj[e] = f->id[j];
+        }
+    else
+        for (int e = 0; e < n16; e++) {
+            const uint32_t j = H->j[e];
+            const int pb = f->phase[j];
+            H->t3[e] = ctx->nu[pb];
+            X->amp_ts[e] = amp * ts[I->phase][pb];
+            X->nu[e] = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
+            X->mj[e] = (double)ctx->mass[pb];
+            X->ndj[e] = (double)ctx->nd[j];
+            X->idj[e] = f->id[j];
+        }
+    /* the pair hashes in vector code (pair_terms.c), the same bits as pfsph_thermo_theta */
+    pfsph__terms_theta(key, I->id, n16, X->idj, X->theta);
+    pfsph__terms_visc_pressure(in, n16, H->j, H->dx, H->dy, H->dz, H->r2, H->t0, H->t1, H->t2);
+    pfsph__terms_thermo(I->m, I->nd, (double)eps, n16, H->r2, H->t0, X->amp_ts, X->nu, X->mj, X->ndj, X->theta, X->t);
     for (int e = 0; e < n; e++) {
         acc->ax += H->t1[e] * H->dx[e];
         acc->ay += H->t1[e] * H->dy[e];
@@ -127,6 +139,31 @@ static inline void thermo_hits(const pfsph_ctx *ctx, const visc_i *I, pfsph_hits
             pa3[1] += H->t2[e] * H->dy[e];
             pa3[2] += H->t2[e] * H->dz[e];
         }
+}
+
+/* The fluid's phase if all its particles have one (else -1). */
+static int fluid_one_phase(const pfsph_particles *f)
+{
+    if (!f->n) return -1;
+    const uint8_t p0 = f->phase[0];
+    uint8_t diff = 0;
+    for (size_t i = 0; i < f->n; i++) diff |= (uint8_t)(f->phase[i] ^ p0);
+    return diff ? -1 : p0;
+}
+
+/* With one fluid phase pa the per-hit inputs of thermo_hits that depend on the phases alone are
+ * the same for every hit: written once per thread over the whole buffer, with the expressions
+ * of thermo_hits (the same values). */
+static void thermo_fill_phase(const pfsph_ctx *ctx, int pa, pfsph_hits *H, thermo_buf *X, double amp,
+                              const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES])
+{
+    const pfsph_real nua = ctx->nu[pa];
+    for (int e = 0; e < PFSPH_HITS_CAP + PFSPH_HITS_PAD; e++) {
+        H->t3[e] = nua;
+        X->amp_ts[e] = amp * ts[pa][pa];
+        X->nu[e] = 0.5 * ((double)nua + (double)nua);
+        X->mj[e] = (double)ctx->mass[pa];
+    }
 }
 
 /* thermo: also the thermostat's random forces (thermostat.h), fused into this pass so that the
@@ -153,6 +190,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     const pfsph_real wall_nu_max = ctx->wall_nu_max;
     const pfsph_real *nd = ctx->nd, inv_v0 = (pfsph_real)1 / ctx->V0;
     const pfsph_hits_fn hits = pfsph_hits_select();
+    const int phase1 = thermo && !nl ? fluid_one_phase(f) : -1, one_phase = phase1 >= 0;
     double amp = 0, ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     uint64_t key = 0, wkey = 0;
     if (thermo) {
@@ -168,6 +206,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
         pfsph_hits H;
         thermo_buf Xb, *X = thermo ? &Xb : NULL;
         (void)X;
+        if (thermo && one_phase) thermo_fill_phase(ctx, phase1, &H, X, amp, ts);
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
@@ -198,7 +237,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                     const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
                     pfsph_real pa3[3] = {0, 0, 0};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i,
-                                    thermo_hits(ctx, &vi, &H, X, &in, eps, amp, ts, key, fused, &acc, pa3));
+                                    thermo_hits(ctx, &vi, &H, X, &in, eps, amp, ts, key, fused, one_phase, &acc, pa3));
                     pax = pa3[0], pay = pa3[1], paz = pa3[2];
                 } else {
                     /* the factors of visc_pair and of the pressure term in vector code

@@ -242,6 +242,55 @@ static void test_determinism(void **state)
     omp_set_num_threads(saved);
 }
 
+/* pfsph_grid_near against pfsph_grid_ranges: a sparse set (a few clusters, as a boundary is),
+ * query points over and beyond the domain; near = 0 exactly where the ranges are empty inside
+ * the grid, 1 outside it. Reach 1 and 2, 2D and 3D. */
+static void test_near(void **state)
+{
+    (void)state;
+    for (int dim = 2; dim <= 3; dim++)
+        for (int reach = 1; reach <= 2; reach++) {
+            pfsph_grid g;
+            assert_int_equal(pfsph_grid_init(&g, dim, LO, HI, H / (pfsph_real)reach), PFSPH_OK);
+            g.reach = reach;
+            g.want_near = 1;
+            pfsph_particles ps;
+            assert_int_equal(pfsph_particles_init(&ps, 16), PFSPH_OK);
+            lcg_state = 99 + (uint64_t)(10 * dim + reach);
+            for (int cl = 0; cl < 4; cl++) {
+                pfsph_real c[3];
+                for (int a = 0; a < 3; a++) c[a] = LO[a] + (pfsph_real)lcg_uniform() * (HI[a] - LO[a]);
+                for (int k = 0; k < 30; k++) {
+                    pfsph_real q[3];
+                    for (int a = 0; a < 3; a++) q[a] = c[a] + (pfsph_real)(0.1 * (lcg_uniform() - 0.5));
+                    if (dim == 2) q[2] = 0;
+                    assert_true(pfsph_particles_push(&ps, q, NULL, 0) >= 0);
+                }
+            }
+            assert_int_equal(pfsph_grid_sort(&g, &ps, NULL), PFSPH_OK);
+            assert_non_null(g.near);
+            int zero = 0, one = 0;
+            for (int t = 0; t < 20000; t++) {
+                pfsph_real q[3];
+                for (int a = 0; a < 3; a++) q[a] = LO[a] + (pfsph_real)((1.2 * lcg_uniform() - 0.1)) * (HI[a] - LO[a]);
+                if (dim == 2) q[2] = 0;
+                pfsph_ranges r;
+                pfsph_grid_ranges(&g, q[0], q[1], q[2], &r);
+                const int nr = pfsph_grid_near(&g, q[0], q[1], q[2]);
+                if (!nr) assert_int_equal(r.n, 0);
+                if (inside(dim, q) && q[0] < LO[0] + (pfsph_real)g.nc[0] * g.cell &&
+                    q[1] < LO[1] + (pfsph_real)g.nc[1] * g.cell && (dim == 2 || q[2] < LO[2] + (pfsph_real)g.nc[2] * g.cell))
+                    assert_int_equal(nr, r.n > 0);
+                zero += !nr;
+                one += nr;
+            }
+            print_message("dim %d reach %d: %d empty, %d near of 20000 points\n", dim, reach, zero, one);
+            assert_true(zero > 1000 && one > 1000);
+            pfsph_particles_free(&ps);
+            pfsph_grid_free(&g);
+        }
+}
+
 /* Small explicit cases: NaN in each coordinate is removed; faces, corners kept; a point outside
  * the domain still gets valid (possibly empty) ranges. */
 static void test_edge_cases(void **state)
@@ -314,6 +363,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_neighbours_3d),
         cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_edge_cases),
+        cmocka_unit_test(test_near),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -12,6 +12,7 @@
 #include "pfsph/film.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/sim.h"
+#include "pfsph/eigen.h"
 #include "testutil.h"
 
 static const double PI = 3.14159265358979323846;
@@ -249,6 +250,43 @@ static void test_filter_matrix(void **state)
     const double z[3][3] = {{0}};
     pfsph_pairwise_filter_matrix(3, z, 0.2, 0.5, T);
     assert_true(T[0][0] == 1 && T[1][1] == 1 && T[2][2] == 1);
+    /* random covariances, clamped or not (the unclamped take w_min C^-1, the others the
+     * eigenvectors), nearly isotropic ones included: against Eqs. 8-12 from Jacobi's
+     * eigen-decomposition, to float precision */
+    uint64_t st = 777;
+    double worst = 0;
+    for (int t = 0; t < 20000; t++) {
+        double g[3][3], Cr[3][3];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                st = st * 6364136223846793005ULL + 1442695040888963407ULL;
+                g[a][b] = (double)(st >> 11) / 9007199254740992.0 - 0.5;
+            }
+        const double iso = t % 3 == 0 ? 1.0 : (t % 3 == 1 ? 0.05 : 1e-6); /* spread of the spectrum */
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                Cr[a][b] = a == b ? 1.0 : 0.0;
+                for (int k = 0; k < 3; k++) Cr[a][b] += iso * g[a][k] * g[b][k] * 10.0;
+            }
+        double w[3], v[3][3], Tref[3][3];
+        pfsph_eigen_sym3(Cr, w, v);
+        double e[3], emin = 1;
+        for (int k = 0; k < 3; k++) {
+            e[k] = fmax(w[k] / w[0], 0.5);
+            emin = fmin(emin, e[k]);
+        }
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                double gg = 0;
+                for (int k = 0; k < 3; k++) gg += v[a][k] * v[b][k] * emin / e[k];
+                Tref[a][b] = (a == b ? 0.8 : 0.0) + 0.2 * gg;
+            }
+        pfsph_pairwise_filter_matrix(3, Cr, 0.2, 0.5, T);
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) worst = fmax(worst, fabs(T[a][b] - Tref[a][b]));
+    }
+    print_message("filter matrix against Jacobi: largest difference %.3g\n", worst);
+    assert_true(worst < 1e-8);
 }
 
 /* T = I and zero net force for an interior particle of square, hexagonal and cubic lattices. */
