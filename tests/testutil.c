@@ -3,6 +3,7 @@
 #include "testutil.h"
 
 #include <math.h>
+#include <omp.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -290,4 +291,71 @@ tu_relax tu_shape_relax(int dim, int nl, int ns, int seed, double t_end, double 
     assert_int_equal(pfsph_sim_removed(sim), 0);
     pfsph_sim_destroy(sim);
     return r;
+}
+
+/* ---- small numerics shared by the measurement tests ---- */
+
+tu_line tu_line_fit(int n, const double *x, const double *y)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    for (int i = 0; i < n; i++) sx += x[i], sy += y[i], sxx += x[i] * x[i], sxy += x[i] * y[i], syy += y[i] * y[i];
+    tu_line l;
+    const double det = n * sxx - sx * sx;
+    l.slope = (n * sxy - sx * sy) / det, l.icpt = (sy - l.slope * sx) / n;
+    const double cov = sxy / n - sx * sy / (n * n), vx = sxx / n - sx * sx / (n * n), vy = syy / n - sy * sy / (n * n);
+    l.r2 = vy > 0 ? cov * cov / (vx * vy) : 0;
+    return l;
+}
+
+void tu_block_mean(const double *s, size_t m, int nb, double *mean, double *se, double *bm)
+{
+    double b_[64];
+    if (nb < 2 || nb > 64 || m < (size_t)nb) { /* no assertion: called from parallel jobs */
+        *mean = *se = NAN;
+        return;
+    }
+    const size_t bl = m / (size_t)nb;
+    double mu = 0, v = 0;
+    for (int b = 0; b < nb; b++) {
+        b_[b] = 0;
+        for (size_t i = (size_t)b * bl; i < (size_t)(b + 1) * bl; i++) b_[b] += s[i];
+        b_[b] /= (double)bl;
+        mu += b_[b] / nb;
+    }
+    for (int b = 0; b < nb; b++) v += (b_[b] - mu) * (b_[b] - mu);
+    *mean = mu;
+    *se = sqrt(v / (nb - 1) / nb);
+    if (bm) memcpy(bm, b_, (size_t)nb * sizeof *bm);
+}
+
+int tu_env_list(const char *env, double *v, int max, int n_default)
+{
+    const char *e = getenv(env);
+    if (!e) return n_default;
+    int n = 0;
+    for (char *p = (char *)e; *p && n < max;) {
+        char *end;
+        v[n] = strtod(p, &end);
+        if (end == p) break;
+        n++, p = end;
+        if (*p == ',') p++;
+    }
+    return n;
+}
+
+void tu_parallel_largest_first(int n, const double *size, void (*fn)(void *arg, int i), void *arg)
+{
+    int order[64];
+    assert_true(n >= 0 && n <= 64);
+    for (int i = 0; i < n; i++) order[i] = i;
+    for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && size[order[j]] > size[order[j - 1]]; j--) {
+            const int t = order[j];
+            order[j] = order[j - 1], order[j - 1] = t;
+        }
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1); /* inside each call (nested regions are inactive anyway) */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+    for (int q = 0; q < n; q++) fn(arg, order[q]);
+    omp_set_num_threads(threads);
 }

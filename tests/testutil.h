@@ -25,6 +25,26 @@ unsigned char *tu_slurp(const char *path, size_t *len);
 void tu_assert_same_file(const char *dir_a, const char *dir_b, const char *name);
 
 
+/* Least-squares line y = icpt + slope x through n points, and its coefficient of determination
+ * r2 (0 when y does not vary). */
+typedef struct tu_line {
+    double slope, icpt, r2;
+} tu_line;
+tu_line tu_line_fit(int n, const double *x, const double *y);
+/* The mean of m samples and its standard error from nb consecutive block means (the samples of
+ * a time series are correlated; blocks longer than the correlation time are not): needs
+ * m >= nb, 2 <= nb <= 64 (else NaN); bm, if not NULL, receives the nb block means. Safe in
+ * parallel jobs (no assertion). */
+void tu_block_mean(const double *s, size_t m, int nb, double *mean, double *se, double *bm);
+/* Up to max comma-separated numbers from the environment variable env into v (a study knob);
+ * returns how many, or n_default with v untouched when env is not set. */
+int tu_env_list(const char *env, double *v, int max, int n_default);
+/* Calls fn(arg, i) for every i in [0, n), in parallel on omp_get_max_threads() threads, the
+ * largest size[i] first (so the longest job starts at once), each call with OpenMP's thread
+ * count set to 1: for independent simulations too small to gain from threads, whose bits
+ * then do not depend on the order. fn must not use cmocka's assertions (they jump). */
+void tu_parallel_largest_first(int n, const double *size, void (*fn)(void *arg, int i), void *arg);
+
 /* A gas bubble in a liquid (test_pf_rising_bubble, test_pf_density_ratio), measured over the
  * fluid particles of ctx: particles of phase `gas` are the bubble, R is its equivalent radius. */
 struct pfsph_ctx;

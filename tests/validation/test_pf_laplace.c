@@ -113,20 +113,20 @@ static void run_drop(drop *dr, double t0, double t_end)
     snprintf(dr->msg, sizeof dr->msg, "%s", err.msg);
     dr->m = m;
     dr->removed = (int)pfsph_sim_removed(sim);
-    if (dr->rc == PFSPH_OK && m >= NB) {
-        double bm[NB];
-        const size_t bl = m / NB;
-        for (int b = 0; b < NB; b++) {
-            bm[b] = 0;
-            for (size_t i = (size_t)b * bl; i < (size_t)(b + 1) * bl; i++) bm[b] += smp[i];
-            bm[b] /= (double)bl;
-            dr->p += bm[b] / NB;
-        }
-        for (int b = 0; b < NB; b++) dr->se += (bm[b] - dr->p) * (bm[b] - dr->p);
-        dr->se = sqrt(dr->se / (NB - 1) / NB);
-    }
+    if (dr->rc == PFSPH_OK && m >= NB) tu_block_mean(smp, m, NB, &dr->p, &dr->se, NULL);
     free(pm);
     free(smp);
+}
+
+typedef struct {
+    drop *dr;
+    double t0, t_end;
+} drop_job;
+
+static void run_job(void *arg, int i)
+{
+    drop_job *j = arg;
+    run_drop(&j->dr[i], j->t0, j->t_end);
 }
 
 static void test_laplace(void **state)
@@ -134,13 +134,7 @@ static void test_laplace(void **state)
     (void)state;
     double radii[MAXR] = {8, 10, 13, 16, 20};
     int nr = 5;
-    if (getenv("PF_RADII")) {
-        nr = 0;
-        for (char *p = getenv("PF_RADII"); *p && nr < MAXR;) {
-            radii[nr++] = strtod(p, &p);
-            if (*p == ',') p++;
-        }
-    }
+    nr = tu_env_list("PF_RADII", radii, MAXR, nr);
     double t_end = getenv("PF_T") ? atof(getenv("PF_T")) : 6.0;
 #ifdef __SANITIZE_ADDRESS__
     t_end = 0.3;
@@ -154,19 +148,8 @@ static void test_laplace(void **state)
         dr[i].Rs = radii[i];
         create_drop(&dr[i]);
     }
-    /* largest first, so that the longest run starts at once */
-    int order[MAXR];
-    for (int i = 0; i < nr; i++) order[i] = i;
-    for (int i = 1; i < nr; i++)
-        for (int j = i; j > 0 && radii[order[j]] > radii[order[j - 1]]; j--) {
-            const int t = order[j];
-            order[j] = order[j - 1], order[j - 1] = t;
-        }
-    const int threads = omp_get_max_threads();
-    omp_set_num_threads(1); /* each simulation on one thread: 200-1,300 particles gain nothing from more */
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
-    for (int q = 0; q < nr; q++) run_drop(&dr[order[q]], t0, t_end);
-    omp_set_num_threads(threads);
+    drop_job job = {dr, t0, t_end};
+    tu_parallel_largest_first(nr, radii, run_job, &job);
     for (int i = 0; i < nr; i++) {
         if (dr[i].rc != PFSPH_OK) print_message("R = %g d: %s\n", dr[i].Rs, dr[i].msg);
         assert_int_equal(dr[i].rc, PFSPH_OK);
@@ -180,17 +163,10 @@ static void test_laplace(void **state)
         pfsph_sim_destroy(dr[i].sim);
     }
     /* least squares p = a + s x, x = 1 / R_e */
-    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, Rmax = 0;
-    for (int i = 0; i < nr; i++) {
-        const double x = 1.0 / dr[i].Re, y = dr[i].p;
-        sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y;
-        Rmax = fmax(Rmax, dr[i].Re);
-    }
-    const double det = nr * sxx - sx * sx;
-    const double slope = (nr * sxy - sx * sy) / det, icpt = (sy - slope * sx) / nr;
-    const double cov = sxy / nr - sx * sy / (nr * nr), vx = sxx / nr - sx * sx / (nr * nr),
-                 vy = syy / nr - sy * sy / (nr * nr);
-    const double r2 = vy > 0 ? cov * cov / (vx * vy) : 0;
+    double x[MAXR], y[MAXR], Rmax = 0;
+    for (int i = 0; i < nr; i++) x[i] = 1.0 / dr[i].Re, y[i] = dr[i].p, Rmax = fmax(Rmax, dr[i].Re);
+    const tu_line fit = tu_line_fit(nr, x, y);
+    const double slope = fit.slope, icpt = fit.icpt, r2 = fit.r2;
     print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n",
                   slope, slope / SIGMA, icpt, 0.25 * SIGMA / Rmax, r2);
 #ifndef __SANITIZE_ADDRESS__
