@@ -96,7 +96,6 @@ static double cpu_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 static double max_speed(const pfsph_particles *f, size_t *worst);
-static int at_rest(const pfsph_particles *f);
 static void build_stages(pfsph_sim *sim);
 
 /* Grid cells. Without pair forces cells of h, queries one cell each way. With them cells of
@@ -599,17 +598,8 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
      * alone (0 without gravity) PCISPH took dt_max and blew up at step 0 (issue 11). */
     if (sim->pw && sim->fluid.n) {
         if (pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->removed)) goto nomem;
-        if (at_rest(&sim->fluid) && at_rest(&sim->boundary)) {
-            /* nothing moves: the viscosity sums are +0 and the pass gives gravity alone, these
-             * bits (g + visc_c * 0); the density was only its input (a tenth of a 100k bench) */
-            const pfsph_real vc0 = (pfsph_real)(2 * (c->dim + 2)) * (pfsph_real)0;
-            const pfsph_real gx = (pfsph_real)c->gravity[0] + vc0, gy = (pfsph_real)c->gravity[1] + vc0,
-                             gz = (pfsph_real)c->gravity[2] + vc0;
-            for (size_t i = 0; i < sim->fluid.n; i++) c->ax[i] = gx, c->ay[i] = gy, c->az[i] = gz;
-        } else {
-            pfsph__number_density(c, sim->fluid.x, sim->fluid.y, sim->fluid.z, c->nd);
-            pfsph__nonpressure(c);
-        }
+        pfsph__number_density(c, sim->fluid.x, sim->fluid.y, sim->fluid.z, c->nd);
+        pfsph__nonpressure(c);
         pfsph_pairwise_apply(sim->pw, c);
         double a2 = 0;
         for (size_t i = 0; i < sim->fluid.n; i++)
@@ -647,14 +637,6 @@ void pfsph_sim_destroy(pfsph_sim *sim)
 }
 
 /* Largest speed; index of the fastest (or of a non-finite) particle in *worst. */
-/* All velocities exactly zero (either sign). */
-static int at_rest(const pfsph_particles *f)
-{
-    for (size_t i = 0; i < f->n; i++)
-        if (f->vx[i] != 0 || f->vy[i] != 0 || f->vz[i] != 0) return 0;
-    return 1;
-}
-
 static double max_speed(const pfsph_particles *f, size_t *worst)
 {
     double vmax = 0;
