@@ -28,6 +28,7 @@ typedef struct pfsph_grid {
     int want_near;      /* set by the owner: pfsph_grid_sort fills near */
     uint8_t *near;      /* ncells entries (or NULL): 0 iff no cell within reach of c holds a
                          * particle (pfsph_grid_near) */
+    uint8_t *near_far;  /* the same for reach_far (pfsph_grid_near_far), when reach_far > reach */
     size_t cap;
 } pfsph_grid;
 
@@ -84,12 +85,9 @@ static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_re
     pfsph_grid_ranges_reach(g, x, y, z, g->reach, r);
 }
 
-/* 0 only if pfsph_grid_ranges from (x, y, z) would return no range (no particle within reach):
- * a pass may then skip the walk, with the same result. 1 without g->near or outside the
- * grid. For a sparse set (the boundary) that most fluid particles are far from. */
-static inline int pfsph_grid_near(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z)
+static inline int pfsph__grid_flag(const pfsph_grid *g, const uint8_t *flags, pfsph_real x, pfsph_real y, pfsph_real z)
 {
-    if (!g->near) return 1;
+    if (!flags) return 1;
     const pfsph_real p[3] = {x, y, z};
     size_t idx = 0, mul = 1;
     for (int a = 0; a < (g->dim == 3 ? 3 : 2); a++) {
@@ -98,7 +96,21 @@ static inline int pfsph_grid_near(const pfsph_grid *g, pfsph_real x, pfsph_real 
         idx += (size_t)(int)t * mul;
         mul *= (size_t)g->nc[a];
     }
-    return g->near[idx];
+    return flags[idx];
+}
+
+/* 0 only if pfsph_grid_ranges from (x, y, z) would return no range (no particle within reach):
+ * a pass may then skip the walk, with the same result. 1 without g->near or outside the
+ * grid. For a sparse set (the boundary) that most fluid particles are far from. */
+static inline int pfsph_grid_near(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z)
+{
+    return pfsph__grid_flag(g, g->near, x, y, z);
+}
+
+/* The same for the far queries (pfsph_grid_ranges_far, pfsph_grid_ranges_radius). */
+static inline int pfsph_grid_near_far(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z)
+{
+    return pfsph__grid_flag(g, g->reach_far > g->reach ? g->near_far : g->near, x, y, z);
 }
 
 /* Ranges covering every particle within g->reach_far * g->cell (the pair forces' k h). */

@@ -39,6 +39,7 @@ void pfsph_grid_free(pfsph_grid *g)
 {
     if (!g) return;
     free(g->near);
+    free(g->near_far);
     free(g->start);
     free(g->key);
     free(g->perm);
@@ -46,22 +47,21 @@ void pfsph_grid_free(pfsph_grid *g)
     memset(g, 0, sizeof(*g));
 }
 
-/* g->near: the occupied cells dilated by g->reach along x, then y, then z (a box dilation is
- * separable), so near[c] = 0 exactly when pfsph_grid_ranges from a point in c returns no
- * range. Out of memory: near = NULL, and pfsph_grid_near answers 1 (walk). */
-static void mark_near(pfsph_grid *g)
+/* *dst: the occupied cells dilated by R cells along x, then y, then z (a box dilation is
+ * separable), so (*dst)[c] = 0 exactly when a walk of reach R from a point in c finds no
+ * particle. Out of memory: *dst = NULL, and the queries answer 1 (walk). */
+static void mark_near(pfsph_grid *g, int R, uint8_t **dst_)
 {
     const size_t nc = g->ncells;
-    uint8_t *a = g->near ? g->near : malloc(nc), *t = malloc(nc);
+    uint8_t *a = *dst_ ? *dst_ : malloc(nc), *t = malloc(nc);
     if (!a || !t) {
         free(a);
         free(t);
-        g->near = NULL;
+        *dst_ = NULL;
         return;
     }
-    g->near = a;
+    *dst_ = a;
     for (size_t c = 0; c < nc; c++) a[c] = g->start[c + 1] > g->start[c];
-    const int R = g->reach;
     const size_t n0 = (size_t)g->nc[0], n1 = (size_t)g->nc[1], n2 = (size_t)g->nc[2];
     const size_t stride[3] = {1, n0, n0 * n1}, len[3] = {n0, n1, n2};
     for (int ax = 0; ax < (g->dim == 3 ? 3 : 2); ax++) {
@@ -143,7 +143,10 @@ int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
     g->start[0] = 0;
 
     if (removed) *removed += n - kept;
-    if (g->want_near) mark_near(g);
+    if (g->want_near) {
+        mark_near(g, g->reach, &g->near);
+        if (g->reach_far > g->reach) mark_near(g, g->reach_far, &g->near_far);
+    }
     return pfsph_particles_permute(ps, g->perm, kept, g->tmp);
 }
 

@@ -253,6 +253,7 @@ static void test_near(void **state)
             pfsph_grid g;
             assert_int_equal(pfsph_grid_init(&g, dim, LO, HI, H / (pfsph_real)reach), PFSPH_OK);
             g.reach = reach;
+            g.reach_far = reach + 1; /* the pair forces' far walks: their own flags */
             g.want_near = 1;
             pfsph_particles ps;
             assert_int_equal(pfsph_particles_init(&ps, 16), PFSPH_OK);
@@ -269,7 +270,8 @@ static void test_near(void **state)
             }
             assert_int_equal(pfsph_grid_sort(&g, &ps, NULL), PFSPH_OK);
             assert_non_null(g.near);
-            int zero = 0, one = 0;
+            assert_non_null(g.near_far);
+            int zero = 0, one = 0, zero_far = 0;
             for (int t = 0; t < 20000; t++) {
                 pfsph_real q[3];
                 for (int a = 0; a < 3; a++) q[a] = LO[a] + (pfsph_real)((1.2 * lcg_uniform() - 0.1)) * (HI[a] - LO[a]);
@@ -283,9 +285,20 @@ static void test_near(void **state)
                     assert_int_equal(nr, r.n > 0);
                 zero += !nr;
                 one += nr;
+                /* the far flags against the far walk (its radius-trimmed form walks a subset) */
+                pfsph_grid_ranges_far(&g, q[0], q[1], q[2], &r);
+                const int nf = pfsph_grid_near_far(&g, q[0], q[1], q[2]);
+                if (!nf) assert_int_equal(r.n, 0);
+                if (inside(dim, q) && q[0] < LO[0] + (pfsph_real)g.nc[0] * g.cell &&
+                    q[1] < LO[1] + (pfsph_real)g.nc[1] * g.cell && (dim == 2 || q[2] < LO[2] + (pfsph_real)g.nc[2] * g.cell))
+                    assert_int_equal(nf, r.n > 0);
+                if (nr) assert_true(nf); /* a wider reach finds at least as much */
+                zero_far += !nf;
             }
-            print_message("dim %d reach %d: %d empty, %d near of 20000 points\n", dim, reach, zero, one);
+            print_message("dim %d reach %d: %d empty, %d near of 20000 points; %d empty at reach %d\n", dim, reach,
+                          zero, one, zero_far, g.reach_far);
             assert_true(zero > 1000 && one > 1000);
+            assert_true(zero_far > 100 && zero_far < zero);
             pfsph_particles_free(&ps);
             pfsph_grid_free(&g);
         }

@@ -23,8 +23,8 @@
  * thread, each simulation on one thread (independent, so the bits do not depend on the order): 131 s of CPU in all
  * (label validation). Under AddressSanitizer the drops run 0.3 s and only the code paths are
  * checked.
- * Knobs for studies: PF_SOLVER, PF_THETA, PF_SEED (7), PF_T (end [s]), PF_RADII ("8,10,13,16,20"
- * in spacings). */
+ * Knobs for studies: PF_SOLVER, PF_TOL (the solver's density tolerance), PF_DTMAX (0.002 s),
+ * PF_THETA, PF_SEED (7), PF_T (end [s]), PF_RADII ("8,10,13,16,20" in spacings). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -52,20 +52,22 @@ typedef struct {
 static void create_drop(drop *dr)
 {
     const double d = 0.01;
-    char json[2048], thermo[96] = "";
+    char json[2048], thermo[96] = "", tol[64] = "";
+    if (getenv("PF_TOL")) snprintf(tol, sizeof tol, ", \"tolerance\": %s", getenv("PF_TOL"));
     if (getenv("PF_THETA"))
         snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},",
                  getenv("PF_THETA"));
     snprintf(json, sizeof json,
              "{\"dimension\": 2, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0],"
              " \"domain\": {\"min\": [-1, -1], \"max\": [1, 1]},"
-             " \"solver\": {\"type\": \"%s\"}, \"time\": {\"dt_max\": 0.002},"
+             " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": %s},"
              " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.001}],"
              " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0], \"radius\": %g}],"
              " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
              " \"sigma\": %g}]}}",
              getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d,
-             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", dr->Rs * d, thermo, SIGMA);
+             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", tol,
+             getenv("PF_DTMAX") ? getenv("PF_DTMAX") : "0.002", dr->Rs * d, thermo, SIGMA);
     dr->sim = tu_sim_from_json(json, "laplace.json");
     dr->Re = sqrt((double)pfsph_sim_ctx(dr->sim)->fluid->n * d * d / PI);
 }
