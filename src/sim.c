@@ -99,9 +99,9 @@ static double max_speed(const pfsph_particles *f, size_t *worst);
 static void build_stages(pfsph_sim *sim);
 
 /* Grid cells. Without pair forces cells of h, queries one cell each way. With them cells of
- * max(h / 2, k h / 3): the h-radius stages walk 2 cells each way (a cube of side 2.5 h instead
- * of 3 h) and the pair forces 3 (2.52 k h instead of 3 k h). Cells of k h, as before, made the
- * h stages walk (3 k h)^3: 2.6x the candidates (docs/benchmarks.md, pairwise). */
+ * max(h, k h / 3): for k <= 3 the h-radius stages walk what plain SPH walks and the pair forces
+ * ceil(k) cells each way. Cells of k h made the h stages walk (3 k h)^3 (2.6x the candidates);
+ * cells of h / 2 made them walk 25 short rows instead of 9 (docs/benchmarks.md, pairwise). */
 static pfsph_real grid_cell(const pfsph_scene *s, pfsph_real h, int *reach, int *reach_far)
 {
     if (!s->pairwise.enabled) {
