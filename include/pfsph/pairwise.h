@@ -40,6 +40,13 @@ void pfsph_pairwise_destroy(pfsph_pairwise *pw); /* NULL is a no-op */
  * cells the k h ball touches; with shifting configured it walks the whole reach). Deterministic
  * for any thread count and CPU. This is also the function the benchmark times. */
 void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx);
+/* As pfsph_pairwise_apply, but the accelerations are WRITTEN to acc[0..2] (not added to ctx->ax),
+ * and the same walk sums the number density delta_i of Eq. 23 into nd (fluid and wall terms as
+ * pfsph__number_density, in this walk's order: equal to rounding): the density and pair stages
+ * in one walk of the k h neighbourhood (sim.c). With pair forces disabled the accelerations are
+ * 0 and nd is still computed. */
+void pfsph_pairwise_apply_density(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd,
+                                  pfsph_real *const acc[3]);
 /* The largest pair-force acceleration |F_i^int / m_i| of the last apply [m/s^2] (0 for NULL). */
 double pfsph_pairwise_amax(const pfsph_pairwise *pw);
 

@@ -185,7 +185,7 @@ typedef struct pw_scratch {
 /* Adds the pairs in W->H (targets in ps) to P's four-lane sums (pair_terms.h): sc = c m_j f(r) / r
  * (Eq. 3 divided by m_i, times x_ij) and, if J->filter, the kernel w of Eq. 7 (NOTES item 2). */
 static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scratch *W, int pa, double ai, int bi,
-                            bool want_vir, pfsph_pair_sums *P)
+                            bool want_vir, pfsph_pair_sums *P, pfsph_real *ds)
 {
     pfsph_hits *H = &W->H;
     const double *coef = J->coef[pa];
@@ -193,6 +193,15 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
     /* the per-pair cosine and kernel in vector code (pair_terms.c), over whole vectors */
     const int n16 = pfsph_hits_pad16(H);
     if (J->filter) pfsph__terms_w(&J->kk, n16, H->r2, H->t0);
+    if (ds) { /* Eq. 23's sum (density.c) from the hits within h: W_h is 0 beyond h, and adds nothing */
+        pfsph__terms_w(&J->ctx->kern, n16, H->r2, H->t1);
+        pfsph_real s = *ds;
+        if (ps == J->ctx->fluid)
+            for (int e = 0; e < n; e++) s += H->t1[e];
+        else
+            for (int e = 0; e < n; e++) s += ps->aux[H->j[e]] * H->t1[e];
+        *ds = s;
+    }
     if (!J->two_phase) {
         /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0); r = 0: no
          * direction, no force, and not in Eq. 7's sum. The cosine in float (pfsph__cos_pair,
@@ -231,19 +240,19 @@ static inline double lanes(const double l[4]) { return (l[0] + l[1]) + (l[2] + l
  * k h of a grid walk, filtered in SIMD (core/hits.h), in the walk's order. */
 static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g, size_t self,
                            pfsph_real xi, pfsph_real yi, pfsph_real zi, int pa, double ai, int bi, bool want_vir,
-                           pfsph_pair_sums *P, pw_scratch *W)
+                           pfsph_pair_sums *P, pw_scratch *W, pfsph_real *ds)
 {
     pfsph_ranges rg;
     if (J->trim) pfsph_grid_ranges_radius(g, xi, yi, zi, J->R, &rg);
     else pfsph_grid_ranges_far(g, xi, yi, zi, &rg);
     PFSPH_HITS_WALK(J->hits, &W->H, rg, ps->x, ps->y, ps->z, xi, yi, zi, J->R2, (uint32_t)self,
-                    sum_hits(J, ps, W, pa, ai, bi, want_vir, P));
+                    sum_hits(J, ps, W, pa, ai, bi, want_vir, P, ds));
 }
 
-/* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial and
- * T_i itself. */
+/* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial,
+ * T_i itself and (nd not NULL) the number density delta_i of Eq. 23 into nd[i]. */
 static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir,
-                            double *vir, double Tout[9], double Wout[9], pw_scratch *W)
+                            double *vir, double Tout[9], double Wout[9], pw_scratch *W, pfsph_real *nd)
 {
     const pfsph_ctx *ctx = J->ctx;
     const pfsph_particles *f = ctx->fluid;
@@ -253,10 +262,15 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
     memset(&P, 0, sizeof P);
     const double ai = J->two_phase ? (double)f->film[i] : 0.0;
     const int bi = J->two_phase ? f->bubble[i] : 0;
-    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, want_vir, &P, W);
-    /* most of a liquid has no wall within k h: its empty walk (rows, flush) cost ~5 % of the pass */
+    /* the density as density.c sums it, self term first, walls apart and scaled by 1 / V0 */
+    pfsph_real s = nd ? pfsph_kernel_w0(&ctx->kern) : 0, sb = 0;
+    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, want_vir, &P, W, nd ? &s : NULL);
+    /* most of a liquid has no wall within k h: its empty walk (rows, flush) cost ~5 % of the pass;
+     * the flags cover k h >= h, so the density's wall term is 0 where they skip */
     if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0 && pfsph_grid_near_far(ctx->bgrid, xi, yi, zi))
-        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)UINT32_MAX, xi, yi, zi, pa, ai, bi, want_vir, &P, W);
+        sum_set(J, ctx->boundary, ctx->bgrid, (size_t)UINT32_MAX, xi, yi, zi, pa, ai, bi, want_vir, &P, W,
+                nd ? &sb : NULL);
+    if (nd) nd[i] = s + sb * ((pfsph_real)1 / ctx->V0);
     /* the lanes' totals; the filter's d = x_j - x_i = -x_ij */
     double S[6], sx[3], sxx[6];
     for (int a = 0; a < 3; a++) {
@@ -308,14 +322,17 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
             for (int b = 0; b < 3; b++) Tout[3 * a + b] = T[a][b];
 }
 
-void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
+/* The pair accelerations added to (add) or written to out[0..2], and nd if not NULL. */
+static void apply(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd, pfsph_real *const out[3], bool add)
 {
     pw->amax = 0;
-    if (!ctx->pairwise->enabled) return;
     pw_job J;
     job_init(&J, ctx, true);
+    if (!ctx->pairwise->enabled) /* the density alone: forces of zero, walked as the pairs are */
+        for (int a = 0; a < PFSPH_MAX_PHASES; a++)
+            for (int b = 0; b < PFSPH_MAX_PHASES; b++) J.coef[a][b] = 0;
     const size_t n = ctx->fluid->n;
-    pfsph_real *ax = ctx->ax, *ay = ctx->ay, *az = ctx->az;
+    pfsph_real *ax = out[0], *ay = out[1], *az = out[2];
     double a2max = 0; /* a max is the same for any thread count and order */
 #pragma omp parallel
     {
@@ -323,15 +340,34 @@ void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 #pragma omp for schedule(dynamic, 256) reduction(max : a2max)
         for (size_t i = 0; i < n; i++) {
             double acc[3];
-            particle(&J, i, acc, false, NULL, NULL, NULL, &W);
-            ax[i] += (pfsph_real)acc[0];
-            ay[i] += (pfsph_real)acc[1];
-            az[i] += (pfsph_real)acc[2];
+            particle(&J, i, acc, false, NULL, NULL, NULL, &W, nd);
+            if (add) {
+                ax[i] += (pfsph_real)acc[0];
+                ay[i] += (pfsph_real)acc[1];
+                az[i] += (pfsph_real)acc[2];
+            } else {
+                ax[i] = (pfsph_real)acc[0];
+                ay[i] = (pfsph_real)acc[1];
+                az[i] = (pfsph_real)acc[2];
+            }
             const double a2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
             if (a2 > a2max) a2max = a2;
         }
     }
     pw->amax = sqrt(a2max);
+}
+
+void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx)
+{
+    pw->amax = 0;
+    if (!ctx->pairwise->enabled) return;
+    pfsph_real *const a[3] = {ctx->ax, ctx->ay, ctx->az};
+    apply(pw, ctx, NULL, a, true);
+}
+
+void pfsph_pairwise_apply_density(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd, pfsph_real *const acc[3])
+{
+    apply(pw, ctx, nd, acc, false);
 }
 
 double pfsph_pairwise_amax(const pfsph_pairwise *pw) { return pw ? pw->amax : 0; }
@@ -358,7 +394,7 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
 #pragma omp for schedule(dynamic, 256)
         for (size_t i = 0; i < n; i++) {
             double acc[3], v = 0;
-            particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws);
+            particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws, NULL);
             if (vir) vir[i] = v;
         }
     }
