@@ -748,11 +748,33 @@ static int st_film(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* rho from the number density; a blow-up check */
+static int density_check(pfsph_sim *sim, blowup_info *bad)
+{
+    pfsph_ctx *c = &sim->ctx;
+    pfsph_particles *f = &sim->fluid;
+    const size_t n = f->n;
+    pfsph_real ndmax = 0;
+#pragma omp parallel for schedule(static) reduction(max : ndmax)
+    for (size_t i = 0; i < n; i++) {
+        f->rho[i] = c->mass[f->phase[i]] * c->nd[i];
+        if (c->nd[i] > ndmax) ndmax = c->nd[i];
+    }
+    /* A particle compressed by half again its rest density means the pressure solve has lost
+     * control (PCISPH aims at 0.5%, WCSPH at Mach 0.1 stays near 1%): stop before the pressure
+     * solve turns it into NaN. */
+    if ((double)ndmax / (double)c->nd0 - 1 > PFSPH_DENSITY_ERROR_LIMIT) {
+        size_t wi = 0;
+        for (size_t i = 1; i < n; i++)
+            if (c->nd[i] > c->nd[wi]) wi = i;
+        return unstable(bad, wi, "relative density error", (double)ndmax / (double)c->nd0 - 1);
+    }
+    return PFSPH_OK;
+}
+
 /* Number density; with neighbour lists (solvers that walk the neighbours many times a step)
  * the density's walk also counts them and the lists are filled: positions stay put until the
  * integration. */
-static int density_check(pfsph_sim *sim, blowup_info *bad);
-
 static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     pfsph_ctx *c = &sim->ctx;
@@ -776,7 +798,7 @@ static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
  * density pass was ~7 % of a pair-force step). The pair accelerations wait in the pressure
  * accelerations' arrays, which nothing reads or writes before the pressure stage (st_forces
  * computes no pressure with pair forces, and these solvers have no pre_forces) and which
- * st_pairwise empties into ctx->ax. */
+ * st_pairwise_add empties into ctx->ax. */
 static int st_density_pairs(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
 {
     (void)err;
@@ -785,30 +807,6 @@ static int st_density_pairs(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     pfsph_real *const pa[3] = {sim->scr[SCR_APX], sim->scr[SCR_APY], sim->scr[SCR_APZ]};
     pfsph_pairwise_apply_density(sim->pw, c, c->nd, pa);
     return density_check(sim, bad);
-}
-
-/* rho from the number density; a blow-up check */
-static int density_check(pfsph_sim *sim, blowup_info *bad)
-{
-    pfsph_ctx *c = &sim->ctx;
-    pfsph_particles *f = &sim->fluid;
-    const size_t n = f->n;
-    pfsph_real ndmax = 0;
-#pragma omp parallel for schedule(static) reduction(max : ndmax)
-    for (size_t i = 0; i < n; i++) {
-        f->rho[i] = c->mass[f->phase[i]] * c->nd[i];
-        if (c->nd[i] > ndmax) ndmax = c->nd[i];
-    }
-    /* A particle compressed by half again its rest density means the pressure solve has lost
-     * control (PCISPH aims at 0.5%, WCSPH at Mach 0.1 stays near 1%): stop before the pressure
-     * solve turns it into NaN. */
-    if ((double)ndmax / (double)c->nd0 - 1 > PFSPH_DENSITY_ERROR_LIMIT) {
-        size_t wi = 0;
-        for (size_t i = 1; i < n; i++)
-            if (c->nd[i] > c->nd[wi]) wi = i;
-        return unstable(bad, wi, "relative density error", (double)ndmax / (double)c->nd0 - 1);
-    }
-    return PFSPH_OK;
 }
 
 static int st_timestep(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
