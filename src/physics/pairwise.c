@@ -144,6 +144,7 @@ typedef struct pw_job {
     pfsph_real R, R2;
     double U_R;      /* 3 pi / (2 R) */
     pfsph_kernel kk; /* cubic spline with support k h, for Eq. 7 (NOTES item 2) */
+    pfsph_real inv_v0; /* 1 / V0: the walls' density term, as density.c scales it */
     bool filter;
     double eta, eps_min;
     int center;
@@ -167,6 +168,7 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx, bool sorted)
     J->R2 = (pfsph_real)(R * R);
     J->U_R = 1.5 * PI / R;
     pfsph_kernel_init(&J->kk, ctx->dim, (pfsph_real)R);
+    J->inv_v0 = (pfsph_real)1 / ctx->V0;
     J->filter = pp->filter && pp->eta > 0;
     J->eta = pp->eta;
     J->eps_min = pp->eps_min;
@@ -270,7 +272,7 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
     if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0 && pfsph_grid_near_far(ctx->bgrid, xi, yi, zi))
         sum_set(J, ctx->boundary, ctx->bgrid, (size_t)UINT32_MAX, xi, yi, zi, pa, ai, bi, want_vir, &P, W,
                 nd ? &sb : NULL);
-    if (nd) nd[i] = s + sb * ((pfsph_real)1 / ctx->V0);
+    if (nd) nd[i] = s + sb * J->inv_v0;
     /* the lanes' totals; the filter's d = x_j - x_i = -x_ij */
     double S[6], sx[3], sxx[6];
     for (int a = 0; a < 3; a++) {

@@ -680,7 +680,6 @@ static void test_film_momentum_threads(void **state)
         }
 }
 
-
 /* The density and pair stages in one walk (pfsph_pairwise_apply_density, used by sim.c for
  * WCSPH and PCISPH): the accelerations are the bits pfsph_pairwise_apply adds, and the number
  * density is the density pass's (pfsph__number_density) up to the order of its float sum: a
@@ -723,19 +722,16 @@ static void test_density_fused(void **state)
             double rel = 0, relb = 0;
             for (size_t i = 0; i < n; i++) {
                 rel = fmax(rel, fabs((double)nd1[i] - nd_ref[i]) / nd_ref[i]);
-                double s = 0, sb = 0; /* Eq. 23 in double over all pairs */
-                for (size_t j = 0; j < n; j++) {
-                    const double r = sqrt(pow((double)w.fluid.x[i] - w.fluid.x[j], 2) + pow((double)w.fluid.y[i] - w.fluid.y[j], 2) +
-                                          pow((double)w.fluid.z[i] - w.fluid.z[j], 2));
-                    s += pfsph_kernel_w(&w.ctx.kern, (pfsph_real)r);
-                }
-                for (size_t j = 0; j < w.boundary.n; j++) {
-                    const double r = sqrt(pow((double)w.fluid.x[i] - w.boundary.x[j], 2) +
-                                          pow((double)w.fluid.y[i] - w.boundary.y[j], 2) +
-                                          pow((double)w.fluid.z[i] - w.boundary.z[j], 2));
-                    sb += (double)w.boundary.aux[j] * pfsph_kernel_w(&w.ctx.kern, (pfsph_real)r);
-                }
-                s += sb / (double)w.ctx.V0;
+                double s = 0; /* Eq. 23 in double over all pairs: fluid, then walls (volume / V0) */
+                const pfsph_particles *sets[2] = {&w.fluid, &w.boundary};
+                for (int k = 0; k < 2; k++)
+                    for (size_t j = 0; j < sets[k]->n; j++) {
+                        const double r = sqrt(pow((double)w.fluid.x[i] - sets[k]->x[j], 2) +
+                                              pow((double)w.fluid.y[i] - sets[k]->y[j], 2) +
+                                              pow((double)w.fluid.z[i] - sets[k]->z[j], 2));
+                        const double vol = k == 0 ? 1.0 : (double)sets[k]->aux[j] / (double)w.ctx.V0;
+                        s += vol * pfsph_kernel_w(&w.ctx.kern, (pfsph_real)r);
+                    }
                 relb = fmax(relb, fabs((double)nd1[i] - s) / s);
             }
             print_message("dim %d, pair forces %s: nd in the pair walk vs the density pass %.2g, vs O(N^2) in double %.2g "
