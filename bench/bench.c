@@ -33,8 +33,7 @@ static void usage(void)
 
 /* Mean number of neighbours j != i within h of each fluid particle: fluid ones through the
  * fluid grid, boundary ones through the boundary grid. Uses the grid of the last step. */
-static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_nb,
-                             double *fluid_cand)
+static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_nb, double *fluid_cand)
 {
     const pfsph_particles *f = c->fluid, *b = c->boundary;
     const double h2 = (double)c->h * (double)c->h;
@@ -55,8 +54,7 @@ static void count_neighbours(const pfsph_ctx *c, double *fluid_nb, double *bnd_n
             pfsph_grid_ranges(c->bgrid, f->x[i], f->y[i], f->z[i], &r);
             for (int k = 0; k < r.n; k++)
                 for (uint32_t j = r.b[k]; j < r.e[k]; j++) {
-                    double dx = f->x[i] - b->x[j], dy = f->y[i] - b->y[j],
-                           dz = f->z[i] - b->z[j];
+                    double dx = f->x[i] - b->x[j], dy = f->y[i] - b->y[j], dz = f->z[i] - b->z[j];
                     if (dx * dx + dy * dy + dz * dz < h2) nb++;
                 }
         }
@@ -103,9 +101,9 @@ static int seed_diffuse(pfsph_sim *sim, long n, double top, pfsph_error *err)
                u2 = hash_unit(4 * (uint64_t)i + 2);
         double x = f->x[j] + d * (2 * u0 - 1), y = f->y[j], z = f->z[j] + d * (2 * u2 - 1);
         switch (i % 5) {
-        case 3: y = top + 0.5 * d * u1; break;    /* foam layer */
+        case 3: y = top + 0.5 * d * u1; break;     /* foam layer */
         case 4: y = top + 2 * d + 0.3 * u1; break; /* spray */
-        default: y += d * (2 * u1 - 1); break;    /* bubbles */
+        default: y += d * (2 * u1 - 1); break;     /* bubbles */
         }
         const pfsph_real p[3] = {(pfsph_real)x, (pfsph_real)y, (pfsph_real)z};
         long s = pfsph_particles_push(&dp, p, NULL, 0);
@@ -129,24 +127,41 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--particles") && v) { target = atol(v); i++; }
-        else if (!strcmp(a, "--steps") && v) { steps = atol(v); i++; }
-        else if (!strcmp(a, "--warmup") && v) { warmup = atol(v); i++; }
-        else if (!strcmp(a, "--threads") && v) { threads = atoi(v); i++; }
-        else if (!strcmp(a, "--solver") && v) {
+        if (!strcmp(a, "--particles") && v) {
+            target = atol(v);
+            i++;
+        } else if (!strcmp(a, "--steps") && v) {
+            steps = atol(v);
+            i++;
+        } else if (!strcmp(a, "--warmup") && v) {
+            warmup = atol(v);
+            i++;
+        } else if (!strcmp(a, "--threads") && v) {
+            threads = atoi(v);
+            i++;
+        } else if (!strcmp(a, "--solver") && v) {
             if (!strcmp(v, "wcsph")) pcisph = 0;
             else if (!strcmp(v, "pcisph")) pcisph = 1;
-            else { usage(); return 2; }
+            else {
+                usage();
+                return 2;
+            }
             i++;
         } else if (!strcmp(a, "--pairwise")) pairwise = 1;
         else if (!strcmp(a, "--no-thermostat")) no_thermo = 1;
-        else if (!strcmp(a, "--diffuse") && v) { ndiffuse = atol(v); i++; }
-        else if (!strcmp(a, "--diffuse-emit-all")) emit_all = 1;
-        else if (!strcmp(a, "--wall-viscosity") && v) { wall_nu = atof(v); i++; }
-        else { usage(); return !strcmp(a, "--help") || !strcmp(a, "-h") ? 0 : 2; }
+        else if (!strcmp(a, "--diffuse") && v) {
+            ndiffuse = atol(v);
+            i++;
+        } else if (!strcmp(a, "--diffuse-emit-all")) emit_all = 1;
+        else if (!strcmp(a, "--wall-viscosity") && v) {
+            wall_nu = atof(v);
+            i++;
+        } else {
+            usage();
+            return !strcmp(a, "--help") || !strcmp(a, "-h") ? 0 : 2;
+        }
     }
-    if (target < 100 || steps < 1 || warmup < 0 || threads < 0 || (emit_all && ndiffuse < 0) ||
-        ndiffuse > 100000000) {
+    if (target < 100 || steps < 1 || warmup < 0 || threads < 0 || (emit_all && ndiffuse < 0) || ndiffuse > 100000000) {
         usage();
         return 2;
     }
@@ -163,8 +178,7 @@ int main(int argc, char **argv)
     if (nz < 1) nz = 1;
     if (ny < 1) ny = 1;
     const double d = 0.6 / (double)ny, r = 0.5 * d;
-    const double bx = ((double)nx + 0.25) * d, by = ((double)ny + 0.25) * d,
-                 bz = ((double)nz + 0.25) * d;
+    const double bx = ((double)nx + 0.25) * d, by = ((double)ny + 0.25) * d, bz = ((double)nz + 0.25) * d;
     const double tx = 1.5 / 0.45 * bx, ty = 1.5 * by, tz = bz; /* tank inner size */
     const double m = 3.0 * d + 0.05;                           /* room for walls */
 
@@ -172,7 +186,8 @@ int main(int argc, char **argv)
     if (pairwise)
         snprintf(pair, sizeof pair,
                  ",\n\"pairwise\": {%s\"coefficients\": [{\"phases\": [\"water\", \"water\"], "
-                 "\"c\": 1000}]}", no_thermo ? "\"thermostat\": false, " : "");
+                 "\"c\": 1000}]}",
+                 no_thermo ? "\"thermostat\": false, " : "");
     /* Diffuse block: the limits of scenes/diffuse_dam_*.json; the cap leaves room above the
      * seeded count so that generation runs (it is skipped at the cap). */
     char dif[1024] = "";
@@ -202,8 +217,8 @@ int main(int argc, char **argv)
              "\"phase\": \"wall\"%s}],\n"
              "\"output\": {\"directory\": \"bench_run\", \"formats\": [], \"boundary\": false}"
              "%s%s}\n",
-             r, threads, -m, -m, -m, tx + m, ty + m, tz + m, pcisph ? "pcisph" : "wcsph", bx,
-             by, bz, tx, ty, tz, wallkey, pair, dif);
+             r, threads, -m, -m, -m, tx + m, ty + m, tz + m, pcisph ? "pcisph" : "wcsph", bx, by, bz, tx, ty, tz,
+             wallkey, pair, dif);
 
     static pfsph_scene scene;
     pfsph_error err = {0};
@@ -229,12 +244,11 @@ int main(int argc, char **argv)
     const pfsph_ctx *ctx = pfsph_sim_ctx(sim);
     const size_t n_fluid0 = ctx->fluid->n, n_bnd = ctx->boundary ? ctx->boundary->n : 0;
 
-    printf("pfsph bench: 3D dam break, solver %s%s, %d threads (OMP_WAIT_POLICY=%s)\n",
-           pcisph ? "pcisph" : "wcsph", pairwise ? " + pairwise" : "",
-           threads > 0 ? threads : omp_get_max_threads(),
+    printf("pfsph bench: 3D dam break, solver %s%s, %d threads (OMP_WAIT_POLICY=%s)\n", pcisph ? "pcisph" : "wcsph",
+           pairwise ? " + pairwise" : "", threads > 0 ? threads : omp_get_max_threads(),
            getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
-    printf("  block %ld x %ld x %ld, particle radius %.4g m, h %.4g m, tank %.3f x %.3f x %.3f m\n",
-           nx, ny, nz, r, (double)ctx->h, tx, ty, tz);
+    printf("  block %ld x %ld x %ld, particle radius %.4g m, h %.4g m, tank %.3f x %.3f x %.3f m\n", nx, ny, nz, r,
+           (double)ctx->h, tx, ty, tz);
     printf("  fluid particles     %zu\n  boundary particles  %zu\n", n_fluid0, n_bnd);
     printf("  create              %.3f s (estimate %.1f MB)\n", t_create, (double)est_bytes / 1e6);
 
@@ -258,13 +272,13 @@ int main(int argc, char **argv)
     }
     const double wall = omp_get_wtime() - t0;
     if (rc != PFSPH_OK)
-        printf("  FAILED at step %llu (t = %.4g s): %s\n",
-               (unsigned long long)pfsph_sim_steps(sim), pfsph_sim_time(sim), err.msg);
+        printf("  FAILED at step %llu (t = %.4g s): %s\n", (unsigned long long)pfsph_sim_steps(sim),
+               pfsph_sim_time(sim), err.msg);
 
     const pfsph_step_stats *st = pfsph_sim_stats(sim);
     const double rate = wall > 0 ? fluid_steps / wall : 0;
-    printf("  steps               %ld measured after %ld warm-up, %.4f s simulated, last dt %.3g s\n",
-           done, warmup, pfsph_sim_time(sim) - sim_t0, st->dt);
+    printf("  steps               %ld measured after %ld warm-up, %.4f s simulated, last dt %.3g s\n", done, warmup,
+           pfsph_sim_time(sim) - sim_t0, st->dt);
     printf("  last step           vmax %.3g m/s, density error avg %.3g%% max %.3g%%\n", st->vmax,
            100 * st->density_err_avg, 100 * st->density_err_max);
     printf("  wall time           %.3f s (%.2f ms/step)\n", wall, done ? 1e3 * wall / (double)done : 0);
@@ -273,8 +287,8 @@ int main(int argc, char **argv)
     double nbf = 0, nbb = 0, ncand = 0;
     count_neighbours(ctx, &nbf, &nbb, &ncand);
     printf("  neighbours within h %.1f fluid + %.1f boundary per fluid particle\n", nbf, nbb);
-    printf("  grid candidates     %.1f fluid particles tested per fluid particle (cell %.4g m)\n",
-           ncand, (double)ctx->grid->cell);
+    printf("  grid candidates     %.1f fluid particles tested per fluid particle (cell %.4g m)\n", ncand,
+           (double)ctx->grid->cell);
     const double avg_it = done ? (double)iters / (double)done : 0;
     if (pcisph) printf("  PCISPH iterations   %.2f per step (average)\n", avg_it);
 
@@ -286,8 +300,8 @@ int main(int argc, char **argv)
     printf("  stage        seconds      %%    CPU [s]\n");
     for (int i = 0; i < PFSPH_NSTAGES; i++) {
         double sec = st1[i] - st0[i];
-        printf("  %-10s %9.4f  %5.1f  %9.4f\n", pfsph_stage_names[i], sec,
-               tot > 0 ? 100 * sec / tot : 0, sc1[i] - sc0[i]);
+        printf("  %-10s %9.4f  %5.1f  %9.4f\n", pfsph_stage_names[i], sec, tot > 0 ? 100 * sec / tot : 0,
+               sc1[i] - sc0[i]);
     }
     printf("  %-10s %9.4f  (wall %.4f)  %9.4f\n", "sum", tot, wall, cpu_tot);
     const double dif_s = st1[PFSPH_STAGE_DIFFUSE] - st0[PFSPH_STAGE_DIFFUSE];
@@ -299,10 +313,10 @@ int main(int argc, char **argv)
         pfsph_sim_diffuse_totals(sim, &created, &refused);
         printf("  diffuse particles   %zu at the end (spray %zu, foam %zu, bubble %zu); %llu "
                "created in all (seeded included), %llu refused\n",
-               dc[0] + dc[1] + dc[2], dc[0], dc[1], dc[2], (unsigned long long)created,
-               (unsigned long long)refused);
+               dc[0] + dc[1] + dc[2], dc[0], dc[1], dc[2], (unsigned long long)created, (unsigned long long)refused);
         printf("  diffuse stage       %.4f s = %.1f%% of the fluid step (%.4f s: all other stages)"
-               "\n", dif_s, fluid_s > 0 ? 100 * dif_s / fluid_s : 0, fluid_s);
+               "\n",
+               dif_s, fluid_s > 0 ? 100 * dif_s / fluid_s : 0, fluid_s);
     }
 
     struct rusage ru;
@@ -310,15 +324,16 @@ int main(int argc, char **argv)
     const double rss = (double)ru.ru_maxrss * 1024.0; /* Linux: kilobytes */
     const double bpp = n_fluid0 ? rss / (double)n_fluid0 : 0;
     printf("  peak RSS            %.1f MB = %.0f bytes per fluid particle (boundary and process "
-           "included)\n", rss / 1e6, bpp);
+           "included)\n",
+           rss / 1e6, bpp);
 
     /* One line for grep. */
     printf("BENCH solver=%s pairwise=%d threads=%d fluid=%zu boundary=%zu steps=%ld wall_s=%.3f "
            "psteps_per_s=%.4g iters=%.2f nb_fluid=%.1f nb_bnd=%.1f cand=%.1f bytes_per_particle=%.0f "
            "diffuse=%zu diffuse_s=%.4f fluid_s=%.4f diffuse_pct=%.1f cpu_s=%.4f status=%s\n",
-           pcisph ? "pcisph" : "wcsph", pairwise, threads > 0 ? threads : omp_get_max_threads(),
-           n_fluid0, n_bnd, done, wall, rate, avg_it, nbf, nbb, ncand, bpp, dc[0] + dc[1] + dc[2],
-           dif_s, fluid_s, fluid_s > 0 ? 100 * dif_s / fluid_s : 0, cpu_tot, rc == PFSPH_OK ? "ok" : "failed");
+           pcisph ? "pcisph" : "wcsph", pairwise, threads > 0 ? threads : omp_get_max_threads(), n_fluid0, n_bnd, done,
+           wall, rate, avg_it, nbf, nbb, ncand, bpp, dc[0] + dc[1] + dc[2], dif_s, fluid_s,
+           fluid_s > 0 ? 100 * dif_s / fluid_s : 0, cpu_tot, rc == PFSPH_OK ? "ok" : "failed");
     pfsph_sim_destroy(sim);
     return rc == PFSPH_OK ? 0 : 3;
 }

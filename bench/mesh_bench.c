@@ -25,8 +25,8 @@ int main(int argc, char **argv)
     int reps = 5, threads = 0;
     double jitter = 0.1;
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--size") && i + 1 < argc &&
-            sscanf(argv[++i], "%ldx%ldx%ld", &nx, &ny, &nz) == 3 && nx > 0 && ny > 0 && nz > 0)
+        if (!strcmp(argv[i], "--size") && i + 1 < argc && sscanf(argv[++i], "%ldx%ldx%ld", &nx, &ny, &nz) == 3 &&
+            nx > 0 && ny > 0 && nz > 0)
             continue;
         if (!strcmp(argv[i], "--reps") && i + 1 < argc && (reps = atoi(argv[++i])) > 0) continue;
         if (!strcmp(argv[i], "--threads") && i + 1 < argc && (threads = atoi(argv[++i])) > 0) continue;
@@ -34,8 +34,9 @@ int main(int argc, char **argv)
             jitter = atof(argv[++i]);
             continue;
         }
-        fprintf(stderr, "usage: mesh_bench [--size NXxNYxNZ] [--reps N] [--threads N] [--jitter F]\n"
-                        "Meshes a block of NX x NY x NZ particles (default 60x80x60) --reps times.\n");
+        fprintf(stderr,
+                "usage: mesh_bench [--size NXxNYxNZ] [--reps N] [--threads N] [--jitter F]\n"
+                "Meshes a block of NX x NY x NZ particles (default 60x80x60) --reps times.\n");
         return 2;
     }
     if (threads) omp_set_num_threads(threads);
@@ -71,18 +72,20 @@ int main(int argc, char **argv)
     qsort(t, (size_t)reps, sizeof *t, cmp);
     qsort(cpu, (size_t)reps, sizeof *cpu, cmp);
     int nt = omp_get_max_threads();
-    printf("mesh_bench: %zu particles (%ldx%ldx%ld, jitter %.2f d), %d threads, %d reps\n", n, nx, ny, nz, jitter,
-           nt, reps);
+    printf("mesh_bench: %zu particles (%ldx%ldx%ld, jitter %.2f d), %d threads, %d reps\n", n, nx, ny, nz, jitter, nt,
+           reps);
     printf("  time min %.3f s, median %.3f s, max %.3f s\n", t[0], t[reps / 2], t[reps - 1]);
     printf("  throughput %.3g particles/s per core (median; min..max %.3g..%.3g)\n", n / t[reps / 2] / nt,
            n / t[reps - 1] / nt, n / t[0] / nt);
     printf("  CPU time (all threads) median %.3f s: %.3g particles per CPU-second (min..max %.3g..%.3g)\n",
            cpu[reps / 2], n / cpu[reps / 2], n / cpu[reps - 1], n / cpu[0]);
     printf("  mesh %zu vertices, %zu faces; %zu surface particles; grid %zu blocks kept, %zu at peak, %.1f MB "
-           "(%.0f B per surface particle)\n", m.nverts, m.ntris, m.surface_particles, m.blocks, m.blocks_peak,
-           m.grid_bytes / 1e6, (double)m.grid_bytes / (double)(m.surface_particles ? m.surface_particles : 1));
+           "(%.0f B per surface particle)\n",
+           m.nverts, m.ntris, m.surface_particles, m.blocks, m.blocks_peak, m.grid_bytes / 1e6,
+           (double)m.grid_bytes / (double)(m.surface_particles ? m.surface_particles : 1));
     printf("  last run: kernels (PCA, smoothing) %.3f s, field and grid growth %.3f s, marching %.3f s, "
-           "merge %.3f s\n", m.seconds[0], m.seconds[1], m.seconds[2], m.seconds[3]);
+           "merge %.3f s\n",
+           m.seconds[0], m.seconds[1], m.seconds[2], m.seconds[3]);
     pfsph_surface_mesh_free(&m);
     free(t);
     free(cpu);

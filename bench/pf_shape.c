@@ -70,10 +70,8 @@ int main(int argc, char **argv)
     omp_set_num_threads(1);
     const double d = 0.01, a = 0.5 * nl * d, b = 0.5 * ns * d;
     char thermo[128], json[4096];
-    if (theta > 0)
-        snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %g},", theta);
-    else
-        snprintf(thermo, sizeof thermo, "\"thermostat\": false,");
+    if (theta > 0) snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %g},", theta);
+    else snprintf(thermo, sizeof thermo, "\"thermostat\": false,");
     if (dim == 2)
         snprintf(json, sizeof json,
                  "{\"dimension\": 2, \"seed\": %d, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
@@ -81,7 +79,8 @@ int main(int argc, char **argv)
                  " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": 0.002},"
                  " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}],"
                  " \"fluid\": [{\"shape\": \"box\", \"min\": [%g, %g], \"max\": [%g, %g]}],"
-                 " \"pairwise\": {%s %s \"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %s}]}}",
+                 " \"pairwise\": {%s %s \"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": "
+                 "%s}]}}",
                  seed, solver, getenv("PF_SOLVEX") ? getenv("PF_SOLVEX") : "", nu, -a, -b, a, b,
                  getenv("PF_PW") ? getenv("PF_PW") : "", thermo, k, sig);
     else
@@ -91,9 +90,10 @@ int main(int argc, char **argv)
                  " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": 0.002},"
                  " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}],"
                  " \"fluid\": [{\"shape\": \"box\", \"min\": [%g, %g, %g], \"max\": [%g, %g, %g]}],"
-                 " \"pairwise\": {%s %s \"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %s}]}}",
-                 seed, solver, getenv("PF_SOLVEX") ? getenv("PF_SOLVEX") : "", nu, -a, -b, -b, a,
-                 b, b, getenv("PF_PW") ? getenv("PF_PW") : "", thermo, k, sig);
+                 " \"pairwise\": {%s %s \"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": "
+                 "%s}]}}",
+                 seed, solver, getenv("PF_SOLVEX") ? getenv("PF_SOLVEX") : "", nu, -a, -b, -b, a, b, b,
+                 getenv("PF_PW") ? getenv("PF_PW") : "", thermo, k, sig);
     static pfsph_scene s;
     pfsph_error err = {0};
     if (pfsph_scene_parse(&s, json, "pf_shape", &err) != PFSPH_OK) {

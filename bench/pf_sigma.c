@@ -53,10 +53,8 @@ int main(int argc, char **argv)
     const double d = 0.01, sigma_t = 4.0;
     omp_set_num_threads(1);
     char json[2048], thermo[128];
-    if (theta > 0)
-        snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %g},", theta);
-    else
-        snprintf(thermo, sizeof thermo, "\"thermostat\": false,");
+    if (theta > 0) snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %g},", theta);
+    else snprintf(thermo, sizeof thermo, "\"thermostat\": false,");
     snprintf(json, sizeof json,
              "{\"dimension\": 2, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0],"
              " \"domain\": {\"min\": [-1, -1], \"max\": [1, 1]},"
@@ -121,7 +119,8 @@ int main(int argc, char **argv)
          * <sum m v_{n+1}^2 + sum x_n . F_n> = 0) */
         pfsph_particles *fw = (pfsph_particles *)f;
         const double dtl = back ? pfsph_sim_stats(sim)->dt : 0;
-        for (size_t i = 0; i < n; i++) fw->x[i] -= (pfsph_real)(dtl * f->vx[i]), fw->y[i] -= (pfsph_real)(dtl * f->vy[i]);
+        for (size_t i = 0; i < n; i++)
+            fw->x[i] -= (pfsph_real)(dtl * f->vx[i]), fw->y[i] -= (pfsph_real)(dtl * f->vy[i]);
         pfsph_pairwise_diagnose_tensor(NULL, c, vir, NULL, W);
         const double mass = c->mass[0], h = c->h;
         double an = 0, dp = 0, tr = 0, pin = 0;
@@ -141,8 +140,8 @@ int main(int argc, char **argv)
                 const double dx = f->x[i] - f->x[j], dy = f->y[i] - f->y[j], r2 = dx * dx + dy * dy;
                 if (r2 >= h * h) continue;
                 const double r = sqrt(r2);
-                const double g = -(pi + f->p[j] / ((double)c->nd[j] * c->nd[j])) *
-                                 pfsph_kernel_dw_r(&c->kern, (pfsph_real)r);
+                const double g =
+                    -(pi + f->p[j] / ((double)c->nd[j] * c->nd[j])) * pfsph_kernel_dw_r(&c->kern, (pfsph_real)r);
                 P[0][0] += 0.5 * g * dx * dx;
                 P[0][1] += 0.5 * g * dx * dy;
                 P[1][0] += 0.5 * g * dy * dx;
@@ -163,14 +162,13 @@ int main(int argc, char **argv)
             }
             if (rr < 0.5 * Re) pin += pm[i], nin++;
         }
-        for (size_t i = 0; i < n; i++) fw->x[i] += (pfsph_real)(dtl * f->vx[i]), fw->y[i] += (pfsph_real)(dtl * f->vy[i]);
+        for (size_t i = 0; i < n; i++)
+            fw->x[i] += (pfsph_real)(dtl * f->vx[i]), fw->y[i] += (pfsph_real)(dtl * f->vy[i]);
         smp[0][m] = an / (2 * PI * Re);
         smp[1][m] = dp;
         smp[2][m] = nin ? pin / nin : 0;
         smp[3][m] = tr / (2 * A);
-        if (raw)
-            printf("%.4f %.4f %.4f %.4f %.4f\n", pfsph_sim_time(sim), smp[0][m], smp[1][m], smp[2][m],
-                   smp[3][m]);
+        if (raw) printf("%.4f %.4f %.4f %.4f %.4f\n", pfsph_sim_time(sim), smp[0][m], smp[1][m], smp[2][m], smp[3][m]);
         m++;
     }
     const char *nm[4] = {"sigma_A [N/m]", "dp_A [Pa]", "P_in [Pa]", "V_tot [Pa]"};

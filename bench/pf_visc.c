@@ -85,15 +85,14 @@ int main(int argc, char **argv)
     const double L = n * d, Z = nz * d, w = 3 * d;
     L_box = L;
     char pw[1024], json[8192];
-    if (theta < 0)
-        snprintf(pw, sizeof pw, " ");
+    if (theta < 0) snprintf(pw, sizeof pw, " ");
     else
         snprintf(pw, sizeof pw,
                  ", \"pairwise\": {%s \"thermostat\": %s, \"k\": %s, \"coefficients\": ["
                  "{\"phases\": [\"water\", \"water\"], \"sigma\": %s},"
                  "{\"phases\": [\"water\", \"wall\"], \"contact_angle\": %s}]}",
-                 getenv("PF_PW") ? getenv("PF_PW") : "",
-                 theta > 0 ? "{\"reduced_temperature\": 0}" : "false", k, sig, angle);
+                 getenv("PF_PW") ? getenv("PF_PW") : "", theta > 0 ? "{\"reduced_temperature\": 0}" : "false", k, sig,
+                 angle);
     if (theta > 0) { /* put theta in */
         char tmp[1024];
         snprintf(tmp, sizeof tmp,
@@ -114,8 +113,7 @@ int main(int argc, char **argv)
                  " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [%.10g, %.10g], \"phase\": \"water\"}],"
                  " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [%.10g, %.10g],"
                  " \"layers\": 3, \"slip\": \"free-slip\"}] %s}",
-                 seed, 0.5 * d, -2 * w, -2 * w, L + 2 * w, L + 2 * w, solver, rho, nu, vx, L, L, L, L,
-                 pw);
+                 seed, 0.5 * d, -2 * w, -2 * w, L + 2 * w, L + 2 * w, solver, rho, nu, vx, L, L, L, L, pw);
     else
         snprintf(json, sizeof json,
                  "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": %.10g, \"gravity\": [0, 0, 0],"
@@ -123,11 +121,12 @@ int main(int argc, char **argv)
                  " \"solver\": {\"type\": \"%s\"}, \"time\": {\"dt_max\": 0.002},"
                  " \"phases\": [{\"name\": \"water\", \"rest_density\": %s, \"viscosity\": %s %s},"
                  "   {\"name\": \"wall\", \"kind\": \"solid\"}],"
-                 " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [%.10g, %.10g, %.10g], \"phase\": \"water\"}],"
+                 " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0, 0], \"max\": [%.10g, %.10g, %.10g], \"phase\": "
+                 "\"water\"}],"
                  " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0, 0], \"max\": [%.10g, %.10g, %.10g],"
                  " \"layers\": 3, \"slip\": \"free-slip\"}] %s}",
-                 seed, 0.5 * d, -2 * w, -2 * w, -2 * w, L + 2 * w, L + 2 * w, Z + 2 * w, solver, rho, nu,
-                 vx, L, L, Z, L, L, Z, pw);
+                 seed, 0.5 * d, -2 * w, -2 * w, -2 * w, L + 2 * w, L + 2 * w, Z + 2 * w, solver, rho, nu, vx, L, L, Z,
+                 L, L, Z, pw);
     static pfsph_scene s;
     pfsph_error err = {0};
     if (pfsph_scene_parse(&s, json, "pf_visc", &err) != PFSPH_OK) {
@@ -173,8 +172,7 @@ int main(int argc, char **argv)
             if (a > astop * A) {
                 sx += t, sy += log(a), sxx += t * t, sxy += t * log(a);
                 nfit++;
-            } else
-                stopped = 1;
+            } else stopped = 1;
         }
         if (t >= t0) tk += kin, ntk++;
     }

@@ -20,16 +20,17 @@ static double cpu_seconds(void)
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
     return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
-           1e-6 * (double)ru.ru_stime.tv_usec;
+        1e-6 * (double)ru.ru_stime.tv_usec;
 }
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: time_to_solution [--scene FILE] [--solver wcsph|pcisph|dfsph] [--end T]\n"
-                    "                        [--threads N]\n"
-                    "Runs FILE (default bench/dam_break_7k.json relative to the working directory)\n"
-                    "to time T [s] (default: the scene's end) with the solver given (default: the\n"
-                    "scene's) and prints wall time, steps and time per stage.\n");
+    fprintf(stderr,
+            "usage: time_to_solution [--scene FILE] [--solver wcsph|pcisph|dfsph] [--end T]\n"
+            "                        [--threads N]\n"
+            "Runs FILE (default bench/dam_break_7k.json relative to the working directory)\n"
+            "to time T [s] (default: the scene's end) with the solver given (default: the\n"
+            "scene's) and prints wall time, steps and time per stage.\n");
 }
 
 int main(int argc, char **argv)
@@ -40,11 +41,22 @@ int main(int argc, char **argv)
     int threads = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--scene") && v) { scene = v; i++; }
-        else if (!strcmp(a, "--solver") && v) { solver = v; i++; }
-        else if (!strcmp(a, "--end") && v) { end = atof(v); i++; }
-        else if (!strcmp(a, "--threads") && v) { threads = atoi(v); i++; }
-        else { usage(); return !strcmp(a, "--help") || !strcmp(a, "-h") ? 0 : 2; }
+        if (!strcmp(a, "--scene") && v) {
+            scene = v;
+            i++;
+        } else if (!strcmp(a, "--solver") && v) {
+            solver = v;
+            i++;
+        } else if (!strcmp(a, "--end") && v) {
+            end = atof(v);
+            i++;
+        } else if (!strcmp(a, "--threads") && v) {
+            threads = atoi(v);
+            i++;
+        } else {
+            usage();
+            return !strcmp(a, "--help") || !strcmp(a, "-h") ? 0 : 2;
+        }
     }
     static pfsph_scene s;
     pfsph_error err = {0};
@@ -95,9 +107,10 @@ int main(int argc, char **argv)
     if (rc) fprintf(stderr, "%s\n", err.msg);
     const unsigned long long steps = (unsigned long long)pfsph_sim_steps(sim);
     printf("%s, %s, %zu fluid particles, %d threads: %.3f s simulated in %.2f s wall, %llu steps "
-           "(mean dt %.3g s, %.2f ms per step)\n", s.name, pfsph_scene_solver_name(&s),
-           pfsph_sim_ctx(sim)->fluid->n, omp_get_max_threads(), pfsph_sim_time(sim), wall, steps,
-           steps ? pfsph_sim_time(sim) / (double)steps : 0, steps ? 1e3 * wall / (double)steps : 0);
+           "(mean dt %.3g s, %.2f ms per step)\n",
+           s.name, pfsph_scene_solver_name(&s), pfsph_sim_ctx(sim)->fluid->n, omp_get_max_threads(),
+           pfsph_sim_time(sim), wall, steps, steps ? pfsph_sim_time(sim) / (double)steps : 0,
+           steps ? 1e3 * wall / (double)steps : 0);
     printf("  cpu (user + sys) %.2f s; solver iterations per step: %.2f (divergence %.2f)\n", cpu,
            steps ? (double)its / (double)steps : 0, steps ? (double)div_its / (double)steps : 0);
     const double *st = pfsph_sim_stage_seconds(sim);

@@ -43,13 +43,14 @@ static int run_lock(const char *dir, int *fd_out, pfsph_error *err)
         char who[128] = "";
         ssize_t n = pread(fd, who, sizeof who - 1, 0);
         close(fd);
-        if (e != EWOULDBLOCK)
-            return pfsph_fail(err, PFSPH_EIO, "%s: cannot lock: %s", path, strerror(e));
+        if (e != EWOULDBLOCK) return pfsph_fail(err, PFSPH_EIO, "%s: cannot lock: %s", path, strerror(e));
         who[n > 0 ? n : 0] = 0;
         char *nl = strchr(who, '\n');
         if (nl) *nl = 0;
-        return pfsph_fail(err, PFSPH_EINPUT, "in use by another pfsph run (%s); wait for it to end or choose "
-                          "another directory", who[0] ? who : "holder unknown");
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "in use by another pfsph run (%s); wait for it to end or choose "
+                          "another directory",
+                          who[0] ? who : "holder unknown");
     }
     char who[128];
     time_t now = time(NULL);
@@ -72,7 +73,8 @@ static void run_unlock(int fd)
 /* "<prefix><digits>.<ext>" with prefix one of the frame sets; *num receives the digits. */
 static int frame_file(const char *name, long *num)
 {
-    static const char *const sets[] = {"fluid_", "boundary_", "diffuse_", "bodies_", "surfaces_", "liquid_", "frame_", NULL};
+    static const char *const sets[] = {"fluid_",    "boundary_", "diffuse_", "bodies_",
+                                       "surfaces_", "liquid_",   "frame_",   NULL};
     for (int k = 0; sets[k]; k++) {
         size_t l = strlen(sets[k]);
         if (strncmp(name, sets[k], l) != 0) continue;
@@ -105,8 +107,8 @@ static int is_temporary(const char *name)
 /* Files pfsph writes at the top of a run directory. */
 static int is_run_file(const char *name)
 {
-    static const char *const names[] = {"scene.json", "summary.json", "stats.csv", "bodies.csv", RUN_JSON,
-                                        "diffuse_counts.png", "frames.mp4", NULL};
+    static const char *const names[] = {"scene.json", "summary.json",       "stats.csv",  "bodies.csv",
+                                        RUN_JSON,     "diffuse_counts.png", "frames.mp4", NULL};
     for (int k = 0; names[k]; k++)
         if (!strcmp(name, names[k])) return 1;
     size_t len = strlen(name); /* the .pvd collections (io/meshing.c) */
@@ -118,8 +120,8 @@ static int is_run_file(const char *name)
  * the output files of frames after `after_frame` (a resume). */
 typedef struct sweep {
     int clear;
-    long after;   /* output frame index; frames above it go (resume) */
-    int errors;   /* unlink failures */
+    long after; /* output frame index; frames above it go (resume) */
+    int errors; /* unlink failures */
     int err_no;
     char failed[PFSPH_PATH_LEN + 64];
 } sweep;
@@ -137,8 +139,7 @@ static void sweep_dir(const char *dir, const char *sub, sweep *sw)
         int go;
         if (!strcmp(sub, "checkpoints"))
             go = is_temporary(n) || (sw->clear && !strncmp(n, "ckpt_", 5) && strstr(n, ".bin"));
-        else
-            go = is_temporary(n) || (frame_file(n, &num) && (sw->clear || num > sw->after));
+        else go = is_temporary(n) || (frame_file(n, &num) && (sw->clear || num > sw->after));
         if (!go) continue;
         snprintf(path, sizeof path, "%s/%s/%s", dir, sub, n);
         if (unlink(path) != 0 && errno != ENOENT && !sw->errors++) {
@@ -168,8 +169,7 @@ static int sweep_run(const char *dir, sweep *sw, pfsph_error *err)
     sweep_dir(dir, "frames", sw);
     sweep_dir(dir, "checkpoints", sw);
     sweep_dir(dir, "png", sw);
-    if (sw->errors)
-        return pfsph_fail(err, PFSPH_EIO, "%s: cannot remove: %s", sw->failed, strerror(sw->err_no));
+    if (sw->errors) return pfsph_fail(err, PFSPH_EIO, "%s: cannot remove: %s", sw->failed, strerror(sw->err_no));
     return PFSPH_OK;
 }
 
@@ -211,7 +211,8 @@ static int read_run_end(const char *dir, double *end, pfsph_error *err)
     unsigned char *data;
     size_t len;
     FILE *f = fopen(path, "rb");
-    if (!f) return errno == ENOENT ? PFSPH_OK : pfsph_fail(err, PFSPH_EIO, "%s: cannot read: %s", path, strerror(errno));
+    if (!f)
+        return errno == ENOENT ? PFSPH_OK : pfsph_fail(err, PFSPH_EIO, "%s: cannot read: %s", path, strerror(errno));
     fclose(f);
     int rc = pfsph__read_file(path, &data, &len, err);
     if (rc) return rc;
@@ -220,8 +221,10 @@ static int read_run_end(const char *dir, double *end, pfsph_error *err)
     const cJSON *e = cJSON_GetObjectItemCaseSensitive(j, "end_time");
     if (!cJSON_IsNumber(e) || !(e->valuedouble >= 0) || !isfinite(e->valuedouble)) {
         cJSON_Delete(j);
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: $.end_time: missing or not a time >= 0 (the file is pfsph's; "
-                          "give --end to resume)", path);
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: $.end_time: missing or not a time >= 0 (the file is pfsph's; "
+                          "give --end to resume)",
+                          path);
     }
     *end = e->valuedouble;
     cJSON_Delete(j);
@@ -229,9 +232,8 @@ static int read_run_end(const char *dir, double *end, pfsph_error *err)
 }
 
 /* layer: the fluid's surface layers (NULL for other sets); film: bubbles' film fractions */
-static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name, int frame,
-                        const pfsph_particles *ps, const char *aux, double time, const uint8_t *layer,
-                        bool film, pfsph_error *err)
+static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name, int frame, const pfsph_particles *ps,
+                        const char *aux, double time, const uint8_t *layer, bool film, pfsph_error *err)
 {
     char path[PFSPH_PATH_LEN + 64];
     pfsph_io_opts o = {.dim = s->dim,
@@ -254,16 +256,15 @@ static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name,
     return PFSPH_OK;
 }
 
-static int write_set(const pfsph_scene *s, const char *dir, const char *name, int frame,
-                     const pfsph_particles *ps, const char *aux, double time, pfsph_error *err)
+static int write_set(const pfsph_scene *s, const char *dir, const char *name, int frame, const pfsph_particles *ps,
+                     const char *aux, double time, pfsph_error *err)
 {
     return write_set_ex(s, dir, name, frame, ps, aux, time, NULL, false, err);
 }
 
 /* The boundary particles with ids >= first (bodies) or below it (static solids) as one set. */
 static int write_boundary_part(const pfsph_scene *s, const char *dir, const char *name, int frame,
-                               const pfsph_particles *b, uint32_t first, bool bodies, double t,
-                               pfsph_error *err)
+                               const pfsph_particles *b, uint32_t first, bool bodies, double t, pfsph_error *err)
 {
     pfsph_particles ps;
     if (pfsph_particles_init(&ps, b->n ? b->n : 1)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
@@ -334,8 +335,8 @@ static void bodies_rows(FILE *f, int frame, const pfsph_sim *sim)
 }
 
 /* Liquid surface meshes (output.surface) and the .pvd collections, after a frame's sets. */
-static int write_frame_extras(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid,
-                              double t, pfsph_error *err)
+static int write_frame_extras(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid, double t,
+                              pfsph_error *err)
 {
     int rc = PFSPH_OK;
     if (s->output.surface.on) rc = pfsph_mesh_frame(s, dir, frame, fluid, t, NULL, err);
@@ -344,8 +345,7 @@ static int write_frame_extras(const pfsph_scene *s, const char *dir, int frame, 
     return rc;
 }
 
-static int write_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_sim *sim,
-                       pfsph_error *err)
+static int write_frame(const pfsph_scene *s, const char *dir, int frame, const pfsph_sim *sim, pfsph_error *err)
 {
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     double t = pfsph_sim_time(sim);
@@ -381,8 +381,7 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, const p
     if (!rc && frame == 0 && c->boundary->n && s->output.write_boundary) {
         if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
         else /* the static part; body particles go to bodies_NNNNN every frame */
-            rc = write_boundary_part(s, dir, "boundary", frame, c->boundary, pfsph_bodies_first_id(B), false,
-                                     t, err);
+            rc = write_boundary_part(s, dir, "boundary", frame, c->boundary, pfsph_bodies_first_id(B), false, t, err);
     }
     const pfsph_particles *d = pfsph_sim_diffuse(sim);
     if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);
@@ -410,15 +409,14 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
 }
 
 typedef struct run_info {
-    int resumed_from;  /* checkpoint frame, -1: fresh run */
-    int ckpt_frame;    /* last checkpoint written by this process, -1: none */
+    int resumed_from; /* checkpoint frame, -1: fresh run */
+    int ckpt_frame;   /* last checkpoint written by this process, -1: none */
     size_t ckpt_bytes;
-    double ckpt_s;     /* seconds to encode and write it */
+    double ckpt_s; /* seconds to encode and write it */
 } run_info;
 
-static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim *sim,
-                         int frames, double wall, const char *status, const char *message,
-                         const run_info *info, pfsph_error *err)
+static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim *sim, int frames, double wall,
+                         const char *status, const char *message, const run_info *info, pfsph_error *err)
 {
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "program", "pfsph");
@@ -516,13 +514,14 @@ static int truncate_csv(const char *path, const char *header, int last, long *ke
 static int check_end(const pfsph_scene *s, double end, pfsph_error *err)
 {
     if (!isfinite(end) || !(end >= 0) || floor(end * s->fps + 1e-9) > PFSPH_MAX_FRAMES)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: end time %g s at %g fps ($.time.fps) makes %.3g frames, more "
-                          "than the %d one run holds", s->source, end, s->fps, end * s->fps, PFSPH_MAX_FRAMES);
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: end time %g s at %g fps ($.time.fps) makes %.3g frames, more "
+                          "than the %d one run holds",
+                          s->source, end, s->fps, end * s->fps, PFSPH_MAX_FRAMES);
     return PFSPH_OK;
 }
 
-static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0,
-                      pfsph_error *err);
+static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0, pfsph_error *err);
 
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
 {
@@ -537,8 +536,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     /* a directory that cannot be made or written is bad input (exit status 2), as is one that
      * another run holds */
     pfsph_error e;
-    if (pfsph_mkdirs(dir, &e))
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: %s \"%s\": %s", s->source, what, dir, e.msg);
+    if (pfsph_mkdirs(dir, &e)) return pfsph_fail(err, PFSPH_EINPUT, "%s: %s \"%s\": %s", s->source, what, dir, e.msg);
     int lock = -1;
     if ((rc = run_lock(dir, &lock, &e))) {
         pfsph_fail(err, rc, "%s: %s \"%s\": %s", s->source, what, dir, e.msg);
@@ -549,8 +547,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     return rc;
 }
 
-static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0,
-                      pfsph_error *err)
+static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0, pfsph_error *err)
 {
     double end = o && o->end_time >= 0 ? o->end_time : s->end_time;
     char path[PFSPH_PATH_LEN + 64];
@@ -564,9 +561,11 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         char names[256];
         int n = dir_entries(dir, names, sizeof names);
         if (n && !(o && o->force))
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: the run directory is not empty (%s): a fresh run does not "
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: the run directory is not empty (%s): a fresh run does not "
                               "mix with what is there; continue it with --resume, or give --force to remove "
-                              "pfsph's files from it first", dir, names);
+                              "pfsph's files from it first",
+                              dir, names);
         sweep sw = {.clear = 1, .after = -1};
         if (n && (rc = sweep_run(dir, &sw, err))) return rc;
     }
@@ -588,7 +587,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         rc = pfsph_checkpoint_resume(dir, sim, &cki, o->message, o->user, err);
         frame0 = cki.frame;
         if (!rc && frame0 > nframes)
-            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: the end time %g s (frame %d) is before the newest checkpoint "
+            rc = pfsph_fail(err, PFSPH_EINPUT,
+                            "%s: the end time %g s (frame %d) is before the newest checkpoint "
                             "(frame %d, t = %g s): nothing to resume; give a later --end, or run afresh with --force",
                             dir, end, nframes, frame0, cki.time);
         if (!rc) {
@@ -599,7 +599,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         }
         if (!rc && frame0 >= 0 && cki.threads != omp_get_max_threads() && o->message) {
             char msg[256];
-            snprintf(msg, sizeof msg, "the checkpoint of frame %d was written with %d threads, this run has %d: "
+            snprintf(msg, sizeof msg,
+                     "the checkpoint of frame %d was written with %d threads, this run has %d: "
                      "frames will not be bit-identical to an uninterrupted run (use --threads %d)",
                      frame0, cki.threads, omp_get_max_threads(), cki.threads);
             o->message(msg, o->user);
@@ -635,9 +636,10 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     }
     if (resume && kept < frame0 && o->message) {
         char msg[PFSPH_PATH_LEN + 256];
-        snprintf(msg, sizeof msg, "%s: the rows of frames %ld..%d are missing (the file was deleted or cut); "
-                 "the resumed rows follow without them (a fresh run with --force rewrites them all)", path,
-                 kept + 1, frame0);
+        snprintf(msg, sizeof msg,
+                 "%s: the rows of frames %ld..%d are missing (the file was deleted or cut); "
+                 "the resumed rows follow without them (a fresh run with --force rewrites them all)",
+                 path, kept + 1, frame0);
         o->message(msg, o->user);
     }
     FILE *csv = fopen(path, resume ? "a" : "w");
@@ -657,8 +659,10 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         }
         if (resume && kept < frame0 && o->message) {
             char msg[PFSPH_PATH_LEN + 256];
-            snprintf(msg, sizeof msg, "%s: the rows of frames %ld..%d are missing (the file was deleted or cut); "
-                     "the resumed rows follow without them", path, kept + 1, frame0);
+            snprintf(msg, sizeof msg,
+                     "%s: the rows of frames %ld..%d are missing (the file was deleted or cut); "
+                     "the resumed rows follow without them",
+                     path, kept + 1, frame0);
             o->message(msg, o->user);
         }
         bcsv = fopen(path, resume ? "a" : "w");
@@ -697,8 +701,9 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     const double time0 = pfsph_sim_time(sim);
     double last_report = omp_get_wtime();
     if (o && o->progress) { /* at once, before the first step */
-        pfsph_progress p = {frame0, nframes, time0, end, pfsph_sim_steps(sim), last_report - w0, 0,
-                            pfsph_sim_ctx(sim)->fluid->n, time0, true};
+        pfsph_progress p = {
+            frame0, nframes, time0, end, pfsph_sim_steps(sim), last_report - w0, 0, pfsph_sim_ctx(sim)->fluid->n,
+            time0,  true};
         o->progress(&p, o->user);
     }
     const uint64_t steps0 = pfsph_sim_steps(sim);
@@ -712,9 +717,16 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
             if (!rc && now - last_report >= 0.25) {
                 last_report = now;
                 double wall = now - w0;
-                pfsph_progress p = {frame - 1, nframes, pfsph_sim_time(sim), end, pfsph_sim_steps(sim), wall,
+                pfsph_progress p = {frame - 1,
+                                    nframes,
+                                    pfsph_sim_time(sim),
+                                    end,
+                                    pfsph_sim_steps(sim),
+                                    wall,
                                     wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
-                                    pfsph_sim_ctx(sim)->fluid->n, time0, true};
+                                    pfsph_sim_ctx(sim)->fluid->n,
+                                    time0,
+                                    true};
                 o->progress(&p, o->user);
             }
         }
@@ -727,8 +739,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
             size_t len = strlen(err->msg);
             if (pfsph_mkdirs(path, &e3) == PFSPH_OK && pfsph_checkpoint_keep(stash, cp, &e3) == PFSPH_OK) {
                 good = 0;
-                snprintf(err->msg + len, sizeof err->msg - len,
-                         ". The last good state (frame %d) is kept in %s", good_frame, cp);
+                snprintf(err->msg + len, sizeof err->msg - len, ". The last good state (frame %d) is kept in %s",
+                         good_frame, cp);
             }
         }
         if (rc) break;
@@ -756,9 +768,16 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (o && o->progress) {
             last_report = omp_get_wtime();
             double wall = last_report - w0;
-            pfsph_progress p = {frame, nframes, pfsph_sim_time(sim), end, pfsph_sim_steps(sim), wall,
+            pfsph_progress p = {frame,
+                                nframes,
+                                pfsph_sim_time(sim),
+                                end,
+                                pfsph_sim_steps(sim),
+                                wall,
                                 wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
-                                pfsph_sim_ctx(sim)->fluid->n, time0, false};
+                                pfsph_sim_ctx(sim)->fluid->n,
+                                time0,
+                                false};
             o->progress(&p, o->user);
         }
     }

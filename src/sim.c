@@ -28,8 +28,8 @@
 #include "physics/viscosity.h"
 #include "scene/shapes.h"
 
-const char *const pfsph_stage_names[PFSPH_NSTAGES] = {
-    "grid", "density", "forces", "pairwise", "pressure", "integrate", "diffuse", "bodies", "film", "output"};
+const char *const pfsph_stage_names[PFSPH_NSTAGES] = {"grid",      "density", "forces", "pairwise", "pressure",
+                                                      "integrate", "diffuse", "bodies", "film",     "output"};
 
 /* per-step scratch of the step itself, one value per fluid particle; the solver's follow */
 enum { SCR_AX, SCR_AY, SCR_AZ, SCR_ND, SCR_APX, SCR_APY, SCR_APZ, SCR_EK, SCR_COMMON };
@@ -56,25 +56,25 @@ struct pfsph_sim {
     pfsph_grid grid, bgrid;
     pfsph_nlist nlist, nlist_b; /* fluid and boundary neighbours, built each step when the
                                  * solver asks (neighbour_lists) */
-    pfsph_real *scr[SCR_MAX]; /* per-step scratch: SCR_COMMON of ours, then the solver's */
+    pfsph_real *scr[SCR_MAX];   /* per-step scratch: SCR_COMMON of ours, then the solver's */
     int nscr;
-    int scr_noise;            /* first of the thermostat's 3 arrays (its accelerations), or -1 */
-    size_t scr_cap;           /* entries in each scratch array */
+    int scr_noise;  /* first of the thermostat's 3 arrays (its accelerations), or -1 */
+    size_t scr_cap; /* entries in each scratch array */
     const pfsph_solver_ops *solver;
     void *solver_state;
     double sound_speed;
-    double amax;            /* largest acceleration of the last step */
-    double amax_np;         /* largest non-pressure acceleration of the last step (or the solver's
+    double amax;           /* largest acceleration of the last step */
+    double amax_np;        /* largest non-pressure acceleration of the last step (or the solver's
                              * bound without viscosity: np_cap_without_viscosity) */
-    double gmag;            /* |gravity| */
-    double vbound;          /* speeds above this are a blow-up */
-    double t_limit;         /* the step in progress never passes this time */
-    size_t removed_before;  /* removed count before this step's sort */
+    double gmag;           /* |gravity| */
+    double vbound;         /* speeds above this are a blow-up */
+    double t_limit;        /* the step in progress never passes this time */
+    size_t removed_before; /* removed count before this step's sort */
     pfsph_pairwise *pw;
     pfsph_diffuse *df;
-    pfsph_film *film;       /* bubbles in air, or NULL */
+    pfsph_film *film; /* bubbles in air, or NULL */
     pfsph_bodies *bodies;
-    pfsph_emitters *em;     /* NULL: the scene has no emitter */
+    pfsph_emitters *em; /* NULL: the scene has no emitter */
     stage stages[MAX_STAGES];
     int nstages;
     double time;
@@ -264,7 +264,8 @@ double pfsph_scene_emitter_speed(const pfsph_scene *s)
     pfsph_emitter_info info[PFSPH_MAX_EMITTERS];
     pfsph_error err;
     if (!s->nemitters || pfsph_scene_emitters_info(s, info, &err)) return 0;
-    const double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
+    const double g =
+        sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     double v = 0;
     for (int i = 0; i < s->nemitters; i++) {
         const double *c = s->emitters[i].center;
@@ -283,8 +284,7 @@ double pfsph_scene_emitter_speed(const pfsph_scene *s)
     return v;
 }
 
-int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
-                         size_t *bytes, pfsph_error *err)
+int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary, size_t *bytes, pfsph_error *err)
 {
     double d = 2 * s->particle_radius;
     long nf = 0, nb = 0;
@@ -322,8 +322,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     int r1, r2;
     double cell = grid_cell(s, h, &r1, &r2);
     double cells = 1;
-    for (int a = 0; a < s->dim; a++)
-        cells *= ceil((s->domain_max[a] - s->domain_min[a]) / cell + 8);
+    for (int a = 0; a < s->dim; a++) cells *= ceil((s->domain_max[a] - s->domain_min[a]) / cell + 8);
     /* Per particle: its set at up to twice its size (the arrays grow by doubling), the grid's
      * sort scratch (key, perm, tmp; 1.25x), and for fluid the step scratch (checkpoints and the
      * last good frame go to disk through a small buffer, docs/checkpoints.md). Measured:
@@ -336,9 +335,9 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
      * and a quarter more for compression near walls and in splashes; boundary lists: half a
      * neighbourhood for every fluid particle (a particle on a wall has about half) */
     const double q = s->support_factor, full = s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q;
-    const double nlist = ops && ops->neighbour_lists ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) +
-                                                           pfsph_nlist_bytes_per_particle(0.5 * full, 1)
-                                                     : 0;
+    const double nlist = ops && ops->neighbour_lists
+        ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) + pfsph_nlist_bytes_per_particle(0.5 * full, 1)
+        : 0;
     const int nscr = SCR_COMMON + (ops ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
     const double per_fluid = 2 * P + nscr * sizeof(pfsph_real) + sort + nlist;
     const double per_boundary = 2 * P + sort;
@@ -348,12 +347,14 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     if (n_boundary) *n_boundary = (size_t)nb;
     if (bytes) *bytes = part_bytes + grid_bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)(part_bytes + grid_bytes);
     if (nf_max + nb > (long)UINT32_MAX)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: the scene makes %ld particles (%ld fluid), more than the %u one run "
-                          "can index; enlarge particle_radius or shrink the fluid", s->source, nf_max + nb, nf_max,
-                          UINT32_MAX);
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: the scene makes %ld particles (%ld fluid), more than the %u one run "
+                          "can index; enlarge particle_radius or shrink the fluid",
+                          s->source, nf_max + nb, nf_max, UINT32_MAX);
     /* a grid the program cannot index, or one that dwarfs the particles: the domain is to blame */
     if (cells > (double)((size_t)1 << 31) || (grid_bytes > (double)(1u << 30) && grid_bytes > 16 * part_bytes))
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: $.domain: the neighbour grids over the domain need %.3g cells of "
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: $.domain: the neighbour grids over the domain need %.3g cells of "
                           "%.3g m (%.3g GiB) for %ld particles; shrink $.domain to where the fluid can go (a grid "
                           "holds at most 2^31 cells, and at most 16x the particles' memory above 1 GiB)",
                           s->source, cells, cell, grid_bytes / 1073741824.0, nf + nb);
@@ -383,14 +384,13 @@ static int alloc_scratch(pfsph_sim *sim, size_t n)
 static void auto_sound_speed(pfsph_sim *sim)
 {
     const pfsph_scene *s = &sim->scene;
-    double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] +
-                    s->gravity[2] * s->gravity[2]);
+    double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     double lo = INFINITY, hi = -INFINITY, v2 = 0;
     const pfsph_particles *f = &sim->fluid;
     for (size_t i = 0; i < f->n; i++) {
         /* height along gravity (y when there is none) */
-        double hgt = g > 0 ? -(f->x[i] * s->gravity[0] + f->y[i] * s->gravity[1] + f->z[i] * s->gravity[2]) / g
-                           : f->y[i];
+        double hgt =
+            g > 0 ? -(f->x[i] * s->gravity[0] + f->y[i] * s->gravity[1] + f->z[i] * s->gravity[2]) / g : f->y[i];
         if (hgt < lo) lo = hgt;
         if (hgt > hi) hi = hgt;
         double w = (double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] + (double)f->vz[i] * f->vz[i];
@@ -412,8 +412,11 @@ int pfsph_sim_surface_layers(const pfsph_sim *sim, int layers, uint8_t *out)
     /* particles moved since the step's sort by at most a step's travel: one cell more each way
      * keeps every neighbour within the radius in the ranges walked */
     int reach = sim->grid.reach + 1;
-    pfsph_surface_opts o = {.radius = 0, .layers = layers, .group = sim->film ? sim->fluid.bubble : NULL,
-                            .boundary = true, .reach = reach > 3 ? 3 : reach};
+    pfsph_surface_opts o = {.radius = 0,
+                            .layers = layers,
+                            .group = sim->film ? sim->fluid.bubble : NULL,
+                            .boundary = true,
+                            .reach = reach > 3 ? 3 : reach};
     pfsph_surface_detect(&sim->ctx, &o, out, work);
     free(work);
     return PFSPH_OK;
@@ -427,8 +430,8 @@ int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out)
     /* the pressure the solver pushed with: DFSPH's divergence solve pushes too (its wall_pressure);
      * with its density pressure alone the interior of a 3D drop read -15 Pa for +133 Pa */
     const pfsph_real *p = sim->solver->wall_pressure && sim->fluid.n
-                              ? sim->solver->wall_pressure(sim->solver_state, &sim->ctx, sim->scr + SCR_COMMON)
-                              : NULL;
+        ? sim->solver->wall_pressure(sim->solver_state, &sim->ctx, sim->scr + SCR_COMMON)
+        : NULL;
     pfsph_pairwise_mechanical_pressure(sim->pw, &sim->ctx, p, vir, out);
     free(vir);
     return PFSPH_OK;
@@ -497,8 +500,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         c->mass[p] = (pfsph_real)(s->phases[p].rest_density * (double)c->V0);
         c->nu[p] = (pfsph_real)s->phases[p].viscosity;
     }
-    if (s->pairwise.enabled && (rc = pfsph_pairwise_resolve(s, c->spacing, c->h, err)) != PFSPH_OK)
-        goto fail;
+    if (s->pairwise.enabled && (rc = pfsph_pairwise_resolve(s, c->spacing, c->h, err)) != PFSPH_OK) goto fail;
     apply_viscosity(c, s);
 
     if ((rc = pfsph_particles_init(&sim->fluid, 1024)) || (rc = pfsph_particles_init(&sim->boundary, 1024))) {
@@ -541,8 +543,10 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     if (s->dim == 2) lo[2] = hi[2] = 0;
     if ((rc = pfsph_grid_init(&sim->grid, s->dim, lo, hi, cell)) ||
         (rc = pfsph_grid_init(&sim->bgrid, s->dim, lo, hi, cell))) {
-        pfsph_fail(err, rc, "the domain needs too many grid cells (%.3g m cells); enlarge "
-                   "particle_radius or shrink the domain", (double)cell);
+        pfsph_fail(err, rc,
+                   "the domain needs too many grid cells (%.3g m cells); enlarge "
+                   "particle_radius or shrink the domain",
+                   (double)cell);
         goto fail;
     }
     sim->grid.reach = sim->bgrid.reach = reach;
@@ -684,9 +688,9 @@ static int report_blowup(pfsph_sim *sim, const char *stage_name, const blowup_in
                           "simulation unstable at step %llu, t = %.6g s, stage %s: %s at particle id %u "
                           "(phase '%s', position %.4g %.4g %.4g); likely cause: %s",
                           (unsigned long long)sim->step, sim->time, stage_name, b->what, f->id[i],
-                          sim->scene.phases[f->phase[i]].name, (double)f->x[i], (double)f->y[i],
-                          (double)f->z[i], hint);
-    return pfsph_fail(err, PFSPH_EUNSTABLE, "simulation unstable at step %llu, t = %.6g s, stage %s: %s; likely cause: %s",
+                          sim->scene.phases[f->phase[i]].name, (double)f->x[i], (double)f->y[i], (double)f->z[i], hint);
+    return pfsph_fail(err, PFSPH_EUNSTABLE,
+                      "simulation unstable at step %llu, t = %.6g s, stage %s: %s; likely cause: %s",
                       (unsigned long long)sim->step, sim->time, stage_name, b->what, hint);
 }
 
@@ -704,7 +708,7 @@ static double choose_dt(pfsph_sim *sim, double vmax, double t_limit, int *collap
     double dt = fmin(s->dt_max, sim->solver->dt_limit(sim->solver_state, &sim->ctx, vmax, sim->amax, sim->amax_np));
     double numax = 0;
     for (int p = 0; p < s->nphases; p++) numax = fmax(numax, s->phases[p].viscosity);
-    if (numax > 0) dt = fmin(dt, 0.125 * d * d / numax);            /* viscous diffusion */
+    if (numax > 0) dt = fmin(dt, 0.125 * d * d / numax); /* viscous diffusion */
     *collapsed = dt < s->dt_min;
     if (dt < s->dt_min) dt = s->dt_min;
     /* Land on t_limit in equal steps: the rest of the interval divided into the fewest steps
@@ -784,7 +788,9 @@ static int st_density(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
         const double q = (double)c->h / (double)c->spacing; /* a full neighbourhood, and a quarter */
         const double guess = 1.25 * (c->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q);
         int rc = pfsph__number_density_list(c, c->nd, &sim->nlist, &sim->nlist_b, guess);
-        if (rc) return pfsph_fail(err, rc, "cannot build the neighbour lists (%s)", rc == PFSPH_ENOMEM ? "out of memory" : "internal error");
+        if (rc)
+            return pfsph_fail(err, rc, "cannot build the neighbour lists (%s)",
+                              rc == PFSPH_ENOMEM ? "out of memory" : "internal error");
         c->nlist = &sim->nlist;
         c->nlist_b = &sim->nlist_b;
     } else {
@@ -818,8 +824,8 @@ static int st_timestep(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     size_t worst = 0;
     double vmax = sim->removed != sim->removed_before ? max_speed(&sim->fluid, &worst) : sim->stats.vmax;
     int collapsed;
-    double dt = choose_dt(sim, sim->bodies ? fmax(vmax, pfsph_bodies_vmax(sim->bodies)) : vmax, sim->t_limit,
-                          &collapsed);
+    double dt =
+        choose_dt(sim, sim->bodies ? fmax(vmax, pfsph_bodies_vmax(sim->bodies)) : vmax, sim->t_limit, &collapsed);
     if (collapsed) {
         vmax = max_speed(&sim->fluid, &worst);
         return unstable(bad, worst, "time step fell below time.dt_min; speed", vmax);
@@ -905,8 +911,8 @@ static int st_body_forces(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)bad;
     (void)err;
     const pfsph_real *p = sim->solver->wall_pressure
-                              ? sim->solver->wall_pressure(sim->solver_state, &sim->ctx, sim->scr + SCR_COMMON)
-                              : sim->fluid.p;
+        ? sim->solver->wall_pressure(sim->solver_state, &sim->ctx, sim->scr + SCR_COMMON)
+        : sim->fluid.p;
     pfsph_bodies_fluid_forces(sim->bodies, &sim->ctx, p);
     return PFSPH_OK;
 }
@@ -954,8 +960,8 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
         f->z[i] += fdt * f->vz[i];
         double e = (double)c->nd[i] / (double)c->nd0 - 1;
         if (e > emax) emax = e;
-        ek[i] = (pfsph_real)0.5 * c->mass[f->phase[i]] *
-                (f->vx[i] * f->vx[i] + f->vy[i] * f->vy[i] + f->vz[i] * f->vz[i]);
+        ek[i] =
+            (pfsph_real)0.5 * c->mass[f->phase[i]] * (f->vx[i] * f->vx[i] + f->vy[i] * f->vy[i] + f->vz[i] * f->vz[i]);
         double v2 = (double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] + (double)f->vz[i] * f->vz[i];
         if (!isfinite(v2) || !isfinite(f->x[i] + f->y[i] + f->z[i])) bad_ = 1;
         else if (v2 > v2max) v2max = v2;
@@ -1122,8 +1128,8 @@ int pfsph_sim_restore_emitters(pfsph_sim *sim, int n, const pfsph_emitter_state 
 }
 const pfsph_bodies *pfsph_sim_bodies(const pfsph_sim *sim) { return sim->bodies; }
 
-int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const pfsph_body_state *st,
-                             const uint32_t *ids, size_t n, pfsph_error *err)
+int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const pfsph_body_state *st, const uint32_t *ids, size_t n,
+                             pfsph_error *err)
 {
     pfsph_particles *b = &sim->boundary;
     if (nbodies != pfsph_bodies_count(sim->bodies))
@@ -1136,8 +1142,8 @@ int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const pfsph_body_state
         for (int a = 0; a < 3; a++) s += st[i].x[a] + st[i].v[a] + st[i].w[a];
         s += st[i].q[0] + st[i].q[1] + st[i].q[2] + st[i].q[3];
         if (!isfinite(s)) return pfsph_fail(err, PFSPH_EINPUT, "restore: body %d has a non-finite state", i);
-        double qn = st[i].q[0] * st[i].q[0] + st[i].q[1] * st[i].q[1] + st[i].q[2] * st[i].q[2] +
-                    st[i].q[3] * st[i].q[3];
+        double qn =
+            st[i].q[0] * st[i].q[0] + st[i].q[1] * st[i].q[1] + st[i].q[2] * st[i].q[2] + st[i].q[3] * st[i].q[3];
         if (!(fabs(qn - 1) < 1e-6))
             return pfsph_fail(err, PFSPH_EINPUT, "restore: body %d's orientation is not a unit quaternion (norm^2 %g)",
                               i, qn);
@@ -1196,25 +1202,26 @@ void pfsph_sim_diffuse_totals(const pfsph_sim *sim, uint64_t *created, uint64_t 
 }
 
 int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_particles *fluid,
-                      const pfsph_particles *diffuse, uint64_t created, uint64_t refused,
-                      pfsph_error *err)
+                      const pfsph_particles *diffuse, uint64_t created, uint64_t refused, pfsph_error *err)
 {
     const pfsph_scene *s = &sim->scene;
     for (size_t i = 0; i < fluid->n; i++)
         if (fluid->phase[i] >= s->nphases || s->phases[fluid->phase[i]].kind == PFSPH_PHASE_SOLID)
-            return pfsph_fail(err, PFSPH_EINPUT, "restore: fluid particle %zu has phase %d, not a fluid phase of the scene",
-                              i, fluid->phase[i]);
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "restore: fluid particle %zu has phase %d, not a fluid phase of the scene", i,
+                              fluid->phase[i]);
     for (size_t i = 0; i < fluid->n; i++)
         if (fluid->bubble[i] > s->film.nbubbles || !(fluid->film[i] >= 0 && fluid->film[i] <= 1) ||
             (fluid->film[i] > 0 && !fluid->bubble[i]))
-            return pfsph_fail(err, PFSPH_EINPUT, "restore: fluid particle %zu has bubble %d and film fraction %g; the "
-                              "scene has %d bubbles", i, fluid->bubble[i], (double)fluid->film[i], s->film.nbubbles);
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "restore: fluid particle %zu has bubble %d and film fraction %g; the "
+                              "scene has %d bubbles",
+                              i, fluid->bubble[i], (double)fluid->film[i], s->film.nbubbles);
     if (sim->df && !diffuse)
         return pfsph_fail(err, PFSPH_EINPUT, "restore: the scene has diffuse particles on but the state has none");
     if (!sim->df && diffuse && diffuse->n)
         return pfsph_fail(err, PFSPH_EINPUT, "restore: the state has diffuse particles but the scene has diffuse off");
-    if (!(st->time >= 0) || !isfinite(st->time))
-        return pfsph_fail(err, PFSPH_EINPUT, "restore: bad time %g", st->time);
+    if (!(st->time >= 0) || !isfinite(st->time)) return pfsph_fail(err, PFSPH_EINPUT, "restore: bad time %g", st->time);
     pfsph_particles *f = &sim->fluid;
     if (fluid->n > f->cap && pfsph_particles_reserve(f, fluid->n) != PFSPH_OK)
         return pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory for %zu fluid particles", fluid->n);
@@ -1222,9 +1229,12 @@ int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_par
         return pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory for %zu fluid particles", fluid->n);
     if (sim->df) {
         int rc = pfsph_diffuse_import(sim->df, diffuse, created, refused);
-        if (rc == PFSPH_ENOMEM) return pfsph_fail(err, rc, "restore: out of memory for %zu diffuse particles", diffuse->n);
-        if (rc) return pfsph_fail(err, rc, "restore: %zu diffuse particles exceed diffuse.max_particles or carry an unknown type",
-                                  diffuse->n);
+        if (rc == PFSPH_ENOMEM)
+            return pfsph_fail(err, rc, "restore: out of memory for %zu diffuse particles", diffuse->n);
+        if (rc)
+            return pfsph_fail(err, rc,
+                              "restore: %zu diffuse particles exceed diffuse.max_particles or carry an unknown type",
+                              diffuse->n);
     }
     for (int k = 0; k < PFSPH_NFIELDS; k++)
         if (fluid->n) memcpy(f->f[k], fluid->f[k], fluid->n * sizeof(pfsph_real));
@@ -1286,8 +1296,8 @@ static int pair_ok(const pfsph_sim *sim, int a, int b, const char *what, pfsph_e
     if (!s->pairwise.enabled || !sim->pw)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: the scene has pair forces off (no \"pairwise\" block)", what);
     if (a < 0 || b < 0 || a >= s->nphases || b >= s->nphases)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: phase index %d or %d out of range (the scene has %d phases)", what,
-                          a, b, s->nphases);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: phase index %d or %d out of range (the scene has %d phases)", what, a,
+                          b, s->nphases);
     return PFSPH_OK;
 }
 
@@ -1350,11 +1360,12 @@ int pfsph_sim_set_pair_contact_angle(pfsph_sim *sim, int a, int b, double deg, p
 int pfsph_sim_drag_body(pfsph_sim *sim, int body, const double target[3], pfsph_error *err)
 {
     int nb = pfsph_bodies_count(sim->bodies);
-    if (body < 0 || body >= nb)
-        return pfsph_fail(err, PFSPH_EINPUT, "drag: no body %d (the scene has %d)", body, nb);
+    if (body < 0 || body >= nb) return pfsph_fail(err, PFSPH_EINPUT, "drag: no body %d (the scene has %d)", body, nb);
     if (!pfsph_bodies_draggable(sim->bodies, body))
-        return pfsph_fail(err, PFSPH_EINPUT, "drag: body \"%s\" is moved by keyframes; dynamic bodies and kinematic "
-                          "bodies without keyframes can be dragged", pfsph_bodies_name(sim->bodies, body));
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "drag: body \"%s\" is moved by keyframes; dynamic bodies and kinematic "
+                          "bodies without keyframes can be dragged",
+                          pfsph_bodies_name(sim->bodies, body));
     /* no faster than the flows the scene is set up for (a tenth of its sound speed, Mach 0.1),
      * and well inside the blow-up bound */
     double vmax = fmin(0.1 * sim->sound_speed, 0.2 * sim->solver->speed_bound(sim->solver_state, &sim->ctx));

@@ -282,8 +282,8 @@ tu_relax tu_shape_relax(int dim, int nl, int ns, int seed, double t_end, double 
             navg++;
         }
         if (i % (int)lround(0.5 / dt_s) == 0)
-            print_message("  seed %d t = %.2f s: moment ratio %.4f, %.4f %% of pairs closer than d/2\n",
-                          seed, pfsph_sim_time(sim), st.ratio, 100 * st.close);
+            print_message("  seed %d t = %.2f s: moment ratio %.4f, %.4f %% of pairs closer than d/2\n", seed,
+                          pfsph_sim_time(sim), st.ratio, 100 * st.close);
     }
     r.cpu = ((double)clock() / CLOCKS_PER_SEC) - c0;
     r.ratio /= navg;

@@ -24,7 +24,6 @@ unsigned char *tu_slurp(const char *path, size_t *len);
 /* dir_a/name and dir_b/name have the same bytes (fails the test otherwise, naming both). */
 void tu_assert_same_file(const char *dir_a, const char *dir_b, const char *name);
 
-
 /* Least-squares line y = icpt + slope x through n points, and its coefficient of determination
  * r2 (0 when y does not vary). */
 typedef struct tu_line {

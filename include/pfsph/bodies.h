@@ -22,8 +22,8 @@ typedef struct pfsph_body_state {
  * file), sample each surface with particles appended to `boundary` (ids after those already
  * there; aux = Akinci volume over the body's own particles), and set up the dynamics with
  * the scene's static solids as fixed colliders. */
-int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing,
-                        pfsph_particles *boundary, pfsph_error *err);
+int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing, pfsph_particles *boundary,
+                        pfsph_error *err);
 void pfsph_bodies_destroy(pfsph_bodies *b); /* NULL is a no-op */
 int pfsph_bodies_count(const pfsph_bodies *b);
 
@@ -47,8 +47,7 @@ double pfsph_bodies_vmax(const pfsph_bodies *b);
 const char *pfsph_bodies_name(const pfsph_bodies *b, int i);
 void pfsph_bodies_get_state(const pfsph_bodies *b, int i, pfsph_body_state *st);
 /* Put a saved state back (checkpoints); particles in `boundary` follow. */
-void pfsph_bodies_set_state(pfsph_bodies *b, int i, const pfsph_body_state *st,
-                            pfsph_particles *boundary);
+void pfsph_bodies_set_state(pfsph_bodies *b, int i, const pfsph_body_state *st, pfsph_particles *boundary);
 /* Fluid force and torque on body i in the last step (about its centre of mass). */
 void pfsph_bodies_last_force(const pfsph_bodies *b, int i, double f[3], double tq[3]);
 double pfsph_bodies_mass(const pfsph_bodies *b, int i);

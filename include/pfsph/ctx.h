@@ -14,11 +14,11 @@
 /* What every stage may read. Fluid arrays are in grid order (grid sorted this step). */
 typedef struct pfsph_ctx {
     int dim;
-    pfsph_real spacing;  /* initial particle spacing d = 2 r [m] */
-    pfsph_real h;        /* SPH support radius [m] */
-    pfsph_real V0;       /* rest particle volume d^dim */
-    pfsph_real nd0;      /* rest number density 1 / V0 */
-    pfsph_kernel kern;   /* support h */
+    pfsph_real spacing;        /* initial particle spacing d = 2 r [m] */
+    pfsph_real h;              /* SPH support radius [m] */
+    pfsph_real V0;             /* rest particle volume d^dim */
+    pfsph_real nd0;            /* rest number density 1 / V0 */
+    pfsph_kernel kern;         /* support h */
     pfsph_particles *fluid;    /* fluid and gas particles */
     pfsph_particles *boundary; /* static solid particles; aux = Akinci volume [m^d] */
     pfsph_grid *grid;          /* fluid grid; cell >= max radius in use */
@@ -27,29 +27,29 @@ typedef struct pfsph_ctx {
      * the density stage when the solver asks for lists; NULL otherwise. */
     const struct pfsph_nlist *nlist;
     const struct pfsph_nlist *nlist_b; /* the same step's boundary neighbours within h */
-    pfsph_real mass[PFSPH_MAX_PHASES];         /* particle mass per phase: rho0 * V0 */
+    pfsph_real mass[PFSPH_MAX_PHASES]; /* particle mass per phase: rho0 * V0 */
     pfsph_real rest_density[PFSPH_MAX_PHASES];
-    pfsph_real nu[PFSPH_MAX_PHASES];           /* kinematic viscosity per phase */
+    pfsph_real nu[PFSPH_MAX_PHASES]; /* kinematic viscosity per phase */
     /* Wall friction per wall model w (the boundary set's `wall`): a fluid particle of viscosity
      * nu feels the Akinci friction of viscosity wall_scale[w] nu + wall_nu[w] from a wall
      * particle of model w (no slip: 1, 0; free slip: 0, 0; a solid's own viscosity: 0, nu_w).
      * nwalls <= 1: every wall is the default, and the friction loop skips the table. */
     int nwalls;
     pfsph_real wall_scale[PFSPH_MAX_WALLS], wall_nu[PFSPH_MAX_WALLS];
-    pfsph_real wall_nu_max;                    /* largest wall_nu */
+    pfsph_real wall_nu_max;   /* largest wall_nu */
     pfsph_real *ax, *ay, *az; /* per-step non-pressure acceleration of fluid particles */
     pfsph_real *nd;           /* per-step number density of fluid particles (Eq. 23) */
     int pressure_done;        /* this step's forces stage also wrote fluid->p and the pressure
                                * acceleration (one walk, solver eos; src/sim.c st_forces) */
     /* the model (copied from the scene by the simulation; physics never sees the scene) */
-    double gravity[3];                 /* m/s^2 */
+    double gravity[3];                   /* m/s^2 */
     double domain_min[3], domain_max[3]; /* fluid leaving it is removed */
-    uint64_t seed;                     /* for counter-based random numbers */
+    uint64_t seed;                       /* for counter-based random numbers */
     int nphases;
-    const pfsph_phase *phases;         /* nphases entries */
+    const pfsph_phase *phases;             /* nphases entries */
     const pfsph_pairwise_params *pairwise; /* resolved; pairwise->enabled may be false */
     const pfsph_diffuse_params *diffuse;
-    const pfsph_film_params *film;     /* bubbles in air; NULL or nbubbles 0: none */
+    const pfsph_film_params *film; /* bubbles in air; NULL or nbubbles 0: none */
     double time, dt;
     uint64_t step;
 } pfsph_ctx;

@@ -11,11 +11,6 @@
 #include "pfsph/particles.h"
 #include "pfsph/ctx.h"
 
-
-
-
-
-
 typedef struct pfsph_diffuse pfsph_diffuse;
 
 /* Create the diffuse system of a simulation: parameters from ctx->scene->diffuse, kernel, grid
@@ -40,17 +35,15 @@ void pfsph_diffuse_totals(const pfsph_diffuse *d, uint64_t *created, uint64_t *r
 /* Replace the live set and the totals (checkpoint restore, docs/checkpoints.md): every field of
  * ps is copied, ids and next_id included. Returns PFSPH_OK, PFSPH_ENOMEM, or PFSPH_EINPUT when
  * ps holds more than max_particles or an unknown type. */
-int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created,
-                         uint64_t refused);
+int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created, uint64_t refused);
 
 /* Insert a diffuse particle (tests, restarts). Returns its index or -1 (cap or ENOMEM). */
-long pfsph_diffuse_add(pfsph_diffuse *d, const pfsph_real x[3], const pfsph_real v[3], int type,
-                       pfsph_real lifetime);
+long pfsph_diffuse_add(pfsph_diffuse *d, const pfsph_real x[3], const pfsph_real v[3], int type, pfsph_real lifetime);
 
 /* Diffusion potentials of one fluid particle i (Eqs. 9, 13, 15; NOTES 13-14), evaluated with
  * the same neighbour rules as the step: v_diff [m/s], E [J], R_D in [0, 1]. For tests. */
-void pfsph_diffuse_potentials(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i,
-                              double *v_diff, double *energy, double *rate);
+void pfsph_diffuse_potentials(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i, double *v_diff, double *energy,
+                              double *rate);
 
 /* Eq. 14 with NOTES 14: 0 below lo, 1 above hi, linear between. */
 static inline double pfsph_diffuse_phi(double m, double lo, double hi)
@@ -59,6 +52,5 @@ static inline double pfsph_diffuse_phi(double m, double lo, double hi)
     if (m >= hi) return 1.0;
     return (m - lo) / (hi - lo);
 }
-
 
 #endif

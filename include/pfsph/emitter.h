@@ -16,18 +16,18 @@
 
 /* What a checkpoint stores of one emitter: all a resumed run needs to continue bit for bit. */
 typedef struct pfsph_emitter_state {
-    double debt;       /* layers owed, in [0, 1) between steps (volume owed / layer volume) */
-    uint64_t emitted;  /* particles created (each took a fluid id) */
-    uint64_t refused;  /* sites skipped because a particle was closer than 0.8 d */
-    uint64_t pushed;   /* particles in front of the opening given the jet's velocity (inlet) */
+    double debt;      /* layers owed, in [0, 1) between steps (volume owed / layer volume) */
+    uint64_t emitted; /* particles created (each took a fluid id) */
+    uint64_t refused; /* sites skipped because a particle was closer than 0.8 d */
+    uint64_t pushed;  /* particles in front of the opening given the jet's velocity (inlet) */
 } pfsph_emitter_state;
 
 /* What an emitter resolved to on the lattice (for `pfsph check` and the docs). */
 typedef struct pfsph_emitter_info {
-    size_t sites;       /* particles per layer */
-    double speed;       /* entry speed along the direction [m/s] */
-    double rate;        /* volume rate [m^3/s, m^2/s in 2D]: sites V0 v_n / d */
-    double layer_rate;  /* layers per second: v_n / d */
+    size_t sites;      /* particles per layer */
+    double speed;      /* entry speed along the direction [m/s] */
+    double rate;       /* volume rate [m^3/s, m^2/s in 2D]: sites V0 v_n / d */
+    double layer_rate; /* layers per second: v_n / d */
 } pfsph_emitter_info;
 
 typedef struct pfsph_emitters pfsph_emitters;

@@ -23,13 +23,13 @@
  * in (i, j) when c is. apart: i and j belong to two different bubbles; their gases are kept
  * apart by the films between them, so the gas-gas term is left out (docs/film.md: without
  * this two touching bubbles of one gas coalesce into one drop within 0.25 s). */
-static inline double pfsph_film_pair_c(const double (*c)[PFSPH_MAX_PHASES], const int *film,
-                                       int pi, double a, int pj, double b, bool apart)
+static inline double pfsph_film_pair_c(const double (*c)[PFSPH_MAX_PHASES], const int *film, int pi, double a, int pj,
+                                       double b, bool apart)
 {
     const int fi = a > 0 && film[pi] >= 0 ? film[pi] : pi;
     const int fj = b > 0 && film[pj] >= 0 ? film[pj] : pj;
     return a * b * c[fi][fj] + a * (1 - b) * c[fi][pj] + (1 - a) * b * c[pi][fj] +
-           (apart ? 0.0 : (1 - a) * (1 - b) * c[pi][pj]); /* Eq. 24 */
+        (apart ? 0.0 : (1 - a) * (1 - b) * c[pi][pj]); /* Eq. 24 */
 }
 
 typedef struct pfsph_film pfsph_film;
@@ -39,8 +39,8 @@ typedef struct pfsph_film pfsph_film;
  * fp->volume = t d^(dim-1) N_s(0) (the film's area at the start is its surface-particle count
  * times d^(dim-1), so a(0) = t / d), and checks that a volume given directly makes a(0) <= 1;
  * on failure err names the block, the key and the value. */
-int pfsph_film_create(pfsph_film **out, const pfsph_ctx *ctx, pfsph_film_params *fp,
-                      const char *source, pfsph_error *err);
+int pfsph_film_create(pfsph_film **out, const pfsph_ctx *ctx, pfsph_film_params *fp, const char *source,
+                      pfsph_error *err);
 void pfsph_film_destroy(pfsph_film *fm); /* NULL is a no-op */
 
 /* The stage (after the grid sort and the shift, before the density): detects each bubble's

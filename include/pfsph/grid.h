@@ -13,22 +13,22 @@
 
 typedef struct pfsph_grid {
     int dim;
-    pfsph_real lo[3], hi[3]; /* extent of the cells [m] */
+    pfsph_real lo[3], hi[3];           /* extent of the cells [m] */
     pfsph_real keep_lo[3], keep_hi[3]; /* particles outside this box are removed by sort
                                         * (defaults to the cell extent) */
     pfsph_real cell, inv_cell;
-    int reach;          /* a query walks reach cells each way: it covers reach * cell (h) */
-    int reach_far;      /* the same for the far queries (k h of the pair forces), <= 3 */
-    int nc[3];          /* cells per axis (nc[2] == 1 in 2D) */
+    int reach;     /* a query walks reach cells each way: it covers reach * cell (h) */
+    int reach_far; /* the same for the far queries (k h of the pair forces), <= 3 */
+    int nc[3];     /* cells per axis (nc[2] == 1 in 2D) */
     size_t ncells;
-    uint32_t *start;    /* ncells + 1 entries: cell c holds [start[c], start[c+1]) */
-    uint32_t *key;      /* scratch, per particle */
-    uint32_t *perm;     /* scratch, per particle */
-    void *tmp;          /* scratch for the permutation */
-    int want_near;      /* set by the owner: pfsph_grid_sort fills near */
-    uint8_t *near;      /* ncells entries (or NULL): 0 iff no cell within reach of c holds a
+    uint32_t *start;   /* ncells + 1 entries: cell c holds [start[c], start[c+1]) */
+    uint32_t *key;     /* scratch, per particle */
+    uint32_t *perm;    /* scratch, per particle */
+    void *tmp;         /* scratch for the permutation */
+    int want_near;     /* set by the owner: pfsph_grid_sort fills near */
+    uint8_t *near;     /* ncells entries (or NULL): 0 iff no cell within reach of c holds a
                          * particle (pfsph_grid_near) */
-    uint8_t *near_far;  /* the same for reach_far (pfsph_grid_near_far), when reach_far > reach */
+    uint8_t *near_far; /* the same for reach_far (pfsph_grid_near_far), when reach_far > reach */
     size_t cap;
 } pfsph_grid;
 
@@ -39,8 +39,7 @@ typedef struct pfsph_ranges {
 
 /* Grid over [lo, hi] with cells of edge `cell`; queries reach one cell each way (set
  * g->reach = 2 after init for cells of half the query radius). */
-int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_real hi[3],
-                    pfsph_real cell);
+int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_real hi[3], pfsph_real cell);
 void pfsph_grid_free(pfsph_grid *g);
 
 /* Remove particles outside the domain (or with non-finite positions; count added to *removed
@@ -50,8 +49,8 @@ int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed);
 /* Index ranges (into the sorted set) of the cells around a point; the union covers every
  * particle within distance R * g->cell of (x, y, z) (R <= 3). The point may lie outside the
  * domain. */
-static inline void pfsph_grid_ranges_reach(const pfsph_grid *g, pfsph_real x, pfsph_real y,
-                                           pfsph_real z, int R, pfsph_ranges *r)
+static inline void pfsph_grid_ranges_reach(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z, int R,
+                                           pfsph_ranges *r)
 {
     int c[3];
     const pfsph_real p[3] = {x, y, z};
@@ -79,8 +78,7 @@ static inline void pfsph_grid_ranges_reach(const pfsph_grid *g, pfsph_real x, pf
     }
 }
 
-static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_real y,
-                                     pfsph_real z, pfsph_ranges *r)
+static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z, pfsph_ranges *r)
 {
     pfsph_grid_ranges_reach(g, x, y, z, g->reach, r);
 }
@@ -114,8 +112,7 @@ static inline int pfsph_grid_near_far(const pfsph_grid *g, pfsph_real x, pfsph_r
 }
 
 /* Ranges covering every particle within g->reach_far * g->cell (the pair forces' k h). */
-static inline void pfsph_grid_ranges_far(const pfsph_grid *g, pfsph_real x, pfsph_real y,
-                                         pfsph_real z, pfsph_ranges *r)
+static inline void pfsph_grid_ranges_far(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z, pfsph_ranges *r)
 {
     pfsph_grid_ranges_reach(g, x, y, z, g->reach_far, r);
 }
@@ -126,8 +123,8 @@ static inline void pfsph_grid_ranges_far(const pfsph_grid *g, pfsph_real x, pfsp
  * rows and their order are those of pfsph_grid_ranges_reach, with some dropped and trimmed.
  * Only for particles at their sorted positions (a particle moved after the sort may sit in a
  * cell outside the band). */
-static inline void pfsph_grid_ranges_radius(const pfsph_grid *g, pfsph_real x, pfsph_real y,
-                                            pfsph_real z, pfsph_real rad, pfsph_ranges *r)
+static inline void pfsph_grid_ranges_radius(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z,
+                                            pfsph_real rad, pfsph_ranges *r)
 {
     int lo[3], hi[3];
     const pfsph_real p[3] = {x, y, z};
@@ -160,7 +157,6 @@ static inline void pfsph_grid_ranges_radius(const pfsph_grid *g, pfsph_real x, p
 
 /* Test oracle: indices j != i of ps with |x_i - x_j| < radius, ascending; returns the count
  * (writes at most max). O(n). */
-size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real radius,
-                             uint32_t *out, size_t max);
+size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real radius, uint32_t *out, size_t max);
 
 #endif

@@ -11,22 +11,20 @@
 /* What to write besides positions, velocities, density, pressure, phase (always written, but see
  * `diffuse`). */
 typedef struct pfsph_io_opts {
-    int dim;              /* 2 or 3: 2D files still carry z = 0 */
-    bool write_id;        /* uint32 "id" */
-    bool write_speed;     /* float "speed" = |v| */
-    const char *aux_name; /* name for the aux field, NULL to skip it (e.g. "volume", "lifetime") */
-    double time;          /* simulated time, stored as field data / comment */
+    int dim;                      /* 2 or 3: 2D files still carry z = 0 */
+    bool write_id;                /* uint32 "id" */
+    bool write_speed;             /* float "speed" = |v| */
+    const char *aux_name;         /* name for the aux field, NULL to skip it (e.g. "volume", "lifetime") */
+    double time;                  /* simulated time, stored as field data / comment */
     const uint8_t *surface_layer; /* per particle, "surface_layer" (UInt8 / uchar: 0 interior,
                            * 1 outermost layer, 2 the next one in); NULL to skip */
-    bool write_film;      /* the film fraction of bubbles in air, "film" (docs/film.md) */
-    bool diffuse;         /* a diffuse set: the class is written as "type" (0 spray, 1 foam,
+    bool write_film;              /* the film fraction of bubbles in air, "film" (docs/film.md) */
+    bool diffuse;                 /* a diffuse set: the class is written as "type" (0 spray, 1 foam,
                            * 2 bubble), no density or pressure (readers put "type" in phase) */
 } pfsph_io_opts;
 
-int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o,
-                    pfsph_error *err);
-int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o,
-                    pfsph_error *err);
+int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o, pfsph_error *err);
+int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o, pfsph_error *err);
 /* Read files written by the functions above into ps (initialised by the callee; free with
  * pfsph_particles_free). Fields absent from the file are zero. *time may be NULL. */
 int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_error *err);

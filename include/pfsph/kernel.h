@@ -6,8 +6,8 @@
 #include "pfsph/types.h"
 
 typedef struct pfsph_kernel {
-    int dim;           /* 2 or 3 */
-    pfsph_real h;      /* support radius [m] */
+    int dim;      /* 2 or 3 */
+    pfsph_real h; /* support radius [m] */
     pfsph_real inv_h;
     pfsph_real sigma;  /* normalisation: 40/(7 pi h^2) in 2D, 8/(pi h^3) in 3D */
     pfsph_real gsigma; /* sigma / h, for the derivative */
@@ -35,8 +35,7 @@ static inline pfsph_real pfsph_kernel_dw_r(const pfsph_kernel *k, pfsph_real r)
     pfsph_real q = r * k->inv_h;
     if (q >= (pfsph_real)1 || r <= (pfsph_real)0) return 0;
     pfsph_real g;
-    if (q <= (pfsph_real)0.5)
-        g = (pfsph_real)6 * ((pfsph_real)3 * q * q - (pfsph_real)2 * q);
+    if (q <= (pfsph_real)0.5) g = (pfsph_real)6 * ((pfsph_real)3 * q * q - (pfsph_real)2 * q);
     else {
         pfsph_real t = (pfsph_real)1 - q;
         g = (pfsph_real)-6 * t * t;

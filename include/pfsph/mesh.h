@@ -20,8 +20,7 @@ typedef struct pfsph_mesh {
  * messages, which read "<source>:<line>: <reason>". Returns PFSPH_EINPUT on bad input,
  * PFSPH_ENOMEM. On error *m is left empty. `text` need not be NUL-terminated (len bytes are
  * read). *m is overwritten, not freed first. Subset and limits: docs/meshes.md. */
-int pfsph_mesh_parse_obj(pfsph_mesh *m, const char *text, size_t len, const char *source,
-                         pfsph_error *err);
+int pfsph_mesh_parse_obj(pfsph_mesh *m, const char *text, size_t len, const char *source, pfsph_error *err);
 /* Read a file and parse it (a missing or unreadable file is PFSPH_EINPUT naming the path). */
 int pfsph_mesh_load_obj(pfsph_mesh *m, const char *path, pfsph_error *err);
 
@@ -36,8 +35,7 @@ int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *e
  * solid a closed mesh bounds, for unit density (multiply volume and tensor by the density).
  * Off-diagonal entries are minus the products of inertia. Exact for the polyhedron (Eberly /
  * Mirtich); any output pointer may be NULL. */
-void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[3],
-                                double inertia[9]);
+void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[3], double inertia[9]);
 
 /* Bounding box of the vertices used by triangles (unused vertices do not count). Returns 0, or
  * -1 when a coordinate is not finite or an index is out of range. */
@@ -48,8 +46,7 @@ int pfsph_mesh_bounds(const pfsph_mesh *m, double lo[3], double hi[3]);
  * spacing; about area / (spacing^2 sqrt(3)/2) points; corners and sharp edges (dihedral
  * above 30 degrees) always get points. PFSPH_EINPUT for a spacing that is not positive and
  * finite or that would need more than about 2e7 points; on error *pts is NULL and *n 0. */
-int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts, size_t *n,
-                              pfsph_error *err);
+int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts, size_t *n, pfsph_error *err);
 
 /* Primitive shapes as closed meshes centred at the origin (cylinder along axis 0/1/2;
  * `segments` around curved surfaces; the sphere is an icosphere with about `segments` edges

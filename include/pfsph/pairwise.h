@@ -11,20 +11,11 @@
 #include "pfsph/shifting.h"
 #include "pfsph/ctx.h"
 
-
-
-
-
-
-
-
-
 /* Anisotropic filter T (Eqs. 8-11) from a symmetric dim x dim covariance C (Eq. 7), row-major
  * 3x3 storage (2D uses the upper-left 2x2; T[2][2] = 1). Eigenvalues are normalised by the
  * largest one before the eps_min clamp; the spectral norm is used in Eq. 11, so an isotropic C
  * gives T = I. A zero C (no neighbours) gives T = I. */
-void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, double eps_min,
-                                  double T[3][3]);
+void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, double eps_min, double T[3][3]);
 
 typedef struct pfsph_pairwise pfsph_pairwise;
 
@@ -45,8 +36,7 @@ void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx);
  * pfsph__number_density, in this walk's order: equal to rounding): the density and pair stages
  * in one walk of the k h neighbourhood (sim.c). With pair forces disabled the accelerations are
  * 0 and nd is still computed. */
-void pfsph_pairwise_apply_density(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd,
-                                  pfsph_real *const acc[3]);
+void pfsph_pairwise_apply_density(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd, pfsph_real *const acc[3]);
 /* The largest pair-force acceleration |F_i^int / m_i| of the last apply [m/s^2] (0 for NULL). */
 double pfsph_pairwise_amax(const pfsph_pairwise *pw);
 
@@ -58,21 +48,19 @@ void pfsph_pairwise_shift(pfsph_pairwise *pw, const pfsph_ctx *ctx);
 /* Diagnostics for tests and measurements, same neighbour loops as apply. For each fluid
  * particle i: vir[i] = sum_j r_ij . F_ji [J] (F_ji the filtered force on i from j, fluid and
  * solid neighbours); T (if not NULL) receives the 9 entries of T_i row-major at T + 9 i. */
-void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir,
-                             double *T);
+void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T);
 
 /* As pfsph_pairwise_diagnose, and (if W is not NULL) the virial tensor of each fluid particle,
  * W_i = sum_j F_ji (x) r_ij [J], 9 entries row-major at W + 9 i (its trace is vir[i]); for the
  * stress-anisotropy route to the Laplace pressure (docs/pairwise.md). */
-void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx,
-                                    double *vir, double *T, double *W);
+void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T, double *W);
 
 /* Mechanical (virial) pressure of each fluid particle [Pa; 2D: N/m]: the virial of the solver's
  * pressure force plus the pair-force virial n_i / (2 dim) sum_j r_ij . F_ji plus the kinetic part
  * n_i m_i |u_i|^2 / dim of its peculiar velocity u_i (docs/thermostat.md). p is the pressure the
  * solver pushed with this step (DFSPH: density plus divergence pressure); NULL: fluid->p. vir is
  * scratch of n doubles. Needs ctx->nd; the pair forces may be off (virial 0). */
-void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, const pfsph_real *p,
-                                        double *vir, pfsph_real *out);
+void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, const pfsph_real *p, double *vir,
+                                        pfsph_real *out);
 
 #endif

@@ -14,11 +14,11 @@ enum pfsph_phase_kind { PFSPH_PHASE_FLUID = 0, PFSPH_PHASE_GAS = 1, PFSPH_PHASE_
 
 typedef struct pfsph_phase {
     char name[PFSPH_NAME_LEN];
-    int kind;              /* enum pfsph_phase_kind */
-    double rest_density;   /* kg/m^3 */
-    double viscosity;      /* kinematic, m^2/s */
-    float color[3];        /* 0..1 */
-    bool color_set;        /* "color" given in the scene (walls are drawn grey otherwise) */
+    int kind;            /* enum pfsph_phase_kind */
+    double rest_density; /* kg/m^3 */
+    double viscosity;    /* kinematic, m^2/s */
+    float color[3];      /* 0..1 */
+    bool color_set;      /* "color" given in the scene (walls are drawn grey otherwise) */
 } pfsph_phase;
 
 /* ---- particle shifting (physics/shifting.c, include/pfsph/shifting.h) ---- */
@@ -58,23 +58,23 @@ enum pfsph_pw_center {
 #define PFSPH_THERMO_REDUCED_DEFAULT 0.01
 
 typedef struct pfsph_thermostat_params {
-    bool enabled;     /* default: on wherever pair forces act */
-    double kT;        /* k_B T [J] (2D: J per metre of depth); < 0: from `reduced` */
-    double reduced;   /* kT = reduced * sigma_ref * d^(dim-1) when kT is not given */
+    bool enabled;   /* default: on wherever pair forces act */
+    double kT;      /* k_B T [J] (2D: J per metre of depth); < 0: from `reduced` */
+    double reduced; /* kT = reduced * sigma_ref * d^(dim-1) when kT is not given */
     /* Filled by pfsph_pairwise_resolve. */
-    double kT_resolved;  /* the temperature the step uses; 0: thermostat off */
-    double sigma_ref;    /* largest liquid-air surface tension of the coefficient table */
-    double rho_ref;      /* rest density of that liquid: kT is its temperature */
+    double kT_resolved; /* the temperature the step uses; 0: thermostat off */
+    double sigma_ref;   /* largest liquid-air surface tension of the coefficient table */
+    double rho_ref;     /* rest density of that liquid: kT is its temperature */
 } pfsph_thermostat_params;
 
 typedef struct pfsph_pairwise_params {
     bool enabled;
-    double k;         /* radius enlargement, default (80/30)^(1/3) (Eq. 5) */
-    bool filter;      /* anisotropic filter on (Eq. 12) */
-    double eta;       /* Eq. 11, default 0.2 */
-    double eps_min;   /* Eq. 8 clamp on eigenvalues normalised by the largest one, default 0.5 */
-    int center;       /* enum pfsph_pw_center */
-    pfsph_shift_params shift; /* particle shifting stage (off unless the scene asks) */
+    double k;                       /* radius enlargement, default (80/30)^(1/3) (Eq. 5) */
+    bool filter;                    /* anisotropic filter on (Eq. 12) */
+    double eta;                     /* Eq. 11, default 0.2 */
+    double eps_min;                 /* Eq. 8 clamp on eigenvalues normalised by the largest one, default 0.5 */
+    int center;                     /* enum pfsph_pw_center */
+    pfsph_shift_params shift;       /* particle shifting stage (off unless the scene asks) */
     pfsph_thermostat_params thermo; /* thermal noise (on unless the scene says otherwise) */
     /* Coefficient matrix c[a][b] over scene phases (solids included), symmetric, >= 0.
      * Pair force c m_i m_j f(r): c in N/kg^2 in 3D; in 2D masses are per metre of depth. */
@@ -83,24 +83,24 @@ typedef struct pfsph_pairwise_params {
     bool c_set[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     /* Targets as written in the scene; resolved into c by pfsph_pairwise_resolve. */
     bool sigma_set[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
-    double sigma[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];   /* N/m (2D: N/m per metre of depth) */
+    double sigma[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES]; /* N/m (2D: N/m per metre of depth) */
     bool angle_set[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     double angle_deg[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     /* Filled by pfsph_pairwise_resolve (for the report). */
     bool resolved;
-    double radius;    /* k*h [m] */
-    double lambda;    /* Eq. 13 constant for the cosine force [m^(dim+2)] */
-    double theta;     /* reduced temperature kT / (sigma_ref d^(dim-1)); 0: thermostat off */
+    double radius;       /* k*h [m] */
+    double lambda;       /* Eq. 13 constant for the cosine force [m^(dim+2)] */
+    double theta;        /* reduced temperature kT / (sigma_ref d^(dim-1)); 0: thermostat off */
     double sigma_factor; /* measured tension / Eq. 13 at theta (pfsph_pairwise_sigma_factor) */
     /* Viscosity correction (docs/thermostat.md, "The viscosity of the hot liquid"): the hot
      * pair-force liquid has a structural viscosity of its own and multiplies the Morris
      * viscosity it is given, nu_eff = nu_struct + gain nu_morris. With the scene key
      * `viscosity_correction` on, each pair-force phase's Morris viscosity becomes
      * max((nu - nu_struct) / gain, nu_floor), so that nu_eff is the phase's `viscosity`. */
-    bool visc_correct;                      /* scene key; default off */
-    double nu_morris[PFSPH_MAX_PHASES];     /* the viscosity the step applies [m^2/s] */
-    double nu_struct[PFSPH_MAX_PHASES];     /* estimated structural viscosity (0: no table) */
-    double nu_floor[PFSPH_MAX_PHASES];      /* smallest Morris viscosity applied */
+    bool visc_correct;                  /* scene key; default off */
+    double nu_morris[PFSPH_MAX_PHASES]; /* the viscosity the step applies [m^2/s] */
+    double nu_struct[PFSPH_MAX_PHASES]; /* estimated structural viscosity (0: no table) */
+    double nu_floor[PFSPH_MAX_PHASES];  /* smallest Morris viscosity applied */
 } pfsph_pairwise_params;
 
 void pfsph_pairwise_defaults(pfsph_pairwise_params *p);
@@ -156,9 +156,9 @@ double pfsph_pairwise_visc_struct(int dim, double theta);
  * the surface count so that the film's liquid volume stays V_L (docs/film.md). */
 typedef struct pfsph_film_params {
     int nbubbles;
-    int film[PFSPH_MAX_PHASES];     /* per gas phase: its bubbles' film liquid phase, -1: none */
-    int gas[PFSPH_MAX_BUBBLES];     /* the bubble's gas phase */
-    int block[PFSPH_MAX_BUBBLES];   /* the scene block it came from (messages) */
+    int film[PFSPH_MAX_PHASES];          /* per gas phase: its bubbles' film liquid phase, -1: none */
+    int gas[PFSPH_MAX_BUBBLES];          /* the bubble's gas phase */
+    int block[PFSPH_MAX_BUBBLES];        /* the scene block it came from (messages) */
     double thickness[PFSPH_MAX_BUBBLES]; /* film thickness at the start [m], 0: volume given */
     double volume[PFSPH_MAX_BUBBLES];    /* liquid volume of the film [m^dim; 2D m^2 per metre];
                                             from the thickness: filled by the simulation */
@@ -170,8 +170,12 @@ void pfsph_film_defaults(pfsph_film_params *p);
 /* ---- diffuse material (physics/diffuse.c, include/pfsph/diffuse.h) ---- */
 
 /* Diffuse particle types, stored in pfsph_particles.phase. */
-enum pfsph_diffuse_type { PFSPH_DIFFUSE_SPRAY = 0, PFSPH_DIFFUSE_FOAM = 1,
-                          PFSPH_DIFFUSE_BUBBLE = 2, PFSPH_DIFFUSE_NTYPES = 3 };
+enum pfsph_diffuse_type {
+    PFSPH_DIFFUSE_SPRAY = 0,
+    PFSPH_DIFFUSE_FOAM = 1,
+    PFSPH_DIFFUSE_BUBBLE = 2,
+    PFSPH_DIFFUSE_NTYPES = 3
+};
 
 /* Per-type weights of Eq. 24 and Eq. 29. */
 typedef struct pfsph_diffuse_coupling {
@@ -183,17 +187,17 @@ typedef struct pfsph_diffuse_coupling {
 
 typedef struct pfsph_diffuse_params {
     bool enabled;
-    long max_particles;    /* cap on live diffuse particles; new ones are refused beyond it */
-    double sampling_rate;  /* k_max of Eq. 16 [1/s]: particles per second per emitter at R_D=1 */
-    double phi_v_min, phi_v_max; /* Eq. 14 limits for v_diff of Eq. 13 [m/s] */
-    double phi_e_min, phi_e_max; /* Eq. 14 limits for E of Eq. 9 [J] */
-    double energy_mass;    /* mass in Eq. 9 [kg]; 0: the fluid particle's own mass */
-    double emit_radius;    /* cylinder radius r of Eq. 19 [m]; 0: the particle radius */
-    double emit_radius_scale; /* s_r (paper's k_r magnification, NOTES 16) [-] */
-    double emit_height_scale; /* s_h (paper's k_h magnification) [-] */
+    long max_particles;                /* cap on live diffuse particles; new ones are refused beyond it */
+    double sampling_rate;              /* k_max of Eq. 16 [1/s]: particles per second per emitter at R_D=1 */
+    double phi_v_min, phi_v_max;       /* Eq. 14 limits for v_diff of Eq. 13 [m/s] */
+    double phi_e_min, phi_e_max;       /* Eq. 14 limits for E of Eq. 9 [J] */
+    double energy_mass;                /* mass in Eq. 9 [kg]; 0: the fluid particle's own mass */
+    double emit_radius;                /* cylinder radius r of Eq. 19 [m]; 0: the particle radius */
+    double emit_radius_scale;          /* s_r (paper's k_r magnification, NOTES 16) [-] */
+    double emit_height_scale;          /* s_h (paper's k_h magnification) [-] */
     double lifetime_min, lifetime_max; /* initial lifetime uniform in [min, max] [s] */
-    int foam_min_neighbors; /* fewer fluid neighbours within h: spray; -1: automatic */
-    int foam_max_neighbors; /* more: bubble; -1: automatic (NOTES 18) */
+    int foam_min_neighbors;            /* fewer fluid neighbours within h: spray; -1: automatic */
+    int foam_max_neighbors;            /* more: bubble; -1: automatic (NOTES 18) */
     pfsph_diffuse_coupling type[PFSPH_DIFFUSE_NTYPES]; /* spray, foam, bubble */
 } pfsph_diffuse_params;
 
@@ -203,8 +207,8 @@ void pfsph_diffuse_defaults(pfsph_diffuse_params *p);
 /* Thresholds after resolving the automatic (-1) ones for a kernel support h and spacing d in
  * dim dimensions: 0.2 and 2/3 of the fluid neighbour count of a full support (the paper's 6 and
  * 20 of 30). */
-void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing,
-                              int *foam_min, int *foam_max);
+void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing, int *foam_min,
+                              int *foam_max);
 
 /* ---- emitters (physics/emitter.c, include/pfsph/emitter.h; docs/emitters.md) ---- */
 

@@ -8,8 +8,12 @@
 
 /* Real-valued persistent fields, in the order of the union below. */
 enum pfsph_field {
-    PFSPH_F_X, PFSPH_F_Y, PFSPH_F_Z,
-    PFSPH_F_VX, PFSPH_F_VY, PFSPH_F_VZ,
+    PFSPH_F_X,
+    PFSPH_F_Y,
+    PFSPH_F_Z,
+    PFSPH_F_VX,
+    PFSPH_F_VY,
+    PFSPH_F_VZ,
     PFSPH_F_RHO,  /* density [kg/m^3] */
     PFSPH_F_P,    /* pressure [Pa] */
     PFSPH_F_AUX,  /* per-set extra: boundary volume [m^d] / diffuse remaining lifetime [s] */
@@ -31,12 +35,12 @@ typedef struct pfsph_particles {
             pfsph_real *film;
         };
     };
-    uint8_t *phase; /* index into the phase table (fluid/boundary) or diffuse type */
-    uint8_t *wall;  /* boundary: its solid's wall model (pfsph_ctx wall tables; 0 = the
+    uint8_t *phase;  /* index into the phase table (fluid/boundary) or diffuse type */
+    uint8_t *wall;   /* boundary: its solid's wall model (pfsph_ctx wall tables; 0 = the
                      * default, no slip with the fluid's viscosity); 0 in other sets */
     uint8_t *bubble; /* fluid: 0, or k + 1 for a particle of bubble k (a block with a "bubble"
                       * key, docs/film.md); 0 in other sets */
-    uint32_t *id;   /* stable id, assigned at creation, never reused within a run */
+    uint32_t *id;    /* stable id, assigned at creation, never reused within a run */
     uint32_t next_id;
 } pfsph_particles;
 
@@ -46,8 +50,7 @@ void pfsph_particles_free(pfsph_particles *ps);
 /* Grow capacity to at least cap, keeping contents. */
 int pfsph_particles_reserve(pfsph_particles *ps, size_t cap);
 /* Append one particle (grows if needed); v may be NULL. Returns its index or -1 on ENOMEM. */
-long pfsph_particles_push(pfsph_particles *ps, const pfsph_real x[3], const pfsph_real v[3],
-                          uint8_t phase);
+long pfsph_particles_push(pfsph_particles *ps, const pfsph_real x[3], const pfsph_real v[3], uint8_t phase);
 /* Permute: new[i] = old[perm[i]] for i < n_new; n becomes n_new (drops particles not in perm).
  * tmp is scratch of at least n*sizeof(pfsph_real) bytes (NULL: allocated internally). */
 int pfsph_particles_permute(pfsph_particles *ps, const uint32_t *perm, size_t n_new, void *tmp);

@@ -7,14 +7,14 @@
 #include "pfsph/types.h"
 
 typedef struct pfsph_render_opts {
-    int width, height;     /* 0: from the scene camera or 960x540 */
-    const char *color_by;  /* NULL: scene camera's, else "phase" */
-    bool video;            /* also frames.mp4 via ffmpeg when present */
-    int first, last;       /* frame range, last < 0 for all */
-    bool quiet;            /* kept for callers; the library never prints (see progress) */
-    bool all_walls;        /* 3D: keep the walls that face the camera (default: cut away) */
-    bool no_legend;        /* no colour bar for the coloured field */
-    bool particles;        /* draw the fluid's and the bodies' particles even where
+    int width, height;    /* 0: from the scene camera or 960x540 */
+    const char *color_by; /* NULL: scene camera's, else "phase" */
+    bool video;           /* also frames.mp4 via ffmpeg when present */
+    int first, last;      /* frame range, last < 0 for all */
+    bool quiet;           /* kept for callers; the library never prints (see progress) */
+    bool all_walls;       /* 3D: keep the walls that face the camera (default: cut away) */
+    bool no_legend;       /* no colour bar for the coloured field */
+    bool particles;       /* draw the fluid's and the bodies' particles even where
                             * frames/liquid_NNNNN.ply (a surface mesh, shaded as water) and
                             * frames/surfaces_NNNNN.ply (the bodies' meshes) exist */
     /* After each PNG: done of total frames, the file written (may be NULL); and a message
@@ -39,8 +39,7 @@ void pfsph_frame_list_free(pfsph_frame_list *fl);
 /* Index of the entry numbered f, or -1. */
 int pfsph_frame_list_find(const pfsph_frame_list *fl, int f);
 
-int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count,
-                     pfsph_error *err);
+int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count, pfsph_error *err);
 
 /* The camera pfsph_render_run uses for a w x h image (the live viewer starts from it, so that
  * both show the same picture): 2D an orthographic view of the x-y plane, 3D the scene's camera
@@ -48,8 +47,8 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
 typedef struct pfsph_render_camera {
     bool ortho;
     double eye[3], right[3], up[3], fwd[3]; /* unit vectors, camera looks along fwd */
-    double f;      /* perspective: focal length in pixels; ortho: pixels per metre */
-    double cx, cy; /* ortho: world x, y at the image centre */
+    double f;                               /* perspective: focal length in pixels; ortho: pixels per metre */
+    double cx, cy;                          /* ortho: world x, y at the image centre */
     int w, h;
 } pfsph_render_camera;
 
@@ -57,8 +56,7 @@ struct pfsph_scene;
 struct pfsph_particles;
 /* boundary may be NULL (no boundary frame). */
 void pfsph_render_camera_for(const struct pfsph_scene *s, const struct pfsph_particles *fluid,
-                             const struct pfsph_particles *boundary, int w, int h,
-                             pfsph_render_camera *out);
+                             const struct pfsph_particles *boundary, int w, int h, pfsph_render_camera *out);
 
 /* The cut-away of `pfsph render` (3D): the tank walls that face the camera are left out so
  * that what stands inside the tank shows, namely wall particles within 5 particle radii of a

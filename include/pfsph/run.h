@@ -9,14 +9,14 @@
 #include "pfsph/scene.h"
 
 typedef struct pfsph_progress {
-    int frame, nframes;   /* frames done / total */
+    int frame, nframes; /* frames done / total */
     double time, end_time;
     uint64_t steps;
-    double wall_s;        /* seconds since the run started */
+    double wall_s; /* seconds since the run started */
     double steps_per_s;
     size_t n_fluid;
-    double time0;         /* simulated time this run started from (a resume's checkpoint) */
-    bool partial;         /* an update within a frame (steps; at most 4 a second), not a frame done */
+    double time0; /* simulated time this run started from (a resume's checkpoint) */
+    bool partial; /* an update within a frame (steps; at most 4 a second), not a frame done */
 } pfsph_progress;
 
 typedef void (*pfsph_progress_fn)(const pfsph_progress *p, void *user);
@@ -47,6 +47,5 @@ typedef struct pfsph_run_opts {
  * time, a directory that cannot be made, written or locked, not empty), PFSPH_EIO (writing
  * output), PFSPH_EUNSTABLE (blow-up; frames written so far are kept) or PFSPH_ENOMEM. */
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err);
-
 
 #endif

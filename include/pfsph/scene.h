@@ -33,7 +33,6 @@ enum pfsph_shape {
  * and the time step shrinks by that factor; needed at density ratios of about 100 and more). */
 enum pfsph_pressure_scale { PFSPH_PRESSURE_PHASE = 0, PFSPH_PRESSURE_COMMON };
 
-
 /* A region of fluid particles. */
 typedef struct pfsph_block {
     int shape;             /* BOX or SPHERE (or CYLINDER) */
@@ -73,30 +72,30 @@ typedef struct pfsph_solid {
 enum pfsph_body_shape { PFSPH_BODY_BOX = 0, PFSPH_BODY_SPHERE, PFSPH_BODY_CYLINDER, PFSPH_BODY_MESH };
 
 typedef struct pfsph_keyframe {
-    double t;              /* s */
-    double position[3];    /* m */
-    double rotation[3];    /* degrees about x, then y, then z (fixed axes) */
+    double t;           /* s */
+    double position[3]; /* m */
+    double rotation[3]; /* degrees about x, then y, then z (fixed axes) */
 } pfsph_keyframe;
 
 typedef struct pfsph_body_def {
     char name[PFSPH_NAME_LEN];
-    int shape;             /* enum pfsph_body_shape */
-    int phase;             /* a solid phase: pair coefficients and colour */
-    double half[3];        /* BOX half extents */
-    double radius, height; /* SPHERE, CYLINDER */
-    int axis;              /* CYLINDER, body coordinates */
-    char mesh[PFSPH_PATH_LEN]; /* MESH: OBJ path, resolved against the scene's directory */
-    double scale;          /* MESH: vertex scale */
-    double position[3];    /* m: centre of mass (a mesh is moved so that its own lies here) */
-    double rotation[3];    /* degrees, as in pfsph_keyframe */
+    int shape;                               /* enum pfsph_body_shape */
+    int phase;                               /* a solid phase: pair coefficients and colour */
+    double half[3];                          /* BOX half extents */
+    double radius, height;                   /* SPHERE, CYLINDER */
+    int axis;                                /* CYLINDER, body coordinates */
+    char mesh[PFSPH_PATH_LEN];               /* MESH: OBJ path, resolved against the scene's directory */
+    double scale;                            /* MESH: vertex scale */
+    double position[3];                      /* m: centre of mass (a mesh is moved so that its own lies here) */
+    double rotation[3];                      /* degrees, as in pfsph_keyframe */
     double velocity[3], angular_velocity[3]; /* m/s, rad/s */
-    double density;        /* kg/m^3 (per unit depth in 2D); 0: from mass */
-    double mass;           /* kg; 0: from density */
-    double inertia[3];     /* principal moments about the centre of mass in body axes [kg m^2];
+    double density;                          /* kg/m^3 (per unit depth in 2D); 0: from mass */
+    double mass;                             /* kg; 0: from density */
+    double inertia[3];                       /* principal moments about the centre of mass in body axes [kg m^2];
                             * 0: from the shape (2D: inertia[2] only, per metre of depth) */
-    double friction;       /* Coulomb coefficient of contacts */
-    double restitution;    /* of contacts, 0..1 */
-    int layers;            /* particle layers inside the surface (2: V0 volumes, 1: Akinci's) */
+    double friction;                         /* Coulomb coefficient of contacts */
+    double restitution;                      /* of contacts, 0..1 */
+    int layers;                              /* particle layers inside the surface (2: V0 volumes, 1: Akinci's) */
     bool kinematic;
     int nkeys;
     pfsph_keyframe keys[PFSPH_MAX_KEYFRAMES];
@@ -134,30 +133,30 @@ typedef struct pfsph_camera {
 typedef struct pfsph_scene {
     char source[PFSPH_PATH_LEN]; /* file it was read from ("<embedded>" for the default) */
     char name[PFSPH_NAME_LEN];
-    int dim;                   /* 2 or 3 */
-    double particle_radius;    /* m; spacing = 2 r */
-    double support_factor;     /* h = support_factor * spacing, default 2 */
-    double gravity[3];         /* m/s^2 */
+    int dim;                             /* 2 or 3 */
+    double particle_radius;              /* m; spacing = 2 r */
+    double support_factor;               /* h = support_factor * spacing, default 2 */
+    double gravity[3];                   /* m/s^2 */
     double domain_min[3], domain_max[3]; /* particles leaving it are removed */
-    int solver;                /* enum pfsph_solver */
+    int solver;                          /* enum pfsph_solver */
     /* time stepping */
-    double cfl;                /* dt <= cfl * spacing / vmax */
-    double dt_min, dt_max;     /* s */
-    double end_time;           /* s */
-    double fps;                /* frames per second of output */
+    double cfl;            /* dt <= cfl * spacing / vmax */
+    double dt_min, dt_max; /* s */
+    double end_time;       /* s */
+    double fps;            /* frames per second of output */
     uint64_t seed;
-    int threads;               /* 0: OpenMP default */
+    int threads; /* 0: OpenMP default */
     /* WCSPH */
-    double sound_speed;        /* m/s; 0 = automatic (10 x estimated max speed) */
-    double gamma;              /* Tait exponent, default 7 */
-    int pressure_scale;        /* enum pfsph_pressure_scale: the Tait pressure's rho0 */
+    double sound_speed; /* m/s; 0 = automatic (10 x estimated max speed) */
+    double gamma;       /* Tait exponent, default 7 */
+    int pressure_scale; /* enum pfsph_pressure_scale: the Tait pressure's rho0 */
     /* PCISPH and DFSPH density solve */
-    double pcisph_tolerance;   /* average relative density error; default 0.005 (PCISPH),
+    double pcisph_tolerance; /* average relative density error; default 0.005 (PCISPH),
                                   0.001 (DFSPH) */
     int pcisph_min_iter, pcisph_max_iter;
     /* DFSPH divergence solve */
-    double div_tolerance;      /* mean |D delta/Dt| dt / delta0, default 0.001 */
-    int div_max_iter;          /* 0: no divergence solve; default 100 */
+    double div_tolerance; /* mean |D delta/Dt| dt / delta0, default 0.001 */
+    int div_max_iter;     /* 0: no divergence solve; default 100 */
     /* phases */
     int nphases;
     pfsph_phase phases[PFSPH_MAX_PHASES];
@@ -167,7 +166,7 @@ typedef struct pfsph_scene {
     pfsph_solid solids[PFSPH_MAX_SOLIDS];
     int nbodies;
     pfsph_body_def bodies[PFSPH_MAX_BODIES];
-    int nemitters;                  /* nozzles that add fluid while running (docs/emitters.md) */
+    int nemitters; /* nozzles that add fluid while running (docs/emitters.md) */
     pfsph_emitter_params emitters[PFSPH_MAX_EMITTERS];
     pfsph_pairwise_params pairwise; /* see pairwise.h */
     pfsph_diffuse_params diffuse;   /* see diffuse.h */
@@ -208,8 +207,7 @@ pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h);
  * spacing [m] and SPH support h [m]; fills s->pairwise.resolved/radius/lambda. Idempotent.
  * Returns PFSPH_EINPUT with a message for impossible targets (a cross surface tension larger
  * than the cohesions allow, a contact angle on a fluid without cohesion, ...). */
-int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h,
-                           pfsph_error *err);
+int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfsph_error *err);
 
 /* Print the coefficient matrix, each target with the coefficient it produced, and the surface
  * tensions and contact angles the final matrix predicts (for `pfsph check`). */

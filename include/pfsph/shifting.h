@@ -10,9 +10,6 @@
 
 #include "pfsph/ctx.h"
 
-
-
-
 /* Shift ctx->fluid positions in place for a step of length dt [s]. The fluid arrays must be in
  * the order of ctx->grid and its cells at least h + max_frac d (the shift is applied after the
  * sort, so every neighbour within h stays in the 3^dim cells searched). Boundary particles
@@ -20,8 +17,8 @@
  * ctx->fluid->n entries each. normal_radius [m] (at least h, at most the grid cell): support
  * of the concentration gradient whose direction is the surface normal. Deterministic for any thread count. Returns the largest shift
  * [m]. */
-double pfsph_shift_apply(const pfsph_ctx *ctx, const pfsph_shift_params *p, double dt,
-                         double normal_radius, pfsph_real *sx, pfsph_real *sy, pfsph_real *sz);
+double pfsph_shift_apply(const pfsph_ctx *ctx, const pfsph_shift_params *p, double dt, double normal_radius,
+                         pfsph_real *sx, pfsph_real *sy, pfsph_real *sz);
 
 /* Particle concentration C_i = V0 sum_j W_ij + sum_b V_b W_ib (self term included) of fluid
  * particle i, and its gradient (with the anti-clumping weight) in g[3]; for tests. */

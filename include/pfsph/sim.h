@@ -7,11 +7,17 @@
 #include "pfsph/ctx.h"
 #include "pfsph/scene.h"
 
-
 enum pfsph_stage {
-    PFSPH_STAGE_GRID, PFSPH_STAGE_DENSITY, PFSPH_STAGE_FORCES, PFSPH_STAGE_PAIRWISE,
-    PFSPH_STAGE_PRESSURE, PFSPH_STAGE_INTEGRATE, PFSPH_STAGE_DIFFUSE, PFSPH_STAGE_BODIES,
-    PFSPH_STAGE_FILM, PFSPH_STAGE_OUTPUT,
+    PFSPH_STAGE_GRID,
+    PFSPH_STAGE_DENSITY,
+    PFSPH_STAGE_FORCES,
+    PFSPH_STAGE_PAIRWISE,
+    PFSPH_STAGE_PRESSURE,
+    PFSPH_STAGE_INTEGRATE,
+    PFSPH_STAGE_DIFFUSE,
+    PFSPH_STAGE_BODIES,
+    PFSPH_STAGE_FILM,
+    PFSPH_STAGE_OUTPUT,
     PFSPH_NSTAGES
 };
 extern const char *const pfsph_stage_names[PFSPH_NSTAGES];
@@ -21,9 +27,9 @@ typedef struct pfsph_step_stats {
     double vmax;            /* m/s */
     double density_err_avg; /* mean of (rho - rho0) / rho0 over fluid, compressed side only */
     double density_err_max;
-    double ekin;            /* J */
-    int iterations;         /* pressure iterations of the last step (PCISPH, DFSPH density solve) */
-    int div_iterations;     /* divergence-solve iterations of the last step (0 without one) */
+    double ekin;        /* J */
+    int iterations;     /* pressure iterations of the last step (PCISPH, DFSPH density solve) */
+    int div_iterations; /* divergence-solve iterations of the last step (0 without one) */
 } pfsph_step_stats;
 
 typedef struct pfsph_sim pfsph_sim;
@@ -91,8 +97,7 @@ void pfsph_sim_diffuse_totals(const pfsph_sim *sim, uint64_t *created, uint64_t 
  * set and totals (diffuse must then be non-NULL). On error the simulation is unchanged except
  * after PFSPH_ENOMEM. */
 int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_particles *fluid,
-                      const pfsph_particles *diffuse, uint64_t created, uint64_t refused,
-                      pfsph_error *err);
+                      const pfsph_particles *diffuse, uint64_t created, uint64_t refused, pfsph_error *err);
 
 /* Rigid bodies (NULL when the scene has none); see bodies.h. */
 struct pfsph_bodies;
@@ -109,13 +114,11 @@ struct pfsph_emitter_state;
 struct pfsph_emitter_info;
 const struct pfsph_emitters *pfsph_sim_emitters(const pfsph_sim *sim);
 /* Restore the emitters' states (a checkpoint's, at time t [s]), checked against the scene's. */
-int pfsph_sim_restore_emitters(pfsph_sim *sim, int n, const struct pfsph_emitter_state *st, double t,
-                               pfsph_error *err);
+int pfsph_sim_restore_emitters(pfsph_sim *sim, int n, const struct pfsph_emitter_state *st, double t, pfsph_error *err);
 
 /* Number of particles and bytes a scene would need, without allocating them. n_fluid: the
  * fluid it starts with; bytes: with the most its emitters can add by the scene's end. */
-int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary,
-                         size_t *bytes, pfsph_error *err);
+int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary, size_t *bytes, pfsph_error *err);
 /* The most particles the scene's emitters can have added by time t [s] (0 without emitters);
  * PFSPH_EINPUT (message with the JSON path) for a nozzle the lattice cannot feed. */
 int pfsph_scene_emitted_max(const pfsph_scene *s, double t, size_t *n, pfsph_error *err);

@@ -34,7 +34,6 @@ typedef struct pfsph_surface_opts {
  * 0 interior, 1 outermost layer, 2 the next one in, ... up to o->layers. A particle without
  * neighbours is layer 1. work: scratch of ctx->fluid->n bytes (unused when layers == 1).
  * Deterministic for any thread count; allocates nothing. */
-void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uint8_t *layer,
-                          uint8_t *work);
+void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uint8_t *layer, uint8_t *work);
 
 #endif

@@ -10,9 +10,9 @@ typedef struct pfsph_body_pose {
 } pfsph_body_pose;
 
 /* n meshes (one per body) into one file, atomically; faces carry their body's index. */
-int pfsph_write_surfaces_ply(const char *path, const pfsph_mesh *meshes, int n,
-                             const pfsph_body_pose *poses, double time, pfsph_error *err);
-int pfsph_write_surfaces_vtp(const char *path, const pfsph_mesh *meshes, int n,
-                             const pfsph_body_pose *poses, double time, pfsph_error *err);
+int pfsph_write_surfaces_ply(const char *path, const pfsph_mesh *meshes, int n, const pfsph_body_pose *poses,
+                             double time, pfsph_error *err);
+int pfsph_write_surfaces_vtp(const char *path, const pfsph_mesh *meshes, int n, const pfsph_body_pose *poses,
+                             double time, pfsph_error *err);
 
 #endif

@@ -13,31 +13,31 @@
 
 /* Lengths are multiples of the particle spacing d. A value <= 0 takes the default. */
 typedef struct pfsph_surface_opts {
-    double spacing;      /* particle spacing d [m]; required */
-    double cell;         /* marching-cubes cell edge / d (0.5) */
-    double support;      /* isotropic kernel support h / d (3) */
-    double pca_radius;   /* neighbourhood radius of the weighted PCA / d (3) */
-    double lambda;       /* Laplacian smoothing of the kernel centres, 0..1 (0.9; < 0: none) */
-    double kr;           /* largest / smallest kernel axis (4) */
-    double kn;           /* kernel scale of particles with few neighbours (0.5) */
-    int n_eps;           /* fewer neighbours than this: isotropic kn kernel (25) */
-    double iso;          /* iso-level of the volume-fraction field; <= 0: calibrated so that a
+    double spacing;    /* particle spacing d [m]; required */
+    double cell;       /* marching-cubes cell edge / d (0.5) */
+    double support;    /* isotropic kernel support h / d (3) */
+    double pca_radius; /* neighbourhood radius of the weighted PCA / d (3) */
+    double lambda;     /* Laplacian smoothing of the kernel centres, 0..1 (0.9; < 0: none) */
+    double kr;         /* largest / smallest kernel axis (4) */
+    double kn;         /* kernel scale of particles with few neighbours (0.5) */
+    int n_eps;         /* fewer neighbours than this: isotropic kn kernel (25) */
+    double iso;        /* iso-level of the volume-fraction field; <= 0: calibrated so that a
                           * flat lattice surface lies half a spacing beyond its last layer */
-    bool isotropic;      /* plain spherical kernels, no PCA (for comparison) */
-    int smooth_iters;    /* Taubin mesh smoothing passes (0: none) */
+    bool isotropic;    /* plain spherical kernels, no PCA (for comparison) */
+    int smooth_iters;  /* Taubin mesh smoothing passes (0: none) */
 } pfsph_surface_opts;
 
 /* A welded triangle mesh, counter-clockwise seen from outside (the liquid). */
 typedef struct pfsph_surface_mesh {
     size_t nverts, ntris;
-    double *v;       /* 3 * nverts */
-    float *n;        /* 3 * nverts unit outward normals (minus the colour-field gradient) */
-    uint32_t *tri;   /* 3 * ntris */
-    uint8_t *phase;  /* ntris: the fluid phase each face bounds */
+    double *v;      /* 3 * nverts */
+    float *n;       /* 3 * nverts unit outward normals (minus the colour-field gradient) */
+    uint32_t *tri;  /* 3 * ntris */
+    uint8_t *phase; /* ntris: the fluid phase each face bounds */
     /* statistics of the last reconstruction (summed over phases) */
-    size_t blocks;       /* sparse-grid blocks kept (those the surface crosses) */
-    size_t blocks_peak;  /* blocks allocated at most at once */
-    size_t grid_bytes;   /* peak bytes of the sparse grid's node values */
+    size_t blocks;            /* sparse-grid blocks kept (those the surface crosses) */
+    size_t blocks_peak;       /* blocks allocated at most at once */
+    size_t grid_bytes;        /* peak bytes of the sparse grid's node values */
     size_t surface_particles; /* particles classified as near the surface */
     double seconds[4];        /* wall time: kernels (PCA), field (grid growth), marching, merge */
 } pfsph_surface_mesh;
@@ -49,8 +49,8 @@ void pfsph_surface_opts_default(pfsph_surface_opts *o, double spacing);
  * *m is overwritten (free with pfsph_surface_mesh_free). Deterministic: the same bytes for any
  * thread count. PFSPH_EINPUT for bad options or coordinates out of the grid's range (about
  * 2^18 cells from the origin), PFSPH_ENOMEM. */
-int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n,
-                              const pfsph_surface_opts *o, pfsph_surface_mesh *m, pfsph_error *err);
+int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n, const pfsph_surface_opts *o,
+                              pfsph_surface_mesh *m, pfsph_error *err);
 
 /* The iso-level a calibrated reconstruction uses for these options (computed on a flat slab). */
 double pfsph_surface_calibrate_iso(const pfsph_surface_opts *o);

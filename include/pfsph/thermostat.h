@@ -78,9 +78,8 @@ static inline double pfsph_thermostat_scale(const pfsph_ctx *ctx, int a)
  * mean to second order within a phase, and no more than twice the lighter particle's friction
  * across a density ratio (the arithmetic mean shook a gas particle next to water with the
  * water's friction, 500x its own at a ratio of 1000). */
-static inline double pfsph__thermo_fluid(double amp_ts, double nu, double mi, double mj, double ndi,
-                                         double ndj, double r2, double dwr, double eps, double rr,
-                                         double theta)
+static inline double pfsph__thermo_fluid(double amp_ts, double nu, double mi, double mj, double ndi, double ndj,
+                                         double r2, double dwr, double eps, double rr, double theta)
 {
     double g = nu * 2.0 * mi * mj / (mi * ndi + mj * ndj) * r2 * -dwr / (r2 + eps);
     return g > 0 ? sqrt(amp_ts * g) * theta / rr : 0.0;
@@ -88,8 +87,8 @@ static inline double pfsph__thermo_fluid(double amp_ts, double nu, double mi, do
 
 /* The same for a fluid particle of mass m_i and a solid particle of volume V_b whose wall
  * friction viscosity is nu_w (Akinci: m_i visc_c nu_w V_b r^2 |W'/r| / (r^2 + eps)). */
-static inline double pfsph__thermo_wall(double amp_ts, double nuw, double mi, double vb, double r2,
-                                        double dwr, double eps, double rr, double theta)
+static inline double pfsph__thermo_wall(double amp_ts, double nuw, double mi, double vb, double r2, double dwr,
+                                        double eps, double rr, double theta)
 {
     double g = nuw * mi * vb * r2 * -dwr / (r2 + eps);
     return g > 0 ? sqrt(amp_ts * g) * theta / rr : 0.0;

@@ -238,7 +238,8 @@ static int load_scene(const char *path, pfsph_scene *s, char **text)
         if (!*text) {
             char msg[PFSPH_PATH_LEN + 128];
             if (errno == EISDIR) snprintf(msg, sizeof msg, "%s: is a directory, not a scene file", path);
-            else if (errno == EILSEQ) snprintf(msg, sizeof msg, "%s: not a scene file (it holds a NUL byte; scenes are JSON text)", path);
+            else if (errno == EILSEQ)
+                snprintf(msg, sizeof msg, "%s: not a scene file (it holds a NUL byte; scenes are JSON text)", path);
             else snprintf(msg, sizeof msg, "%s: cannot read: %s", path, strerror(errno));
             print_error(NULL, msg);
             return errno == ENOMEM ? 1 : 2;
@@ -274,16 +275,18 @@ static int check_memory(const pfsph_scene *s, int verbose)
         return exit_code(rc);
     }
     if (verbose) {
-        if (ne) printf("particles: %zu fluid at the start, up to %zu with the emitters' by t = %g s, %zu boundary\n",
-                       nf, nf + ne, s->end_time, nb);
+        if (ne)
+            printf("particles: %zu fluid at the start, up to %zu with the emitters' by t = %g s, %zu boundary\n", nf,
+                   nf + ne, s->end_time, nb);
         else printf("particles: %zu fluid, %zu boundary\n", nf, nb);
         printf("memory estimate: %.1f MiB (%.0f bytes per fluid particle)%s\n", (double)bytes / 1048576.0,
                nf + ne ? (double)bytes / (double)(nf + ne) : 0.0, ne ? ", for the most fluid" : "");
     }
     if (mem > 0 && (double)bytes > 0.8 * (double)mem) {
-        fprintf(stderr, "pfsph: %s: the scene needs about %.1f GiB, more than 80%% of this machine's %.1f GiB; "
-                "enlarge particle_radius or shrink the fluid\n", s->source, (double)bytes / 1073741824.0,
-                (double)mem / 1073741824.0);
+        fprintf(stderr,
+                "pfsph: %s: the scene needs about %.1f GiB, more than 80%% of this machine's %.1f GiB; "
+                "enlarge particle_radius or shrink the fluid\n",
+                s->source, (double)bytes / 1073741824.0, (double)mem / 1073741824.0);
         return 2;
     }
     return 0;
@@ -404,8 +407,10 @@ static int cmd_run(int argc, char **argv)
     char *text = NULL;
     int rc = load_scene(scene_path, &s, &text);
     if (!rc && end >= 0 && floor(end * s.fps + 1e-9) > PFSPH_MAX_FRAMES) {
-        fprintf(stderr, "pfsph: --end %g: at %g fps ($.time.fps of %s) that makes %.3g frames, more than the %d "
-                "one run holds\n", end, s.fps, s.source, end * s.fps, PFSPH_MAX_FRAMES);
+        fprintf(stderr,
+                "pfsph: --end %g: at %g fps ($.time.fps of %s) that makes %.3g frames, more than the %d "
+                "one run holds\n",
+                end, s.fps, s.source, end * s.fps, PFSPH_MAX_FRAMES);
         rc = 2;
     }
     if (!rc) rc = check_memory(&s, 0);
@@ -418,11 +423,18 @@ static int cmd_run(int argc, char **argv)
     if (threads > 0) omp_set_num_threads(threads);
     else if (s.threads > 0) omp_set_num_threads(s.threads);
     progress_state ps = {isatty(2), quiet, -1e9};
-    pfsph_run_opts o = {.out_dir = out, .end_time = end, .scene_text = text, .progress = show_progress, .user = &ps,
-                        .resume = resume != NULL, .message = show_message, .force = force};
+    pfsph_run_opts o = {.out_dir = out,
+                        .end_time = end,
+                        .scene_text = text,
+                        .progress = show_progress,
+                        .user = &ps,
+                        .resume = resume != NULL,
+                        .message = show_message,
+                        .force = force};
     const char *dir = out ? out : s.output.dir;
-    if (!quiet) fprintf(stderr, "pfsph %s: %s -> %s (%d threads)%s\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads(),
-                        resume ? ", resuming" : "");
+    if (!quiet)
+        fprintf(stderr, "pfsph %s: %s -> %s (%d threads)%s\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads(),
+                resume ? ", resuming" : "");
     pfsph_error err = {0};
     rc = pfsph_run(&s, &o, &err);
     free(text);
@@ -472,7 +484,8 @@ static int cmd_check(int argc, char **argv)
         printf("density ratio %.4g between fluid phases", ratio);
         if (s.solver == PFSPH_SOLVER_WCSPH && s.pressure_scale == PFSPH_PRESSURE_COMMON)
             printf(": one pressure scale, the lightest phase's sound speed is %.3gx the "
-                   "solver's (the time step shrinks by as much)\n", sqrt(ratio));
+                   "solver's (the time step shrinks by as much)\n",
+                   sqrt(ratio));
         else if (s.solver == PFSPH_SOLVER_PCISPH && ratio > 10.0 + 1e-9)
             printf(": PCISPH is tested to 10 and diverged at 100 (docs/pairwise.md, \"Density "
                    "ratios\"); use solver \"wcsph\" with \"pressure_scale\": \"common\"\n");
@@ -482,8 +495,7 @@ static int cmd_check(int argc, char **argv)
         else if (s.solver == PFSPH_SOLVER_WCSPH && ratio > 100.0 + 1e-9)
             printf(": per-phase pressure scales are tested to 100 and blew up at 1000 "
                    "(docs/pairwise.md, \"Density ratios\"); use \"pressure_scale\": \"common\"\n");
-        else
-            printf("\n");
+        else printf("\n");
     }
     if (s.nbodies) {
         /* check_memory has read and checked the mesh files already */
@@ -512,8 +524,9 @@ static int cmd_check(int argc, char **argv)
                 const pfsph_emitter_params *e = &s.emitters[i];
                 double m = info[i].rate * s.phases[e->phase].rest_density;
                 printf("  [%d] %s of %zu sites, phase \"%s\", %.4g m/s, %.4g m^%d/s (%.4g kg/s%s, %.4g layers/s), "
-                       "from %g s to ", i, shapes[e->shape], info[i].sites, s.phases[e->phase].name, info[i].speed,
-                       info[i].rate, s.dim, m, s.dim == 2 ? " per metre" : "", info[i].layer_rate, e->start);
+                       "from %g s to ",
+                       i, shapes[e->shape], info[i].sites, s.phases[e->phase].name, info[i].speed, info[i].rate, s.dim,
+                       m, s.dim == 2 ? " per metre" : "", info[i].layer_rate, e->start);
                 if (isfinite(e->stop)) printf("%g s\n", e->stop);
                 else printf("the end\n");
             }
@@ -584,8 +597,8 @@ static int cmd_render(int argc, char **argv)
             if (++i >= argc) return usage_error("%s needs a field", a);
             o.color_by = argv[i];
         } else if (!strcmp(a, "--size")) {
-            if (++i >= argc || sscanf(argv[i], "%dx%d", &o.width, &o.height) != 2 || o.width < 16 ||
-                o.height < 16 || o.width > 16384 || o.height > 16384)
+            if (++i >= argc || sscanf(argv[i], "%dx%d", &o.width, &o.height) != 2 || o.width < 16 || o.height < 16 ||
+                o.width > 16384 || o.height > 16384)
                 return usage_error("--size: '%s' is not WxH (16..16384)", i < argc ? argv[i] : "");
         } else if (a[0] == '-') return usage_error("unknown option '%s'", a);
         else if (!dir) dir = a;
@@ -691,8 +704,9 @@ static int cmd_view(int argc, char **argv)
 #else
     (void)argc;
     (void)argv;
-    fprintf(stderr, "pfsph: view: this build has no viewer (it needs GLFW 3 and libepoxy at build time: Debian "
-                    "libglfw3-dev libepoxy-dev, then cmake -DPFSPH_VIEWER=ON); `pfsph render` makes PNG previews\n");
+    fprintf(stderr,
+            "pfsph: view: this build has no viewer (it needs GLFW 3 and libepoxy at build time: Debian "
+            "libglfw3-dev libepoxy-dev, then cmake -DPFSPH_VIEWER=ON); `pfsph render` makes PNG previews\n");
     return 2;
 #endif
 }
@@ -721,8 +735,7 @@ int main(int argc, char **argv)
             char h[] = "--help";
             char *v[] = {h, NULL};
             return cmd_view(1, v);
-        }
-        else return usage_error("help: unknown command '%s'", topic);
+        } else return usage_error("help: unknown command '%s'", topic);
         return 0;
     }
     if (!strcmp(cmd, "run")) return cmd_run(argc - 2, argv + 2);

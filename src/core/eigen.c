@@ -242,7 +242,7 @@ void pfsph_eigen_sym3_fast(const double a[3][3], double w[3], double v[3][3])
         return;
     }
     double u[3][3]; /* u[k]: unit eigenvector of e[k] */
-    if (far > 0) { /* the largest is the farther from the middle one */
+    if (far > 0) {  /* the largest is the farther from the middle one */
         evec_simple(m, e[0], u[0]);
         evec_plane(m, u[0], e[1], u[1]);
         cross3(u[0], u[1], u[2]);

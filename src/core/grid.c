@@ -5,8 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_real hi[3],
-                    pfsph_real cell)
+int pfsph_grid_init(pfsph_grid *g, int dim, const pfsph_real lo[3], const pfsph_real hi[3], pfsph_real cell)
 {
     memset(g, 0, sizeof(*g));
     g->dim = dim;
@@ -150,15 +149,13 @@ int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
     return pfsph_particles_permute(ps, g->perm, kept, g->tmp);
 }
 
-size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real radius,
-                             uint32_t *out, size_t max)
+size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real radius, uint32_t *out, size_t max)
 {
     size_t cnt = 0;
     double r2 = (double)radius * (double)radius;
     for (size_t j = 0; j < ps->n; j++) {
         if (j == i) continue;
-        double dx = (double)ps->x[i] - ps->x[j], dy = (double)ps->y[i] - ps->y[j],
-               dz = (double)ps->z[i] - ps->z[j];
+        double dx = (double)ps->x[i] - ps->x[j], dy = (double)ps->y[i] - ps->y[j], dz = (double)ps->z[i] - ps->z[j];
         if (dx * dx + dy * dy + dz * dz < r2) {
             if (cnt < max) out[cnt] = (uint32_t)j;
             cnt++;

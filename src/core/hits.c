@@ -52,7 +52,8 @@ __attribute__((target("avx512f"))) static void hits_avx512(pfsph_hits *h, const 
         if (skip - j < 16) m &= ~(1u << (skip - j));
         if (!m) continue;
         const __mmask16 k = (__mmask16)m;
-        _mm512_storeu_si512(h->j + n, _mm512_maskz_compress_epi32(k, _mm512_add_epi32(_mm512_set1_epi32((int)j), lane)));
+        _mm512_storeu_si512(h->j + n,
+                            _mm512_maskz_compress_epi32(k, _mm512_add_epi32(_mm512_set1_epi32((int)j), lane)));
         _mm512_storeu_ps(h->dx + n, _mm512_maskz_compress_ps(k, dx));
         _mm512_storeu_ps(h->dy + n, _mm512_maskz_compress_ps(k, dy));
         _mm512_storeu_ps(h->dz + n, _mm512_maskz_compress_ps(k, dz));
@@ -90,7 +91,8 @@ __attribute__((target("avx2"))) static void hits_avx2(pfsph_hits *h, const float
         const __m256 dz = _mm256_sub_ps(Z, _mm256_maskload_ps(tz + j, live));
         const __m256 r2 =
             _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
-        unsigned m = (unsigned)_mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(r2, H2, _CMP_LT_OQ), _mm256_castsi256_ps(live)));
+        unsigned m =
+            (unsigned)_mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(r2, H2, _CMP_LT_OQ), _mm256_castsi256_ps(live)));
         if (skip - j < 8) m &= ~(1u << (skip - j));
         if (!m) continue;
         const __m256i p = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)compress8[m]));

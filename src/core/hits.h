@@ -56,21 +56,21 @@ const char *pfsph_hits_level_name(void);
 /* Walks the grid ranges r of a query, appending their hits to h and calling FLUSH (a
  * statement that evaluates h's n entries in order) whenever a range might not fit, and once at
  * the end; the hits are then in grid-walk order across flushes. */
-#define PFSPH_HITS_WALK(fn, h, r, tx, ty, tz, x, y, z, h2, skip, FLUSH)                                         \
-    do {                                                                                                       \
-        (h)->n = 0;                                                                                            \
-        for (int q_ = 0; q_ < (r).n; q_++)                                                                     \
-            for (uint32_t b_ = (r).b[q_]; b_ < (r).e[q_];) {                                                   \
-                if ((h)->n > PFSPH_HITS_CAP - 64) {                                                            \
-                    FLUSH;                                                                                     \
-                    (h)->n = 0;                                                                                \
-                }                                                                                              \
-                uint32_t room_ = (uint32_t)(PFSPH_HITS_CAP - (h)->n);                                          \
-                uint32_t e_ = (r).e[q_] - b_ > room_ ? b_ + room_ : (r).e[q_];                                  \
-                (fn)((h), (tx), (ty), (tz), b_, e_, (x), (y), (z), (h2), (skip));                              \
-                b_ = e_;                                                                                       \
-            }                                                                                                  \
-        FLUSH;                                                                                                 \
+#define PFSPH_HITS_WALK(fn, h, r, tx, ty, tz, x, y, z, h2, skip, FLUSH)           \
+    do {                                                                          \
+        (h)->n = 0;                                                               \
+        for (int q_ = 0; q_ < (r).n; q_++)                                        \
+            for (uint32_t b_ = (r).b[q_]; b_ < (r).e[q_];) {                      \
+                if ((h)->n > PFSPH_HITS_CAP - 64) {                               \
+                    FLUSH;                                                        \
+                    (h)->n = 0;                                                   \
+                }                                                                 \
+                uint32_t room_ = (uint32_t)(PFSPH_HITS_CAP - (h)->n);             \
+                uint32_t e_ = (r).e[q_] - b_ > room_ ? b_ + room_ : (r).e[q_];    \
+                (fn)((h), (tx), (ty), (tz), b_, e_, (x), (y), (z), (h2), (skip)); \
+                b_ = e_;                                                          \
+            }                                                                     \
+        FLUSH;                                                                    \
     } while (0)
 
 #endif

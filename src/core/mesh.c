@@ -218,8 +218,7 @@ static int obj_face(obj_ctx *c, const char *p, const char *end)
         if (k >= 2) { /* fan triangulation: (v0, v_{k-1}, v_k) */
             if (c->nt >= MESH_MAX_TRIS) return obj_fail(c, "more than 10000000 triangles");
             if (grow((void **)&c->t, &c->capt, 3 * (c->nt + 1), sizeof(uint32_t)))
-                return pfsph_fail(c->err, PFSPH_ENOMEM, "%s:%zu: out of memory", c->src,
-                                  c->line);
+                return pfsph_fail(c->err, PFSPH_ENOMEM, "%s:%zu: out of memory", c->src, c->line);
             uint32_t *t = c->t + 3 * c->nt++;
             t[0] = first;
             t[1] = prev;
@@ -232,8 +231,7 @@ static int obj_face(obj_ctx *c, const char *p, const char *end)
     return 0;
 }
 
-int pfsph_mesh_parse_obj(pfsph_mesh *m, const char *text, size_t len, const char *source,
-                         pfsph_error *err)
+int pfsph_mesh_parse_obj(pfsph_mesh *m, const char *text, size_t len, const char *source, pfsph_error *err)
 {
     memset(m, 0, sizeof *m);
     if (!source) source = "obj";
@@ -255,8 +253,7 @@ int pfsph_mesh_parse_obj(pfsph_mesh *m, const char *text, size_t len, const char
         if (e < end && *e == '\r' && e + 1 < end && e[1] == '\n') e++;
         p = e < end ? e + 1 : end;
     }
-    if (!rc && c.nt == 0) rc = pfsph_fail(err, PFSPH_EINPUT, "%s:%zu: no faces (empty mesh)",
-                                          source, c.line);
+    if (!rc && c.nt == 0) rc = pfsph_fail(err, PFSPH_EINPUT, "%s:%zu: no faces (empty mesh)", source, c.line);
     if (rc) {
         free(c.v);
         free(c.t);
@@ -326,10 +323,7 @@ static void cross3(const double *a, const double *b, double *o)
     o[1] = a[2] * b[0] - a[0] * b[2];
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
-static double dot3(const double *a, const double *b)
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 int pfsph_mesh_bounds(const pfsph_mesh *m, double lo[3], double hi[3])
 {
@@ -383,18 +377,16 @@ static double signed_volume(const pfsph_mesh *m, const double ref[3])
 int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *err)
 {
     if (!source) source = "mesh";
-    if (!m || m->ntris == 0) return pfsph_fail(err, PFSPH_EINPUT, "%s: mesh has no triangles",
-                                               source);
+    if (!m || m->ntris == 0) return pfsph_fail(err, PFSPH_EINPUT, "%s: mesh has no triangles", source);
     if (m->ntris > MESH_MAX_TRIS || m->nverts > MESH_MAX_VERTS)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: mesh too large", source);
     for (size_t i = 0; i < 3 * m->ntris; i++)
         if (m->tri[i] >= m->nverts)
-            return pfsph_fail(err, PFSPH_EINPUT,
-                              "%s: triangle %zu uses vertex %lu, out of range (%zu vertices)",
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: triangle %zu uses vertex %lu, out of range (%zu vertices)",
                               source, i / 3 + 1, (unsigned long)m->tri[i] + 1, m->nverts);
     double lo[3], hi[3], ref[3], d[3];
-    if (pfsph_mesh_bounds(m, lo, hi)) return pfsph_fail(err, PFSPH_EINPUT,
-                                                "%s: a vertex coordinate is not finite", source);
+    if (pfsph_mesh_bounds(m, lo, hi))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: a vertex coordinate is not finite", source);
     for (int a = 0; a < 3; a++) {
         ref[a] = 0.5 * (lo[a] + hi[a]);
         d[a] = hi[a] - lo[a];
@@ -413,8 +405,7 @@ int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *e
         cross3(e1, e2, n);
         double area = 0.5 * sqrt(dot3(n, n));
         if (!(area >= 1e-12 * diag2))
-            return pfsph_fail(err, PFSPH_EINPUT,
-                              "%s: triangle %zu (vertices %lu %lu %lu) is degenerate (area %.3g)",
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: triangle %zu (vertices %lu %lu %lu) is degenerate (area %.3g)",
                               source, t + 1, (unsigned long)ti[0] + 1, (unsigned long)ti[1] + 1,
                               (unsigned long)ti[2] + 1, area);
     }
@@ -436,22 +427,18 @@ int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *e
     for (size_t i = 0; i < ne && !rc;) {
         size_t j = i + 1;
         while (j < ne && e[j].key == e[i].key) j++;
-        unsigned long va = (unsigned long)(e[i].key >> 32) + 1,
-                      vb = (unsigned long)(e[i].key & 0xffffffffu) + 1;
+        unsigned long va = (unsigned long)(e[i].key >> 32) + 1, vb = (unsigned long)(e[i].key & 0xffffffffu) + 1;
         if (j - i == 1)
-            rc = pfsph_fail(err, PFSPH_EINPUT,
-                            "%s: edge %lu-%lu is open (used by triangle %lu only)", source, va,
-                            vb, (unsigned long)e[i].tri + 1);
+            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: edge %lu-%lu is open (used by triangle %lu only)", source, va, vb,
+                            (unsigned long)e[i].tri + 1);
         else if (j - i > 2)
-            rc = pfsph_fail(err, PFSPH_EINPUT,
-                            "%s: edge %lu-%lu is non-manifold (shared by %zu triangles)", source,
-                            va, vb, j - i);
+            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: edge %lu-%lu is non-manifold (shared by %zu triangles)", source, va,
+                            vb, j - i);
         else if (e[i].fwd == e[i + 1].fwd)
             rc = pfsph_fail(err, PFSPH_EINPUT,
                             "%s: triangles %lu and %lu have inconsistent orientation across "
                             "edge %lu-%lu",
-                            source, (unsigned long)e[i].tri + 1, (unsigned long)e[i + 1].tri + 1,
-                            va, vb);
+                            source, (unsigned long)e[i].tri + 1, (unsigned long)e[i + 1].tri + 1, va, vb);
         i = j;
     }
     free(e);
@@ -459,8 +446,7 @@ int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *e
 
     double vol = signed_volume(m, ref);
     if (!isfinite(vol) || fabs(vol) <= 1e-12 * diag2 * sqrt(diag2))
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: mesh encloses zero volume (%.3g)", source,
-                          vol);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: mesh encloses zero volume (%.3g)", source, vol);
     if (vol < 0) /* inside out: flip every triangle */
         for (size_t t = 0; t < m->ntris; t++) {
             uint32_t tmp = m->tri[3 * t + 1];
@@ -475,8 +461,8 @@ int pfsph_mesh_validate_closed(pfsph_mesh *m, const char *source, pfsph_error *e
  * (the triangle-mesh form of Mirtich 1996): volume integrals of 1, x, y, z, x^2, y^2, z^2,
  * xy, yz, zx turned into surface integrals by the divergence theorem, exact for polyhedra. */
 
-static void eberly_sub(double w0, double w1, double w2, double *f1, double *f2, double *f3,
-                       double *g0, double *g1, double *g2)
+static void eberly_sub(double w0, double w1, double w2, double *f1, double *f2, double *f3, double *g0, double *g1,
+                       double *g2)
 {
     double t0 = w0 + w1, t1 = w0 * w0, t2 = t1 + w1 * t0;
     *f1 = t0 + w2;
@@ -487,8 +473,7 @@ static void eberly_sub(double w0, double w1, double w2, double *f1, double *f2, 
     *g2 = *f2 + w2 * (*f1 + w2);
 }
 
-void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[3],
-                                double inertia[9])
+void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[3], double inertia[9])
 {
     double ref[3] = {0, 0, 0}, lo[3], hi[3];
     /* integrate about the bounding-box centre: far-off meshes keep their precision */
@@ -505,8 +490,7 @@ void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[
         double a1 = p1[0] - p0[0], b1 = p1[1] - p0[1], c1 = p1[2] - p0[2];
         double a2 = p2[0] - p0[0], b2 = p2[1] - p0[1], c2 = p2[2] - p0[2];
         double d0 = b1 * c2 - b2 * c1, d1 = a2 * c1 - a1 * c2, d2 = a1 * b2 - a2 * b1;
-        double f1x, f2x, f3x, g0x, g1x, g2x, f1y, f2y, f3y, g0y, g1y, g2y, f1z, f2z, f3z, g0z,
-            g1z, g2z;
+        double f1x, f2x, f3x, g0x, g1x, g2x, f1y, f2y, f3y, g0y, g1y, g2y, f1z, f2z, f3z, g0z, g1z, g2z;
         eberly_sub(p0[0], p1[0], p2[0], &f1x, &f2x, &f3x, &g0x, &g1x, &g2x);
         eberly_sub(p0[1], p1[1], p2[1], &f1y, &f2y, &f3y, &g0y, &g1y, &g2y);
         eberly_sub(p0[2], p1[2], p2[2], &f1z, &f2z, &f3z, &g0z, &g1z, &g2z);
@@ -521,8 +505,8 @@ void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[
         in[8] += d1 * (p0[2] * g0y + p1[2] * g1y + p2[2] * g2y);
         in[9] += d2 * (p0[0] * g0z + p1[0] * g1z + p2[0] * g2z);
     }
-    static const double mult[10] = {1.0 / 6,   1.0 / 24,  1.0 / 24,  1.0 / 24,  1.0 / 60,
-                                    1.0 / 60,  1.0 / 60,  1.0 / 120, 1.0 / 120, 1.0 / 120};
+    static const double mult[10] = {1.0 / 6,  1.0 / 24, 1.0 / 24,  1.0 / 24,  1.0 / 60,
+                                    1.0 / 60, 1.0 / 60, 1.0 / 120, 1.0 / 120, 1.0 / 120};
     for (int i = 0; i < 10; i++) in[i] *= mult[i];
     double vol = in[0], c[3] = {0, 0, 0};
     if (vol != 0)
@@ -533,10 +517,8 @@ void pfsph_mesh_mass_properties(const pfsph_mesh *m, double *volume, double com[
     if (inertia) {
         /* second moments about the reference point, shifted to the centre of mass
          * (parallel-axis theorem); the tensor does not depend on where we integrated */
-        double xx = in[4] - vol * c[0] * c[0], yy = in[5] - vol * c[1] * c[1],
-               zz = in[6] - vol * c[2] * c[2];
-        double xy = in[7] - vol * c[0] * c[1], yz = in[8] - vol * c[1] * c[2],
-               zx = in[9] - vol * c[2] * c[0];
+        double xx = in[4] - vol * c[0] * c[0], yy = in[5] - vol * c[1] * c[1], zz = in[6] - vol * c[2] * c[2];
+        double xy = in[7] - vol * c[0] * c[1], yz = in[8] - vol * c[1] * c[2], zx = in[9] - vol * c[2] * c[0];
         inertia[0] = yy + zz;
         inertia[4] = zz + xx;
         inertia[8] = xx + yy;
@@ -584,8 +566,7 @@ static void cell_of(const sampler *s, const double *p, int32_t c[3])
 static cell_slot *find_slot(cell_slot *tab, size_t size, const int32_t c[3])
 {
     size_t mask = size - 1, i = cell_hash(c) & mask;
-    while (tab[i].head != UINT32_MAX &&
-           (tab[i].c[0] != c[0] || tab[i].c[1] != c[1] || tab[i].c[2] != c[2]))
+    while (tab[i].head != UINT32_MAX && (tab[i].c[0] != c[0] || tab[i].c[1] != c[1] || tab[i].c[2] != c[2]))
         i = (i + 1) & mask;
     return tab + i;
 }
@@ -637,8 +618,7 @@ static int offer(sampler *s, const double *p, double r2)
 {
     if (near_sample(s, p, r2)) return 0;
     if (s->n >= SAMPLE_MAX)
-        return pfsph_fail(s->err, PFSPH_EINPUT, "spacing too small: more than %zu samples",
-                          SAMPLE_MAX);
+        return pfsph_fail(s->err, PFSPH_EINPUT, "spacing too small: more than %zu samples", SAMPLE_MAX);
     if (s->n == s->cap) {
         size_t nc = s->cap ? 2 * s->cap : 1024;
         double *np = realloc(s->p, 3 * nc * sizeof(double));
@@ -700,10 +680,7 @@ typedef struct {
     size_t n, cap;
 } hole_heap;
 
-static int hole_above(const hole *a, const hole *b)
-{
-    return a->d > b->d || (a->d == b->d && a->seq < b->seq);
-}
+static int hole_above(const hole *a, const hole *b) { return a->d > b->d || (a->d == b->d && a->seq < b->seq); }
 
 static int heap_push(hole_heap *hp, const hole *x)
 {
@@ -754,14 +731,11 @@ static int scan_point(hole_scan *hs, const double *p, double *dist)
     *dist = d;
     if (d <= hs->thr) return 0;
     hole h = {.d = d, .p = {p[0], p[1], p[2]}, .seq = hs->seq++};
-    return heap_push(hs->hp, &h)
-               ? pfsph_fail(hs->s->err, PFSPH_ENOMEM, "out of memory sampling the surface")
-               : 0;
+    return heap_push(hs->hp, &h) ? pfsph_fail(hs->s->err, PFSPH_ENOMEM, "out of memory sampling the surface") : 0;
 }
 
 /* Points along the segment a-b at steps of at most `step` (endpoints excluded). */
-static int offer_edge(sampler *s, const double *a, const double *b, double step, double r2,
-                      hole_scan *hs)
+static int offer_edge(sampler *s, const double *a, const double *b, double step, double r2, hole_scan *hs)
 {
     double d[3];
     sub3(b, a, d);
@@ -786,8 +760,8 @@ static int offer_edge(sampler *s, const double *a, const double *b, double step,
 
 /* A hex lattice of the given step over the triangle (rows parallel to its longest edge),
  * keeping points at least `margin` from every edge. */
-static int offer_lattice(sampler *s, const double *P0, const double *P1, const double *P2,
-                         double step, double margin, double r2, hole_scan *hs)
+static int offer_lattice(sampler *s, const double *P0, const double *P1, const double *P2, double step, double margin,
+                         double r2, hole_scan *hs)
 {
     const double *P[3] = {P0, P1, P2};
     double len2[3];
@@ -879,8 +853,7 @@ static int sharp_edges(const pfsph_mesh *m, unsigned char *sharp)
         size_t j = i + 1;
         while (j < ne && e[j].key == e[i].key) j++;
         int sh = 1;
-        if (j - i == 2) sh = dot3(nrm + 3 * (size_t)e[i].tri, nrm + 3 * (size_t)e[i + 1].tri) <
-                             cos_sharp;
+        if (j - i == 2) sh = dot3(nrm + 3 * (size_t)e[i].tri, nrm + 3 * (size_t)e[i + 1].tri) < cos_sharp;
         for (size_t k = i; k < j; k++) sharp[3 * (size_t)e[k].tri + e[k].fwd] = (unsigned char)sh;
         i = j;
     }
@@ -889,14 +862,12 @@ static int sharp_edges(const pfsph_mesh *m, unsigned char *sharp)
     return 0;
 }
 
-int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts, size_t *n,
-                              pfsph_error *err)
+int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts, size_t *n, pfsph_error *err)
 {
     *pts = NULL;
     *n = 0;
     if (!(spacing > 0) || !isfinite(spacing))
-        return pfsph_fail(err, PFSPH_EINPUT, "sampling spacing %g must be positive and finite",
-                          spacing);
+        return pfsph_fail(err, PFSPH_EINPUT, "sampling spacing %g must be positive and finite", spacing);
     if (!m || m->ntris == 0) return pfsph_fail(err, PFSPH_EINPUT, "mesh has no triangles");
     if (m->ntris > MESH_MAX_TRIS) return pfsph_fail(err, PFSPH_EINPUT, "mesh too large");
     double lo[3], hi[3];
@@ -906,8 +877,7 @@ int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts,
     double area = 0, elen = 0, ext = 0;
     for (int a = 0; a < 3; a++) ext = fmax(ext, hi[a] - lo[a]);
     for (size_t t = 0; t < m->ntris; t++) {
-        const double *p0 = m->v + 3 * (size_t)m->tri[3 * t],
-                     *p1 = m->v + 3 * (size_t)m->tri[3 * t + 1],
+        const double *p0 = m->v + 3 * (size_t)m->tri[3 * t], *p1 = m->v + 3 * (size_t)m->tri[3 * t + 1],
                      *p2 = m->v + 3 * (size_t)m->tri[3 * t + 2];
         double e1[3], e2[3], e3[3], c[3];
         sub3(p1, p0, e1);
@@ -919,9 +889,8 @@ int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts,
     }
     double est = area / (spacing * spacing) + elen / spacing + (double)m->nverts;
     if (!isfinite(est) || est > 2e7 || ext / spacing > 1e7)
-        return pfsph_fail(err, PFSPH_EINPUT,
-                          "spacing %g too small for a mesh of area %g (about %.3g samples)",
-                          spacing, area, est);
+        return pfsph_fail(err, PFSPH_EINPUT, "spacing %g too small for a mesh of area %g (about %.3g samples)", spacing,
+                          area, est);
     unsigned char *sharp = malloc(3 * m->ntris);
     if (!sharp || sharp_edges(m, sharp)) {
         free(sharp);
@@ -936,20 +905,16 @@ int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts,
     /* 1. ends of sharp edges (corners), 2. points along sharp edges at most one spacing apart
      * (kept if no sample within R_EDGE) */
     for (size_t i = 0; i < 3 * m->ntris && !rc; i++)
-        if (sharp[i] || sharp[i - i % 3 + (i + 2) % 3])
-            rc = offer(&s, m->v + 3 * (size_t)m->tri[i], re * re);
+        if (sharp[i] || sharp[i - i % 3 + (i + 2) % 3]) rc = offer(&s, m->v + 3 * (size_t)m->tri[i], re * re);
     for (size_t i = 0; i < 3 * m->ntris && !rc; i++)
         if (sharp[i])
-            rc = offer_edge(&s, m->v + 3 * (size_t)m->tri[i],
-                            m->v + 3 * (size_t)m->tri[i - i % 3 + (i + 1) % 3], spacing, re * re,
-                            NULL);
+            rc = offer_edge(&s, m->v + 3 * (size_t)m->tri[i], m->v + 3 * (size_t)m->tri[i - i % 3 + (i + 1) % 3],
+                            spacing, re * re, NULL);
     /* 3. each triangle's fine lattice in raster order, kept if no sample within R_STRUCT:
      * greedy in scan order this settles into nearly hexagonal rows about R_STRUCT apart */
     for (size_t t = 0; t < m->ntris && !rc; t++)
-        rc = offer_lattice(&s, m->v + 3 * (size_t)m->tri[3 * t],
-                           m->v + 3 * (size_t)m->tri[3 * t + 1],
-                           m->v + 3 * (size_t)m->tri[3 * t + 2], STEP_STRUCT * spacing, 0.0,
-                           ra * ra, NULL);
+        rc = offer_lattice(&s, m->v + 3 * (size_t)m->tri[3 * t], m->v + 3 * (size_t)m->tri[3 * t + 1],
+                           m->v + 3 * (size_t)m->tri[3 * t + 2], STEP_STRUCT * spacing, 0.0, ra * ra, NULL);
     /* 4. gap filling, farthest point first: every candidate of a lattice of step FILL_STEP
      * (covering each triangle up to its edges, covering radius <= FILL_STEP) farther than
      * R_FILL from all samples goes into a max-heap; the farthest becomes a sample (its key is
@@ -961,8 +926,7 @@ int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts,
     hole_heap hp = {0};
     hole_scan hs = {.s = &s, .hp = &hp, .thr = rf, .cap = rmax};
     for (size_t t = 0; t < m->ntris && !rc; t++) {
-        const double *p0 = m->v + 3 * (size_t)m->tri[3 * t],
-                     *p1 = m->v + 3 * (size_t)m->tri[3 * t + 1],
+        const double *p0 = m->v + 3 * (size_t)m->tri[3 * t], *p1 = m->v + 3 * (size_t)m->tri[3 * t + 1],
                      *p2 = m->v + 3 * (size_t)m->tri[3 * t + 2];
         rc = offer_edge(&s, p0, p1, fs, 0, &hs);
         if (!rc) rc = offer_edge(&s, p1, p2, fs, 0, &hs);
@@ -977,8 +941,7 @@ int pfsph_mesh_sample_surface(const pfsph_mesh *m, double spacing, double **pts,
         if (d <= rf) continue;
         if (d < h.d && hp.n && hole_above(&hp.h[0], &(hole){d, {0, 0, 0}, h.seq})) {
             h.d = d; /* stale key: back in at its true distance */
-            if (heap_push(&hp, &h))
-                rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling the surface");
+            if (heap_push(&hp, &h)) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling the surface");
             continue;
         }
         rc = offer(&s, h.p, 0.0);
@@ -1044,8 +1007,7 @@ int pfsph_mesh_box(pfsph_mesh *m, const double half[3])
 /* Vertex index of grid point (i, j) = A + i/f (B - A) + j/f (C - A) of an icosphere face:
  * a corner, a point on one of the 30 shared edges (stored from the lower corner index up), or
  * a point inside the face (numbered row by row from `base`). */
-static uint32_t ico_index(const uint8_t ed[30][2], size_t f, size_t base, int A, int B, int C,
-                          size_t i, size_t j)
+static uint32_t ico_index(const uint8_t ed[30][2], size_t f, size_t base, int A, int B, int C, size_t i, size_t j)
 {
     if (i == 0 && j == 0) return (uint32_t)A;
     if (j == 0 && i == f) return (uint32_t)B;
@@ -1068,20 +1030,17 @@ static uint32_t ico_index(const uint8_t ed[30][2], size_t f, size_t base, int A,
 int pfsph_mesh_sphere(pfsph_mesh *m, double radius, int segments)
 {
     memset(m, 0, sizeof *m);
-    if (!(radius > 0) || !isfinite(radius) || segments < 3 || segments > 4096)
-        return PFSPH_EINPUT;
+    if (!(radius > 0) || !isfinite(radius) || segments < 3 || segments > 4096) return PFSPH_EINPUT;
     const size_t f = (size_t)ceil(segments * 1.1071487177940904 / ((2 * MESH_PI)) - 1e-9);
     const double gr = 1.6180339887498949; /* golden ratio */
     /* (+-1, +-gr, 0) and cyclic permutations; the entry marked +-1 before a 0 (cyclically)
      * is the one scaled by gr */
-    static const int8_t iv[12][3] = {{-1, 1, 0}, {1, 1, 0},  {-1, -1, 0}, {1, -1, 0},
-                                     {0, -1, 1}, {0, 1, 1},  {0, -1, -1}, {0, 1, -1},
-                                     {1, 0, -1}, {1, 0, 1},  {-1, 0, -1}, {-1, 0, 1}};
-    static const uint8_t ifc[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},  {0, 7, 10},
-                                       {0, 10, 11}, {1, 5, 9}, {5, 11, 4}, {11, 10, 2},
-                                       {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},
-                                       {3, 2, 6},  {3, 6, 8},  {3, 8, 9},  {4, 9, 5},
-                                       {2, 4, 11}, {6, 2, 10}, {8, 6, 7},  {9, 8, 1}};
+    static const int8_t iv[12][3] = {{-1, 1, 0},  {1, 1, 0},  {-1, -1, 0}, {1, -1, 0}, {0, -1, 1},  {0, 1, 1},
+                                     {0, -1, -1}, {0, 1, -1}, {1, 0, -1},  {1, 0, 1},  {-1, 0, -1}, {-1, 0, 1}};
+    static const uint8_t ifc[20][3] = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
     uint8_t ed[30][2];
     int ne = 0;
     for (int fc = 0; fc < 20; fc++)
@@ -1099,8 +1058,7 @@ int pfsph_mesh_sphere(pfsph_mesh *m, double radius, int segments)
     double cv[12][3];
     for (int i = 0; i < 12; i++) {
         double p[3];
-        for (int a = 0; a < 3; a++)
-            p[a] = iv[i][a] * ((iv[i][a] != 0 && iv[i][(a + 1) % 3] == 0) ? gr : 1.0);
+        for (int a = 0; a < 3; a++) p[a] = iv[i][a] * ((iv[i][a] != 0 && iv[i][(a + 1) % 3] == 0) ? gr : 1.0);
         double l = sqrt(dot3(p, p));
         for (int a = 0; a < 3; a++) cv[i][a] = p[a] / l;
     }
@@ -1110,8 +1068,7 @@ int pfsph_mesh_sphere(pfsph_mesh *m, double radius, int segments)
     for (int e = 0; e < 30; e++)
         for (size_t k = 1; k < f; k++, vi++)
             for (int a = 0; a < 3; a++)
-                m->v[3 * vi + a] = cv[ed[e][0]][a] + (double)k / (double)f *
-                                                         (cv[ed[e][1]][a] - cv[ed[e][0]][a]);
+                m->v[3 * vi + a] = cv[ed[e][0]][a] + (double)k / (double)f * (cv[ed[e][1]][a] - cv[ed[e][0]][a]);
     size_t ti = 0;
     for (int fc = 0; fc < 20; fc++) {
         int A = ifc[fc][0], B = ifc[fc][1], C = ifc[fc][2];
@@ -1120,16 +1077,14 @@ int pfsph_mesh_sphere(pfsph_mesh *m, double radius, int segments)
             for (size_t i = 1; i + j < f; i++, vi++)
                 for (int a = 0; a < 3; a++)
                     m->v[3 * vi + a] = cv[A][a] + (double)i / (double)f * (cv[B][a] - cv[A][a]) +
-                                       (double)j / (double)f * (cv[C][a] - cv[A][a]);
+                        (double)j / (double)f * (cv[C][a] - cv[A][a]);
         /* "up" triangles (i,j),(i+1,j),(i,j+1) and "down" ones, same winding as A, B, C */
         for (size_t j = 0; j < f; j++)
             for (size_t i = 0; i + j < f; i++) {
-                uint32_t g00 = ico_index(ed, f, base, A, B, C, i, j),
-                         g10 = ico_index(ed, f, base, A, B, C, i + 1, j),
+                uint32_t g00 = ico_index(ed, f, base, A, B, C, i, j), g10 = ico_index(ed, f, base, A, B, C, i + 1, j),
                          g01 = ico_index(ed, f, base, A, B, C, i, j + 1);
                 set_tri(m, ti++, g00, g10, g01);
-                if (i + j + 2 <= f)
-                    set_tri(m, ti++, g10, ico_index(ed, f, base, A, B, C, i + 1, j + 1), g01);
+                if (i + j + 2 <= f) set_tri(m, ti++, g10, ico_index(ed, f, base, A, B, C, i + 1, j + 1), g01);
             }
     }
     for (size_t i = 0; i < nv; i++) {
@@ -1142,8 +1097,8 @@ int pfsph_mesh_sphere(pfsph_mesh *m, double radius, int segments)
 int pfsph_mesh_cylinder(pfsph_mesh *m, double radius, double height, int axis, int segments)
 {
     memset(m, 0, sizeof *m);
-    if (!(radius > 0) || !isfinite(radius) || !(height > 0) || !isfinite(height) || axis < 0 ||
-        axis > 2 || segments < 3 || segments > 1000000)
+    if (!(radius > 0) || !isfinite(radius) || !(height > 0) || !isfinite(height) || axis < 0 || axis > 2 ||
+        segments < 3 || segments > 1000000)
         return PFSPH_EINPUT;
     size_t n = (size_t)segments;
     /* rings: bottom 0..n-1, top n..2n-1, then the two cap centres (fans from the centre
@@ -1167,8 +1122,7 @@ int pfsph_mesh_cylinder(pfsph_mesh *m, double radius, double height, int axis, i
     }
     uint32_t cb = (uint32_t)(2 * n), ct = cb + 1;
     for (size_t i = 0; i < n; i++) {
-        uint32_t b0 = (uint32_t)i, b1 = (uint32_t)((i + 1) % n), t0 = b0 + (uint32_t)n,
-                 t1 = b1 + (uint32_t)n;
+        uint32_t b0 = (uint32_t)i, b1 = (uint32_t)((i + 1) % n), t0 = b0 + (uint32_t)n, t1 = b1 + (uint32_t)n;
         set_tri(m, 4 * i, b0, b1, t1);
         set_tri(m, 4 * i + 1, b0, t1, t0);
         set_tri(m, 4 * i + 2, ct, t0, t1);
@@ -1184,13 +1138,12 @@ void pfsph_mesh_transform(pfsph_mesh *m, double s, const double R[9], const doub
     for (size_t i = 0; i < m->nverts; i++) {
         double *p = m->v + 3 * i, q[3];
         for (int a = 0; a < 3; a++)
-            q[a] = s * (R[3 * a] * p[0] + R[3 * a + 1] * p[1] + R[3 * a + 2] * p[2]) +
-                   (t ? t[a] : 0.0);
+            q[a] = s * (R[3 * a] * p[0] + R[3 * a + 1] * p[1] + R[3 * a + 2] * p[2]) + (t ? t[a] : 0.0);
         memcpy(p, q, sizeof q);
     }
     /* a mirroring transform (s^3 det R < 0) would turn the surface inside out: re-orient */
-    double det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) +
-                 R[2] * (R[3] * R[7] - R[4] * R[6]);
+    double det =
+        R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
     if (s * s * s * det < 0)
         for (size_t k = 0; k < m->ntris; k++) {
             uint32_t tmp = m->tri[3 * k + 1];

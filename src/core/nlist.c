@@ -175,5 +175,6 @@ void pfsph_nlist_free(pfsph_nlist *l)
 
 double pfsph_nlist_bytes_per_particle(double neighbours, int with_dw)
 {
-    return sizeof(uint32_t) * (1.0 + 1.125 * neighbours) + (with_dw ? sizeof(pfsph_real) * 1.125 * neighbours : 0) + 0.5;
+    return sizeof(uint32_t) * (1.0 + 1.125 * neighbours) + (with_dw ? sizeof(pfsph_real) * 1.125 * neighbours : 0) +
+        0.5;
 }

@@ -54,9 +54,8 @@ typedef struct {
     size_t n;
 } sigma_table;
 
-static const sigma_table sigma_tables[2] = {
-    {sigma_theta2, sigma_ratio2, sizeof sigma_theta2 / sizeof sigma_theta2[0]},
-    {sigma_theta3, sigma_ratio3, sizeof sigma_theta3 / sizeof sigma_theta3[0]}};
+static const sigma_table sigma_tables[2] = {{sigma_theta2, sigma_ratio2, sizeof sigma_theta2 / sizeof sigma_theta2[0]},
+                                            {sigma_theta3, sigma_ratio3, sizeof sigma_theta3 / sizeof sigma_theta3[0]}};
 
 double pfsph_pairwise_sigma_factor(int dim, double theta)
 {
@@ -129,9 +128,8 @@ typedef struct {
 
 static const angle_table *angle_table_of(int dim, double theta)
 {
-    static const angle_table t[2] = {
-        {angle_r2, angle_deg2, sizeof angle_r2 / sizeof angle_r2[0]},
-        {angle_r3, angle_deg3, sizeof angle_r3 / sizeof angle_r3[0]}};
+    static const angle_table t[2] = {{angle_r2, angle_deg2, sizeof angle_r2 / sizeof angle_r2[0]},
+                                     {angle_r3, angle_deg3, sizeof angle_r3 / sizeof angle_r3[0]}};
     if ((dim != 2 && dim != 3) || !(theta > 0) || t[dim - 2].n < 2) return NULL;
     return &t[dim - 2];
 }
@@ -213,7 +211,7 @@ void pfsph_diffuse_defaults(pfsph_diffuse_params *p)
     p->emit_radius_scale = 1.0;
     p->emit_height_scale = 1.0;
     p->lifetime_min = 0.0;
-    p->lifetime_max = 3.0;    /* Tables 1-3 "survival time (max)" */
+    p->lifetime_max = 3.0; /* Tables 1-3 "survival time (max)" */
     p->foam_min_neighbors = -1;
     p->foam_max_neighbors = -1;
     /* Section 4.2: spray k_b = k_cp = 0; foam k_ext = k_b = 0; Section 6.2: k_b = 5.6,
@@ -223,16 +221,14 @@ void pfsph_diffuse_defaults(pfsph_diffuse_params *p)
     p->type[PFSPH_DIFFUSE_BUBBLE] = (pfsph_diffuse_coupling){1.0, 5.6, 0.5, 0.33};
 }
 
-void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing,
-                              int *foam_min, int *foam_max)
+void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing, int *foam_min,
+                              int *foam_max)
 {
     /* Fluid neighbours of a point inside a full support: support volume / particle volume. */
     double q = h / spacing;
-    double full = dim == 3 ? 4.0 / 3.0 * 3.141592653589793 * q * q * q
-                           : 3.141592653589793 * q * q;
+    double full = dim == 3 ? 4.0 / 3.0 * 3.141592653589793 * q * q * q : 3.141592653589793 * q * q;
     *foam_min = p->foam_min_neighbors >= 0 ? p->foam_min_neighbors : (int)lround(0.2 * full);
-    *foam_max = p->foam_max_neighbors >= 0 ? p->foam_max_neighbors
-                                           : (int)lround(2.0 / 3.0 * full);
+    *foam_max = p->foam_max_neighbors >= 0 ? p->foam_max_neighbors : (int)lround(2.0 / 3.0 * full);
 }
 
 void pfsph_film_defaults(pfsph_film_params *p)

@@ -52,8 +52,7 @@ void pfsph_particles_free(pfsph_particles *ps)
     memset(ps, 0, sizeof(*ps));
 }
 
-long pfsph_particles_push(pfsph_particles *ps, const pfsph_real x[3], const pfsph_real v[3],
-                          uint8_t phase)
+long pfsph_particles_push(pfsph_particles *ps, const pfsph_real x[3], const pfsph_real v[3], uint8_t phase)
 {
     if (ps->n == ps->cap) {
         size_t cap = ps->cap ? ps->cap * 2 : 1024;

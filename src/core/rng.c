@@ -14,8 +14,7 @@ static inline uint32_t mulhilo(uint32_t a, uint32_t b, uint32_t *hi)
     return (uint32_t)p;
 }
 
-void pfsph_rng_u32x4(uint64_t seed, uint32_t id, uint64_t step, uint32_t stream,
-                     uint32_t out[4])
+void pfsph_rng_u32x4(uint64_t seed, uint32_t id, uint64_t step, uint32_t stream, uint32_t out[4])
 {
     uint32_t c0 = id, c1 = (uint32_t)step, c2 = (uint32_t)(step >> 32), c3 = stream;
     uint32_t k0 = (uint32_t)seed, k1 = (uint32_t)(seed >> 32);
@@ -37,8 +36,7 @@ void pfsph_rng_u32x4(uint64_t seed, uint32_t id, uint64_t step, uint32_t stream,
     out[3] = c3;
 }
 
-void pfsph_rng_uniform4(uint64_t seed, uint32_t id, uint64_t step, uint32_t stream,
-                        double out[4])
+void pfsph_rng_uniform4(uint64_t seed, uint32_t id, uint64_t step, uint32_t stream, double out[4])
 {
     uint32_t u[4];
     pfsph_rng_u32x4(seed, id, step, stream, u);

@@ -7,8 +7,8 @@
 
 /* One peel: for each particle still in (layer[i] == 0, or every particle on the first pass)
  * out[i] = 1 when its sphere has an uncovered point. Neighbours already peeled do not cover. */
-static void peel(const pfsph_ctx *ctx, const pfsph_surface_opts *o, double radius, int reach,
-                 bool first, const uint8_t *layer, uint8_t *out)
+static void peel(const pfsph_ctx *ctx, const pfsph_surface_opts *o, double radius, int reach, bool first,
+                 const uint8_t *layer, uint8_t *out)
 {
     const pfsph_particles *f = ctx->fluid;
     const pfsph_particles *b = o->boundary && ctx->boundary && ctx->bgrid ? ctx->boundary : NULL;
@@ -79,7 +79,8 @@ static void peel(const pfsph_ctx *ctx, const pfsph_surface_opts *o, double radiu
             e1[0] = u[1] * t[2] - u[2] * t[1], e1[1] = u[2] * t[0] - u[0] * t[2], e1[2] = u[0] * t[1] - u[1] * t[0];
             const double l = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
             for (int a = 0; a < 3; a++) e1[a] /= l;
-            e2[0] = u[1] * e1[2] - u[2] * e1[1], e2[1] = u[2] * e1[0] - u[0] * e1[2], e2[2] = u[0] * e1[1] - u[1] * e1[0];
+            e2[0] = u[1] * e1[2] - u[2] * e1[1], e2[1] = u[2] * e1[0] - u[0] * e1[2],
+            e2[2] = u[0] * e1[1] - u[1] * e1[0];
         }
         const double C = 0.86602540378443865, Sn = 0.5; /* cos, sin of 30 degrees */
         const int npts = ctx->dim == 2 ? 3 : 5;
@@ -113,8 +114,7 @@ static void peel(const pfsph_ctx *ctx, const pfsph_surface_opts *o, double radiu
     }
 }
 
-void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uint8_t *layer,
-                          uint8_t *work)
+void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uint8_t *layer, uint8_t *work)
 {
     const size_t n = ctx->fluid->n;
     if (!n) return;

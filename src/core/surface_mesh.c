@@ -17,15 +17,16 @@
 
 #include "pfsph/eigen.h"
 
-#define BS 7             /* cells per block edge */
-#define BN (BS + 1)      /* nodes per block edge: 0 .. BS (the last layer is the next block's first);
+#define BS 7 /* cells per block edge */
+#define BN \
+    (BS + 1) /* nodes per block edge: 0 .. BS (the last layer is the next block's first);
                           * 8, so that a row of nodes is two 4-wide vectors */
 #define BNODES (BN * BN * BN)
 #define NEDGE (BNODES * 7) /* edges of a block: lower node x direction (1..7 as xyz bits) */
 #define MAXTRI (BS * BS * BS * 12)
 #define COORD_BITS 21
-#define LANES 8          /* PCA candidates are padded to a multiple of this (any vector width) */
-#define FAR 1e18f        /* padding candidate: beyond every radius, squares stay finite */
+#define LANES 8   /* PCA candidates are padded to a multiple of this (any vector width) */
+#define FAR 1e18f /* padding candidate: beyond every radius, squares stay finite */
 #define PI 3.14159265358979323846
 
 /* A kernel as the field reads it, in grid cells: centre I + f (I the node at or below it, f in
@@ -34,21 +35,21 @@
 typedef struct kern {
     int32_t I[3];
     float f[3];
-    float g[6];   /* symmetric map cell offsets -> unit-kernel coordinates: xx xy xz yy yz zz */
-    float amp;    /* d^3 |det G| sigma: the value at the centre over W(0) */
-    float rad;    /* support radius [cells] */
+    float g[6]; /* symmetric map cell offsets -> unit-kernel coordinates: xx xy xz yy yz zz */
+    float amp;  /* d^3 |det G| sigma: the value at the centre over W(0) */
+    float rad;  /* support radius [cells] */
 } kern;
 
 typedef struct block {
     int64_t key;
     int32_t b[3];
-    float *f;       /* BNODES node values */
+    float *f; /* BNODES node values */
     /* marching output: owned vertices (edges whose lower node lies in [0, BS)^3), ascending edge */
     uint32_t nv, nt;
-    uint16_t *ve;   /* nv edge indices */
-    double *vp;     /* 3 nv */
-    float *vn;      /* 3 nv */
-    uint32_t *tri;  /* 3 nt: owned rank, or FOREIGN | neighbour offset bits << 12 | its edge */
+    uint16_t *ve;  /* nv edge indices */
+    double *vp;    /* 3 nv */
+    float *vn;     /* 3 nv */
+    uint32_t *tri; /* 3 nt: owned rank, or FOREIGN | neighbour offset bits << 12 | its edge */
 } block;
 
 #define FOREIGN 0x80000000u
@@ -331,8 +332,7 @@ static void pca_sums(const float *bx, const float *by, const float *bz, size_t n
 /* Kernels of n points: centres, anisotropy, in grid cells of cellw. surf[i] (may be NULL) gets
  * 1 for particles near the surface (few neighbours, offset centre of mass or flattened
  * neighbourhood). *rad_max: the largest support radius [cells]. */
-static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o, kern *K, uint8_t *surf,
-                         float *rad_max)
+static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o, kern *K, uint8_t *surf, float *rad_max)
 {
     const double d = o->spacing, r = o->pca_radius, h = o->support * d, cellw = o->cell * d;
     const double ks = 1.0 / lattice_sigma(o->pca_radius), cs = 0.5 * r * d; /* cells of half the radius */
@@ -438,7 +438,7 @@ static int kernels_build(const double *x, size_t n, const pfsph_surface_opts *o,
                     pfsph_eigen_sym3((const double(*)[3])C, w, V);
                     for (int u = 0; u < 3; u++) {
                         double sv = w[u] < w[0] / o->kr ? w[0] / o->kr : w[u];
-                        scale[u] = sqrt(ks * sv); /* axis length ~ standard deviation (docs/surfaces.md) */
+                        scale[u] = sqrt(ks * sv);       /* axis length ~ standard deviation (docs/surfaces.md) */
                         if (scale[u] > 2) scale[u] = 2; /* bounded search radius (docs/surfaces.md) */
                     }
                     flat = w[2] < 0.6 * w[0];
@@ -591,7 +591,7 @@ static int bmap_put(bmap *m, int64_t key, int32_t v)
     return PFSPH_OK;
 }
 
-#define NIDX(a, b, c) (((c) * BN + (b)) * BN + (a))
+#define NIDX(a, b, c) (((c)*BN + (b)) * BN + (a))
 
 /* one kernel into the block whose first node is O (global node index): rows of BN nodes along x.
  * A node's offset from the centre is (global index - I) - f, exact integers converted, and its
@@ -615,8 +615,8 @@ static void splat(float *restrict fv, const kern *k, const int32_t O[3], const i
     const float m00 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2], m01 = g[0] * g[1] + g[1] * g[3] + g[2] * g[4],
                 m02 = g[0] * g[2] + g[1] * g[4] + g[2] * g[5], m11 = g[1] * g[1] + g[3] * g[3] + g[4] * g[4],
                 m12 = g[1] * g[2] + g[3] * g[4] + g[4] * g[5], m22 = g[2] * g[2] + g[4] * g[4] + g[5] * g[5];
-    const float i00 = 1.0f / m00, sa = m11 - m01 * m01 * i00, sb = m12 - m01 * m02 * i00,
-                sc = m22 - m02 * m02 * i00, isa = 1.0f / sa, amp = k->amp;
+    const float i00 = 1.0f / m00, sa = m11 - m01 * m01 * i00, sb = m12 - m01 * m02 * i00, sc = m22 - m02 * m02 * i00,
+                isa = 1.0f / sa, amp = k->amp;
     const int32_t ux0 = O[0] - k->I[0], vy0 = O[1] - k->I[1];
     float us[BN];
     for (int a = 0; a < BN; a++) us[a] = (float)(ux0 + a) - k->f[0];
@@ -679,7 +679,7 @@ static inline int cell_case(const uint8_t *in, int a, int b, int c)
 {
     const uint8_t *p = in + NIDX(a, b, c);
     return p[0] | p[1] << 1 | p[BN] << 2 | p[BN + 1] << 3 | p[BN * BN] << 4 | p[BN * BN + 1] << 5 |
-           p[BN * BN + BN] << 6 | p[BN * BN + BN + 1] << 7;
+        p[BN * BN + BN] << 6 | p[BN * BN + BN + 1] << 7;
 }
 
 static void block_inside(const float *f, float iso, uint8_t *in)
@@ -795,7 +795,7 @@ static void grad_at(const float *f, int a, int b, int c, double cellw, double g[
 /* per-thread scratch of the marching: the edge table (local vertex number or -1) and buffers */
 typedef struct march_scratch {
     int32_t tab[NEDGE];
-    uint32_t ren[NEDGE];   /* local number -> owned rank or foreign reference */
+    uint32_t ren[NEDGE]; /* local number -> owned rank or foreign reference */
     uint32_t tri[3 * MAXTRI];
     uint8_t in[BNODES];
 } march_scratch;
@@ -1087,8 +1087,9 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
             uint64_t m = 0;
             for (int c = 0; c < BS; c++) m |= (uint64_t)0x7f << (BN * c); /* own rows: b, c < BS */
             for (int g = 0; g < 3; g++) {
-                int j = bmap_find(&map, pack3((int64_t)bl[i].b[0] + NB_OFF[g][0], (int64_t)bl[i].b[1] + NB_OFF[g][1],
-                                              (int64_t)bl[i].b[2] + NB_OFF[g][2]));
+                int j = bmap_find(&map,
+                                  pack3((int64_t)bl[i].b[0] + NB_OFF[g][0], (int64_t)bl[i].b[1] + NB_OFF[g][1],
+                                        (int64_t)bl[i].b[2] + NB_OFF[g][2]));
                 src[3 * i + g] = j >= 0 && bl[j].f ? j : -1;
                 if (src[3 * i + g] >= 0) continue;
                 if (g == 0)
@@ -1105,9 +1106,11 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
         for (size_t i = first; i < nb; i++) {
             float *f = bl[i].f;
             if (src[3 * i] >= 0)
-                for (int c = 0; c < BS; c++) memcpy(f + NIDX(0, BS, c), bl[src[3 * i]].f + NIDX(0, 0, c), BN * sizeof *f);
+                for (int c = 0; c < BS; c++)
+                    memcpy(f + NIDX(0, BS, c), bl[src[3 * i]].f + NIDX(0, 0, c), BN * sizeof *f);
             if (src[3 * i + 1] >= 0)
-                for (int b = 0; b < BS; b++) memcpy(f + NIDX(0, b, BS), bl[src[3 * i + 1]].f + NIDX(0, b, 0), BN * sizeof *f);
+                for (int b = 0; b < BS; b++)
+                    memcpy(f + NIDX(0, b, BS), bl[src[3 * i + 1]].f + NIDX(0, b, 0), BN * sizeof *f);
             if (src[3 * i + 2] >= 0) memcpy(f + NIDX(0, BS, BS), bl[src[3 * i + 2]].f + NIDX(0, 0, 0), BN * sizeof *f);
             int any;
             need[i] = block_needs(f, iso, &any);
@@ -1189,8 +1192,9 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
                 continue;
             }
             int o = (int)(r >> 12 & 7);
-            long j = block_find(bl, kept, pack3((int64_t)b->b[0] + (o & 1), (int64_t)b->b[1] + (o >> 1 & 1),
-                                                (int64_t)b->b[2] + (o >> 2)));
+            long j = block_find(
+                bl, kept,
+                pack3((int64_t)b->b[0] + (o & 1), (int64_t)b->b[1] + (o >> 1 & 1), (int64_t)b->b[2] + (o >> 2)));
             long v = j < 0 ? -1 : edge_find(bl + j, r & 0xfff);
             if (v < 0) fail = 1; /* cannot happen: the owner holds every crossed edge of its cells */
             else t[k] = (uint32_t)(voff[j] + (size_t)v);
@@ -1233,11 +1237,14 @@ static int resolve_checked(const pfsph_surface_opts *in, bool smoothing, pfsph_s
     if (o->lambda > 1 || o->kr < 1 || o->cell > 4 || o->cell < 0.05 || o->support > 8 || o->support < 0.5 ||
         o->pca_radius > 8 || o->pca_radius < o->cell || (smoothing && o->smooth_iters > 1000)) {
         if (smoothing)
-            return pfsph_fail(err, PFSPH_EINPUT, "surface: options out of range (lambda %g, kr %g, cell %g d, "
-                              "support %g d, neighbourhood %g d, %d smoothing passes)", o->lambda, o->kr,
-                              o->cell, o->support, o->pca_radius, o->smooth_iters);
-        return pfsph_fail(err, PFSPH_EINPUT, "surface: options out of range (lambda %g, kr %g, cell %g d, "
-                          "support %g d, neighbourhood %g d)", o->lambda, o->kr, o->cell, o->support, o->pca_radius);
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "surface: options out of range (lambda %g, kr %g, cell %g d, "
+                              "support %g d, neighbourhood %g d, %d smoothing passes)",
+                              o->lambda, o->kr, o->cell, o->support, o->pca_radius, o->smooth_iters);
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "surface: options out of range (lambda %g, kr %g, cell %g d, "
+                          "support %g d, neighbourhood %g d)",
+                          o->lambda, o->kr, o->cell, o->support, o->pca_radius);
     }
     return PFSPH_OK;
 }
@@ -1252,10 +1259,13 @@ int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n, c
     if (rc0 != PFSPH_OK) return rc0;
     const double reach = (double)(1 << 18) * o.cell * o.spacing; /* the grid's integer coordinates */
     for (size_t i = 0; i < 3 * n; i++) {
-        if (!isfinite(x[i])) return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu has a non-finite position", i / 3);
+        if (!isfinite(x[i]))
+            return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu has a non-finite position", i / 3);
         if (fabs(x[i]) > reach)
-            return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu is %g m from the origin, beyond the meshing "
-                              "grid's %g m (2^18 cells)", i / 3, fabs(x[i]), reach);
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "surface: particle %zu is %g m from the origin, beyond the meshing "
+                              "grid's %g m (2^18 cells)",
+                              i / 3, fabs(x[i]), reach);
     }
     const float iso = (float)(o.iso > 0 ? o.iso : pfsph_surface_calibrate_iso(&o));
     mc_table *T = malloc(sizeof *T);
@@ -1482,19 +1492,23 @@ static int contour_one(const double *x, size_t n, uint8_t phase, const pfsph_sur
     int64_t i0 = (int64_t)floor(lo[0] / cellw) - 1, j0 = (int64_t)floor(lo[1] / cellw) - 1;
     int64_t nx = (int64_t)ceil(hi[0] / cellw) + 1 - i0 + 1, ny = (int64_t)ceil(hi[1] / cellw) + 1 - j0 + 1;
     if ((double)nx * (double)ny > (double)(1 << 26)) {
-        rc = pfsph_fail(err, PFSPH_EINPUT, "surface: the 2D contour's grid would have %.3g nodes (the particles "
-                        "span %g x %g m at cells of %g m); at most 2^26", (double)nx * (double)ny, hi[0] - lo[0],
-                        hi[1] - lo[1], cellw);
+        rc = pfsph_fail(err, PFSPH_EINPUT,
+                        "surface: the 2D contour's grid would have %.3g nodes (the particles "
+                        "span %g x %g m at cells of %g m); at most 2^26",
+                        (double)nx * (double)ny, hi[0] - lo[0], hi[1] - lo[1], cellw);
         goto out;
     }
     f = calloc((size_t)(nx * ny), sizeof *f);
     if (!f) goto out;
     for (size_t q = 0; q < n; q++) { /* in particle order: one sum order for every node */
         const kern2 *k = K + q;
-        int64_t a0 = (int64_t)ceil((k->c[0] - k->rad) / cellw) - i0, a1 = (int64_t)floor((k->c[0] + k->rad) / cellw) - i0;
-        int64_t b0 = (int64_t)ceil((k->c[1] - k->rad) / cellw) - j0, b1 = (int64_t)floor((k->c[1] + k->rad) / cellw) - j0;
+        int64_t a0 = (int64_t)ceil((k->c[0] - k->rad) / cellw) - i0,
+                a1 = (int64_t)floor((k->c[0] + k->rad) / cellw) - i0;
+        int64_t b0 = (int64_t)ceil((k->c[1] - k->rad) / cellw) - j0,
+                b1 = (int64_t)floor((k->c[1] + k->rad) / cellw) - j0;
         for (int64_t b = b0; b <= b1; b++)
-            for (int64_t a = a0; a <= a1; a++) f[b * nx + a] += kern2_at(k, (double)(i0 + a) * cellw, (double)(j0 + b) * cellw);
+            for (int64_t a = a0; a <= a1; a++)
+                f[b * nx + a] += kern2_at(k, (double)(i0 + a) * cellw, (double)(j0 + b) * cellw);
     }
     /* marching triangles: square (a, b) split along its diagonal (a, b)-(a+1, b+1); an edge is
      * (lower node, direction 0 +x, 1 +y, 2 +x+y), key node * 3 + direction */
@@ -1616,10 +1630,13 @@ int pfsph_surface_contour2d(const double *x, const uint8_t *phase, size_t n, con
     for (size_t i = 0; i < n; i++)
         for (int u = 0; u < 2; u++) {
             double v = x[3 * i + u];
-            if (!isfinite(v)) return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu has a non-finite position", i);
+            if (!isfinite(v))
+                return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu has a non-finite position", i);
             if (fabs(v) > reach)
-                return pfsph_fail(err, PFSPH_EINPUT, "surface: particle %zu is %g m from the origin, beyond the "
-                                  "contour grid's %g m (2^18 cells)", i, fabs(v), reach);
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "surface: particle %zu is %g m from the origin, beyond the "
+                                  "contour grid's %g m (2^18 cells)",
+                                  i, fabs(v), reach);
         }
     double iso = o.iso > 0 ? o.iso : pfsph_surface_calibrate_iso2d(&o);
     int present[256] = {0};

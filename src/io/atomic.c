@@ -44,8 +44,7 @@ int pfsph__afile_open(pfsph__afile *a, const char *path, pfsph_error *err)
     if (fd < 0) {
         int e = errno;
         afile_release(a);
-        return pfsph_fail(err, PFSPH_EIO, "%s: cannot create temporary file: %s", path,
-                          strerror(e));
+        return pfsph_fail(err, PFSPH_EIO, "%s: cannot create temporary file: %s", path, strerror(e));
     }
     a->f = fdopen(fd, "wb");
     if (!a->f) {
@@ -60,12 +59,10 @@ int pfsph__afile_open(pfsph__afile *a, const char *path, pfsph_error *err)
 
 int pfsph__afile_write(pfsph__afile *a, const void *data, size_t len, pfsph_error *err)
 {
-    if (!a->f)
-        return pfsph_fail(err, PFSPH_EIO, "%s: write after failure", a->path ? a->path : "?");
+    if (!a->f) return pfsph_fail(err, PFSPH_EIO, "%s: write after failure", a->path ? a->path : "?");
     if (len && fwrite(data, 1, len, a->f) != len) {
         int e = errno;
-        return pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", a->path,
-                          strerror(e ? e : EIO));
+        return pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", a->path, strerror(e ? e : EIO));
     }
     return PFSPH_OK;
 }
@@ -233,10 +230,16 @@ void pfsph__enc_free(pfsph__enc *e)
 size_t pfsph__type_size(int type)
 {
     switch (type) {
-    case PFSPH__T_I8: case PFSPH__T_U8: return 1;
-    case PFSPH__T_I16: case PFSPH__T_U16: return 2;
-    case PFSPH__T_I32: case PFSPH__T_U32: case PFSPH__T_F32: return 4;
-    case PFSPH__T_I64: case PFSPH__T_U64: case PFSPH__T_F64: return 8;
+    case PFSPH__T_I8:
+    case PFSPH__T_U8: return 1;
+    case PFSPH__T_I16:
+    case PFSPH__T_U16: return 2;
+    case PFSPH__T_I32:
+    case PFSPH__T_U32:
+    case PFSPH__T_F32: return 4;
+    case PFSPH__T_I64:
+    case PFSPH__T_U64:
+    case PFSPH__T_F64: return 8;
     default: return 0;
     }
 }
@@ -246,14 +249,46 @@ double pfsph__get_as_double(int type, const unsigned char *src)
     switch (type) {
     case PFSPH__T_I8: return (double)(int8_t)src[0];
     case PFSPH__T_U8: return (double)src[0];
-    case PFSPH__T_I16: { int16_t v; pfsph__get_le(&v, src, 2); return v; }
-    case PFSPH__T_U16: { uint16_t v; pfsph__get_le(&v, src, 2); return v; }
-    case PFSPH__T_I32: { int32_t v; pfsph__get_le(&v, src, 4); return v; }
-    case PFSPH__T_U32: { uint32_t v; pfsph__get_le(&v, src, 4); return v; }
-    case PFSPH__T_I64: { int64_t v; pfsph__get_le(&v, src, 8); return (double)v; }
-    case PFSPH__T_U64: { uint64_t v; pfsph__get_le(&v, src, 8); return (double)v; }
-    case PFSPH__T_F32: { float v; pfsph__get_le(&v, src, 4); return v; }
-    case PFSPH__T_F64: { double v; pfsph__get_le(&v, src, 8); return v; }
+    case PFSPH__T_I16: {
+        int16_t v;
+        pfsph__get_le(&v, src, 2);
+        return v;
+    }
+    case PFSPH__T_U16: {
+        uint16_t v;
+        pfsph__get_le(&v, src, 2);
+        return v;
+    }
+    case PFSPH__T_I32: {
+        int32_t v;
+        pfsph__get_le(&v, src, 4);
+        return v;
+    }
+    case PFSPH__T_U32: {
+        uint32_t v;
+        pfsph__get_le(&v, src, 4);
+        return v;
+    }
+    case PFSPH__T_I64: {
+        int64_t v;
+        pfsph__get_le(&v, src, 8);
+        return (double)v;
+    }
+    case PFSPH__T_U64: {
+        uint64_t v;
+        pfsph__get_le(&v, src, 8);
+        return (double)v;
+    }
+    case PFSPH__T_F32: {
+        float v;
+        pfsph__get_le(&v, src, 4);
+        return v;
+    }
+    case PFSPH__T_F64: {
+        double v;
+        pfsph__get_le(&v, src, 8);
+        return v;
+    }
     default: return 0;
     }
 }

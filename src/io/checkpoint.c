@@ -313,10 +313,7 @@ static void w_bulk(wbuf *w, const void *v, size_t n)
     w_send(w, v, n);
 }
 
-static size_t set_bytes(size_t n)
-{
-    return 8 + 4 + n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 2 + 4);
-}
+static size_t set_bytes(size_t n) { return 8 + 4 + n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 2 + 4); }
 
 static void w_set(wbuf *w, const pfsph_particles *ps)
 {
@@ -432,8 +429,7 @@ static void make_header(unsigned char *out, const pfsph_sim *sim, size_t payload
     w_u32(&w, hcrc);
 }
 
-int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t *len,
-                            pfsph_error *err)
+int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t *len, pfsph_error *err)
 {
     *data = NULL;
     *len = 0;
@@ -454,8 +450,7 @@ int pfsph_checkpoint_encode(const pfsph_sim *sim, int frame, void **data, size_t
 }
 
 /* The checkpoint into f (opened for writing at its start); *len its size. */
-static int encode_file(const pfsph_sim *sim, int frame, FILE *f, const char *path, size_t *len,
-                       pfsph_error *err)
+static int encode_file(const pfsph_sim *sim, int frame, FILE *f, const char *path, size_t *len, pfsph_error *err)
 {
     const size_t payload = payload_bytes(sim);
     const size_t total = HEADER_LEN + payload;
@@ -512,10 +507,30 @@ static uint8_t r_u8(rbuf *r)
     if (r_need(r, 1)) v = r->p[r->pos++];
     return v;
 }
-static uint32_t r_u32(rbuf *r) { uint32_t v; r_raw(r, &v, 4); return v; }
-static int32_t r_i32(rbuf *r) { int32_t v; r_raw(r, &v, 4); return v; }
-static uint64_t r_u64(rbuf *r) { uint64_t v; r_raw(r, &v, 8); return v; }
-static double r_f64(rbuf *r) { double v; r_raw(r, &v, 8); return v; }
+static uint32_t r_u32(rbuf *r)
+{
+    uint32_t v;
+    r_raw(r, &v, 4);
+    return v;
+}
+static int32_t r_i32(rbuf *r)
+{
+    int32_t v;
+    r_raw(r, &v, 4);
+    return v;
+}
+static uint64_t r_u64(rbuf *r)
+{
+    uint64_t v;
+    r_raw(r, &v, 8);
+    return v;
+}
+static double r_f64(rbuf *r)
+{
+    double v;
+    r_raw(r, &v, 8);
+    return v;
+}
 
 /* Read a particle set; ps is initialised here (free with pfsph_particles_free). */
 static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *what, pfsph_error *err)
@@ -525,11 +540,11 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
     uint32_t next_id = r_u32(r);
     const size_t per = PFSPH_NFIELDS * sizeof(pfsph_real) + 2 + 4;
     if (r->bad || n > (r->len - r->pos) / per)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle count %llu exceeds the file",
-                          name, what, (unsigned long long)n);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle count %llu exceeds the file", name,
+                          what, (unsigned long long)n);
     if (pfsph_particles_init(ps, (size_t)n ? (size_t)n : 1) != PFSPH_OK)
-        return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory for %llu %s particles", name,
-                          (unsigned long long)n, what);
+        return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory for %llu %s particles", name, (unsigned long long)n,
+                          what);
     for (int k = 0; k < PFSPH_NFIELDS; k++) {
         if (pfsph__host_le()) {
             memcpy(ps->f[k], r->p + r->pos, (size_t)n * sizeof(pfsph_real));
@@ -549,24 +564,26 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
         if (ps->id[i] >= next_id) {
             const uint32_t id = ps->id[i]; /* read before the arrays go */
             pfsph_particles_free(ps);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle id %u not below next id %u",
-                              name, what, id, next_id);
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle id %u not below next id %u", name,
+                              what, id, next_id);
         }
     for (int k = 0; k < PFSPH_NFIELDS; k++)
         for (size_t i = 0; i < ps->n; i++)
             if (!isfinite((double)ps->f[k][i])) {
                 const double v = (double)ps->f[k][i];
                 pfsph_particles_free(ps);
-                return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle %zu has a non-finite "
-                                  "field (%g)", name, what, i, v);
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "%s: corrupt checkpoint: %s particle %zu has a non-finite "
+                                  "field (%g)",
+                                  name, what, i, v);
             }
     return PFSPH_OK;
 }
 
 /* The clock and counters against the scene: the frame within what a run can hold (and the
  * file name's frame when there is one), the time on that frame, finite non-negative rates. */
-static int check_clock(const pfsph_scene *s, int32_t fr, long expect_frame, int32_t threads,
-                       const pfsph_sim_state *st, const char *name, pfsph_error *err)
+static int check_clock(const pfsph_scene *s, int32_t fr, long expect_frame, int32_t threads, const pfsph_sim_state *st,
+                       const char *name, pfsph_error *err)
 {
     if (fr < 0 || fr > PFSPH_MAX_FRAMES)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: frame %d is outside 0..%d", name, (int)fr,
@@ -575,8 +592,10 @@ static int check_clock(const pfsph_scene *s, int32_t fr, long expect_frame, int3
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: it holds frame %d, its name says %ld", name,
                           (int)fr, expect_frame);
     if (!isfinite(st->time) || !(fabs(st->time * s->fps - fr) <= 1e-6 * (1 + fr)))
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: time %g s is not the time of frame %d at "
-                          "%g fps", name, st->time, (int)fr, s->fps);
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: corrupt checkpoint: time %g s is not the time of frame %d at "
+                          "%g fps",
+                          name, st->time, (int)fr, s->fps);
     if (threads < 1 || threads > 65536)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: thread count %d", name, (int)threads);
     /* steps are at least dt_min long, except one shortened step per frame */
@@ -586,13 +605,16 @@ static int check_clock(const pfsph_scene *s, int32_t fr, long expect_frame, int3
     const struct {
         const char *what;
         double v;
-    } rates[] = {{"amax", st->amax}, {"amax_np", st->amax_np}, {"dt", st->stats.dt}, {"vmax", st->stats.vmax},
+    } rates[] = {{"amax", st->amax},
+                 {"amax_np", st->amax_np},
+                 {"dt", st->stats.dt},
+                 {"vmax", st->stats.vmax},
                  {"density_err_avg", st->stats.density_err_avg},
-                 {"density_err_max", st->stats.density_err_max}, {"ekin", st->stats.ekin}};
+                 {"density_err_max", st->stats.density_err_max},
+                 {"ekin", st->stats.ekin}};
     for (size_t k = 0; k < sizeof rates / sizeof rates[0]; k++)
         if (!(rates[k].v >= 0) || !isfinite(rates[k].v))
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s is %g", name, rates[k].what,
-                              rates[k].v);
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s is %g", name, rates[k].what, rates[k].v);
     if (st->stats.dt > s->dt_max * (1 + 1e-9))
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: dt %g s above time.dt_max %g s", name,
                           st->stats.dt, s->dt_max);
@@ -625,10 +647,9 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
     const unsigned char *b = data;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     if (len < HEADER_LEN)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: truncated checkpoint (%zu bytes, the header alone is %d)", name,
-                          len, HEADER_LEN);
-    if (memcmp(b, MAGIC, 8) != 0)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: not a pfsph checkpoint (bad magic)", name);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: truncated checkpoint (%zu bytes, the header alone is %d)", name, len,
+                          HEADER_LEN);
+    if (memcmp(b, MAGIC, 8) != 0) return pfsph_fail(err, PFSPH_EINPUT, "%s: not a pfsph checkpoint (bad magic)", name);
     rbuf r = {b, len, 8, 0};
     uint32_t version = r_u32(&r);
     uint32_t real_size = r_u32(&r);
@@ -639,11 +660,11 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
     if ((uint32_t)crc32(crc32(0L, Z_NULL, 0), b, 36) != hcrc)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: header checksum mismatch", name);
     if (version != PFSPH_CHECKPOINT_VERSION)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint format version %u, this pfsph reads version %u",
-                          name, version, PFSPH_CHECKPOINT_VERSION);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint format version %u, this pfsph reads version %u", name,
+                          version, PFSPH_CHECKPOINT_VERSION);
     if (real_size != sizeof(pfsph_real))
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint written in %s precision, this pfsph is built for %s",
-                          name, real_size == 8 ? "double" : "float", PFSPH_REAL_NAME);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint written in %s precision, this pfsph is built for %s", name,
+                          real_size == 8 ? "double" : "float", PFSPH_REAL_NAME);
     if (payload != len - HEADER_LEN)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: %s checkpoint: %zu bytes, the header says %llu", name,
                           len - HEADER_LEN < payload ? "truncated" : "corrupt", len,
@@ -658,9 +679,10 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: checksum mismatch (CRC32 %08x, expected %08x)",
                           name, crc, pcrc);
     if (hash != pfsph_scene_hash(pfsph_sim_scene(sim)))
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint belongs to another scene (scene hash %016llx, "
-                          "this scene %016llx)", name, (unsigned long long)hash,
-                          (unsigned long long)pfsph_scene_hash(pfsph_sim_scene(sim)));
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: checkpoint belongs to another scene (scene hash %016llx, "
+                          "this scene %016llx)",
+                          name, (unsigned long long)hash, (unsigned long long)pfsph_scene_hash(pfsph_sim_scene(sim)));
 
     int32_t fr = r_i32(&r);
     int32_t threads = r_i32(&r);
@@ -695,10 +717,11 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
     /* fluid particles are added only by emitters: the ids are those the scene made, then one per
      * emitted particle (checked below, once the emitters' counts are read) */
     const int nem = pfsph_emitters_count(pfsph_sim_emitters(sim));
-    if ((nem ? fluid.next_id < c->fluid->next_id : fluid.next_id != c->fluid->next_id) ||
-        st.removed > fluid.next_id) {
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: fluid next id %u and %zu removed, the scene "
-                        "makes %u fluid particles", name, fluid.next_id, st.removed, c->fluid->next_id);
+    if ((nem ? fluid.next_id < c->fluid->next_id : fluid.next_id != c->fluid->next_id) || st.removed > fluid.next_id) {
+        rc = pfsph_fail(err, PFSPH_EINPUT,
+                        "%s: corrupt checkpoint: fluid next id %u and %zu removed, the scene "
+                        "makes %u fluid particles",
+                        name, fluid.next_id, st.removed, c->fluid->next_id);
         pfsph_particles_free(&fluid);
         return rc;
     }
@@ -730,11 +753,9 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
         if (bst && !r.bad && nbid <= (r.len - r.pos) / 4) {
             bids = malloc((nbid ? nbid : 1) * sizeof *bids);
             for (uint64_t j = 0; bids && j < nbid; j++) bids[j] = r_u32(&r);
-        } else
-            r.bad = 1;
+        } else r.bad = 1;
         if (!bst || !bids) r.bad = 1;
-    } else if (nbod > PFSPH_MAX_BODIES)
-        r.bad = 1;
+    } else if (nbod > PFSPH_MAX_BODIES) r.bad = 1;
     pfsph_emitter_state est[PFSPH_MAX_EMITTERS];
     uint64_t emitted = 0;
     if (nem && !r.bad) {
@@ -753,12 +774,15 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
         rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint has %u bodies, the scene %d", name, nbod,
                         pfsph_bodies_count(pfsph_sim_bodies(sim)));
     } else if (nbod && nbp != pfsph_bodies_particle_count(pfsph_sim_bodies(sim))) {
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint has %u body particles, the scene makes %u (a mesh file "
-                        "changed?)", name, nbp, pfsph_bodies_particle_count(pfsph_sim_bodies(sim)));
+        rc = pfsph_fail(err, PFSPH_EINPUT,
+                        "%s: checkpoint has %u body particles, the scene makes %u (a mesh file "
+                        "changed?)",
+                        name, nbp, pfsph_bodies_particle_count(pfsph_sim_bodies(sim)));
     } else if (nem && (uint64_t)fluid.next_id != (uint64_t)c->fluid->next_id + emitted) {
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: fluid next id %u, the scene makes %u fluid "
-                        "particles and its emitters made %llu", name, fluid.next_id, c->fluid->next_id,
-                        (unsigned long long)emitted);
+        rc = pfsph_fail(err, PFSPH_EINPUT,
+                        "%s: corrupt checkpoint: fluid next id %u, the scene makes %u fluid "
+                        "particles and its emitters made %llu",
+                        name, fluid.next_id, c->fluid->next_id, (unsigned long long)emitted);
     } else if (nem && check_emitters(pfsph_sim_emitters(sim), nem, est, st.time, name, err)) {
         rc = PFSPH_EINPUT;
     } else if ((has_d != 0) != (pfsph_sim_diffuse(sim) != NULL)) {
@@ -787,8 +811,8 @@ static int decode(pfsph_sim *sim, const void *data, size_t len, const char *name
     return rc;
 }
 
-int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const char *name,
-                            pfsph_checkpoint_info *info, pfsph_error *err)
+int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const char *name, pfsph_checkpoint_info *info,
+                            pfsph_error *err)
 {
     return decode(sim, data, len, name, -1, info, err);
 }
@@ -797,8 +821,7 @@ int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const 
 
 static long name_frame(const char *name);
 
-static int save(const char *path, const pfsph_sim *sim, int frame, int durable, size_t *bytes,
-                pfsph_error *err)
+static int save(const char *path, const pfsph_sim *sim, int frame, int durable, size_t *bytes, pfsph_error *err)
 {
     pfsph__afile a;
     int rc = pfsph__afile_open(&a, path, err);
@@ -813,8 +836,7 @@ static int save(const char *path, const pfsph_sim *sim, int frame, int durable, 
     return rc;
 }
 
-int pfsph_checkpoint_save(const char *path, const pfsph_sim *sim, int frame, size_t *bytes,
-                          pfsph_error *err)
+int pfsph_checkpoint_save(const char *path, const pfsph_sim *sim, int frame, size_t *bytes, pfsph_error *err)
 {
     return save(path, sim, frame, 1, bytes, err);
 }
@@ -829,8 +851,7 @@ int pfsph_checkpoint_keep(const char *stash, const char *dest, pfsph_error *err)
     return pfsph__rename_durable(stash, dest, err);
 }
 
-int pfsph_checkpoint_load(const char *path, pfsph_sim *sim, pfsph_checkpoint_info *info,
-                          pfsph_error *err)
+int pfsph_checkpoint_load(const char *path, pfsph_sim *sim, pfsph_checkpoint_info *info, pfsph_error *err)
 {
     unsigned char *data;
     size_t len;
@@ -905,8 +926,8 @@ static int list_checkpoints(const char *run_dir, long **out, size_t *n, pfsph_er
     return PFSPH_OK;
 }
 
-int pfsph_checkpoint_write_run(const char *run_dir, const pfsph_sim *sim, int frame, int keep,
-                               size_t *bytes, pfsph_error *err)
+int pfsph_checkpoint_write_run(const char *run_dir, const pfsph_sim *sim, int frame, int keep, size_t *bytes,
+                               pfsph_error *err)
 {
     char path[PFSPH_PATH_LEN + 64];
     snprintf(path, sizeof path, "%s/checkpoints", run_dir);
@@ -967,8 +988,8 @@ static void remove_temporaries(const char *run_dir)
     closedir(d);
 }
 
-int pfsph_checkpoint_resume(const char *run_dir, pfsph_sim *sim, pfsph_checkpoint_info *info,
-                            pfsph_message_fn warn, void *user, pfsph_error *err)
+int pfsph_checkpoint_resume(const char *run_dir, pfsph_sim *sim, pfsph_checkpoint_info *info, pfsph_message_fn warn,
+                            void *user, pfsph_error *err)
 {
     long *frames;
     size_t n;
@@ -1003,6 +1024,5 @@ int pfsph_checkpoint_resume(const char *run_dir, pfsph_sim *sim, pfsph_checkpoin
     }
     free(frames);
     snprintf(path, sizeof path, "%s/checkpoints", run_dir);
-    return pfsph_fail(err, PFSPH_EINPUT, "%s: no valid checkpoint to resume from (all were rejected, see above)",
-                      path);
+    return pfsph_fail(err, PFSPH_EINPUT, "%s: no valid checkpoint to resume from (all were rejected, see above)", path);
 }

@@ -16,14 +16,17 @@ int pfsph_write_houdini_geo(const char *path, const pfsph_particles *ps, double 
     int rc = pfsph__enc_open(&e, &af, path, err);
     if (rc != PFSPH_OK) return rc;
     (void)time; /* the frame number gives it; no detail attribute, to stay in the documented core */
-    pfsph__enc_printf(&e, "PGEOMETRY V5\nNPoints %zu NPrims 0\nNPointGroups 0 NPrimGroups 0\n"
-                      "NPointAttrib 5 NVertexAttrib 0 NPrimAttrib 0 NAttrib 0\n", ps->n);
-    pfsph__enc_printf(&e, "PointAttrib\nv 3 vector 0 0 0\ndensity 1 float 0\npressure 1 float 0\n"
+    pfsph__enc_printf(&e,
+                      "PGEOMETRY V5\nNPoints %zu NPrims 0\nNPointGroups 0 NPrimGroups 0\n"
+                      "NPointAttrib 5 NVertexAttrib 0 NPrimAttrib 0 NAttrib 0\n",
+                      ps->n);
+    pfsph__enc_printf(&e,
+                      "PointAttrib\nv 3 vector 0 0 0\ndensity 1 float 0\npressure 1 float 0\n"
                       "phase 1 int 0\nid 1 int 0\n");
     for (size_t i = 0; i < ps->n; i++)
-        pfsph__enc_printf(&e, "%.9g %.9g %.9g 1 (%.9g %.9g %.9g %.9g %.9g %d %u)\n", (double)ps->x[i],
-                          (double)ps->y[i], (double)ps->z[i], (double)ps->vx[i], (double)ps->vy[i],
-                          (double)ps->vz[i], (double)ps->rho[i], (double)ps->p[i], ps->phase[i], ps->id[i]);
+        pfsph__enc_printf(&e, "%.9g %.9g %.9g 1 (%.9g %.9g %.9g %.9g %.9g %d %u)\n", (double)ps->x[i], (double)ps->y[i],
+                          (double)ps->z[i], (double)ps->vx[i], (double)ps->vy[i], (double)ps->vz[i], (double)ps->rho[i],
+                          (double)ps->p[i], ps->phase[i], ps->id[i]);
     pfsph__enc_printf(&e, "beginExtra\nendExtra\n");
     rc = pfsph__enc_flush(&e);
     pfsph__enc_free(&e);
@@ -34,12 +37,12 @@ int pfsph_write_houdini_geo(const char *path, const pfsph_particles *ps, double 
     return pfsph__afile_commit(&af, err);
 }
 
-#define BAD(...)                                                                                   \
-    do {                                                                                           \
-        char why_[256];                                                                            \
-        snprintf(why_, sizeof why_, __VA_ARGS__);                                                  \
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s:%d: %s", path, line, why_);                         \
-        goto out;                                                                                  \
+#define BAD(...)                                                           \
+    do {                                                                   \
+        char why_[256];                                                    \
+        snprintf(why_, sizeof why_, __VA_ARGS__);                          \
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s:%d: %s", path, line, why_); \
+        goto out;                                                          \
     } while (0)
 
 /* the next line of text (NUL-terminated in place); NULL at the end */
@@ -175,6 +178,7 @@ int pfsph_export_houdini(const char *dir, int *frames, pfsph_error *err)
         pfsph_particles_free(&ps);
         if (!rc) (*frames)++;
     }
-    if (!rc && !*frames) rc = pfsph_fail(err, PFSPH_EINPUT, "%s: no fluid frames (frames/fluid_NNNNN.vtp or .ply)", dir);
+    if (!rc && !*frames)
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: no fluid frames (frames/fluid_NNNNN.vtp or .ply)", dir);
     return rc;
 }

@@ -35,9 +35,19 @@ void pfsph__afile_abort(pfsph__afile *a);
 int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_error *err);
 
 /* Scalar type codes of the on-disk formats. */
-enum pfsph__type { PFSPH__T_NONE = 0, PFSPH__T_I8, PFSPH__T_U8, PFSPH__T_I16, PFSPH__T_U16,
-                   PFSPH__T_I32, PFSPH__T_U32, PFSPH__T_I64, PFSPH__T_U64, PFSPH__T_F32,
-                   PFSPH__T_F64 };
+enum pfsph__type {
+    PFSPH__T_NONE = 0,
+    PFSPH__T_I8,
+    PFSPH__T_U8,
+    PFSPH__T_I16,
+    PFSPH__T_U16,
+    PFSPH__T_I32,
+    PFSPH__T_U32,
+    PFSPH__T_I64,
+    PFSPH__T_U64,
+    PFSPH__T_F32,
+    PFSPH__T_F64
+};
 size_t pfsph__type_size(int type);
 /* A PLY scalar type name ("float", "uint8", ...) as its code; PFSPH__T_NONE if unknown. */
 int pfsph__ply_type(const char *s);
@@ -71,10 +81,7 @@ static inline void pfsph__put_le(unsigned char *dst, const void *src, size_t siz
         }
 }
 
-static inline void pfsph__get_le(void *dst, const unsigned char *src, size_t size)
-{
-    pfsph__put_le(dst, src, size);
-}
+static inline void pfsph__get_le(void *dst, const unsigned char *src, size_t size) { pfsph__put_le(dst, src, size); }
 
 /* A small write buffer in front of an atomic file, so values can be emitted one at a time. */
 typedef struct pfsph__enc {

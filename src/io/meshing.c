@@ -31,10 +31,14 @@ int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, doubl
     if (rc != PFSPH_OK) return rc;
     pfsph__enc_printf(&e, "ply\nformat binary_little_endian 1.0\ncomment pfsph %s liquid surface\n", PFSPH_VERSION);
     pfsph__enc_printf(&e, "comment time %.17g\n", time);
-    pfsph__enc_printf(&e, "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
-                      "property float nx\nproperty float ny\nproperty float nz\n", m->nverts);
-    pfsph__enc_printf(&e, "element face %zu\nproperty list uchar uint vertex_indices\nproperty uchar phase\n"
-                      "end_header\n", m->ntris);
+    pfsph__enc_printf(&e,
+                      "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
+                      "property float nx\nproperty float ny\nproperty float nz\n",
+                      m->nverts);
+    pfsph__enc_printf(&e,
+                      "element face %zu\nproperty list uchar uint vertex_indices\nproperty uchar phase\n"
+                      "end_header\n",
+                      m->ntris);
     for (size_t i = 0; i < m->nverts; i++) {
         for (int k = 0; k < 3; k++) {
             float v = (float)m->v[3 * i + k];
@@ -72,23 +76,34 @@ int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, doubl
 
 /* VTP PolyData of a mesh or an outline: points, Normals (point data), cells of `arity` indices
  * under `cells` ("Polys" or "Lines"), phase (cell data), TimeValue. Atomic. */
-static int write_polydata_vtp(const char *path, const double *v, const float *nrm, size_t nverts,
-                              const uint32_t *idx, const uint8_t *phase, size_t ncells, int arity,
-                              const char *cells, double time, pfsph_error *err)
+static int write_polydata_vtp(const char *path, const double *v, const float *nrm, size_t nverts, const uint32_t *idx,
+                              const uint8_t *phase, size_t ncells, int arity, const char *cells, double time,
+                              pfsph_error *err)
 {
     pfsph__afile af;
     pfsph__enc e;
     int rc = pfsph__enc_open(&e, &af, path, err);
     if (rc != PFSPH_OK) return rc;
-    pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n");
-    pfsph__enc_printf(&e, "<FieldData>\n<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.17g</DataArray>\n</FieldData>\n", time);
-    pfsph__enc_printf(&e, "<Piece NumberOfPoints=\"%zu\" NumberOf%s=\"%zu\">\n<Points>\n<DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">\n", nverts, cells, ncells);
-    for (size_t i = 0; i < nverts; i++)
-        pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
-    pfsph__enc_printf(&e, "</DataArray>\n</Points>\n<PointData Normals=\"Normals\">\n<DataArray type=\"Float32\" Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    pfsph__enc_printf(&e,
+                      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" "
+                      "byte_order=\"LittleEndian\">\n<PolyData>\n");
+    pfsph__enc_printf(&e,
+                      "<FieldData>\n<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" "
+                      "format=\"ascii\">%.17g</DataArray>\n</FieldData>\n",
+                      time);
+    pfsph__enc_printf(&e,
+                      "<Piece NumberOfPoints=\"%zu\" NumberOf%s=\"%zu\">\n<Points>\n<DataArray type=\"Float32\" "
+                      "NumberOfComponents=\"3\" format=\"ascii\">\n",
+                      nverts, cells, ncells);
+    for (size_t i = 0; i < nverts; i++) pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    pfsph__enc_printf(&e,
+                      "</DataArray>\n</Points>\n<PointData Normals=\"Normals\">\n<DataArray type=\"Float32\" "
+                      "Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for (size_t i = 0; i < nverts; i++)
         pfsph__enc_printf(&e, "%.5f %.5f %.5f\n", nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
-    pfsph__enc_printf(&e, "</DataArray>\n</PointData>\n<%s>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n", cells);
+    pfsph__enc_printf(
+        &e, "</DataArray>\n</PointData>\n<%s>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n",
+        cells);
     for (size_t t = 0; t < ncells; t++) {
         const uint32_t *c = idx + (size_t)arity * t;
         if (arity == 3) pfsph__enc_printf(&e, "%u %u %u\n", c[0], c[1], c[2]);
@@ -96,7 +111,10 @@ static int write_polydata_vtp(const char *path, const double *v, const float *nr
     }
     pfsph__enc_printf(&e, "</DataArray>\n<DataArray type=\"UInt32\" Name=\"offsets\" format=\"ascii\">\n");
     for (size_t t = 1; t <= ncells; t++) pfsph__enc_printf(&e, "%zu\n", (size_t)arity * t);
-    pfsph__enc_printf(&e, "</DataArray>\n</%s>\n<CellData Scalars=\"phase\">\n<DataArray type=\"UInt8\" Name=\"phase\" format=\"ascii\">\n", cells);
+    pfsph__enc_printf(&e,
+                      "</DataArray>\n</%s>\n<CellData Scalars=\"phase\">\n<DataArray type=\"UInt8\" Name=\"phase\" "
+                      "format=\"ascii\">\n",
+                      cells);
     for (size_t t = 0; t < ncells; t++) pfsph__enc_printf(&e, "%d\n", phase[t]);
     pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
     return finish(&e, &af, err);
@@ -125,12 +143,12 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
     size_t len;
     int rc = pfsph__read_file(path, &buf, &len, err);
     if (rc != PFSPH_OK) return rc;
-#define BAD(...)                                                                           \
-    do {                                                                                   \
-        char m_[400];                                                                      \
-        snprintf(m_, sizeof m_, __VA_ARGS__);                                              \
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid surface PLY: %s", path, m_);       \
-        goto done;                                                                         \
+#define BAD(...)                                                                     \
+    do {                                                                             \
+        char m_[400];                                                                \
+        snprintf(m_, sizeof m_, __VA_ARGS__);                                        \
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid surface PLY: %s", path, m_); \
+        goto done;                                                                   \
     } while (0)
     surf_prop vp[SURF_MAX_PROPS], fp[SURF_MAX_PROPS];
     int nvp = 0, nfp = 0, elem = 0; /* elem: 0 none yet, 1 vertex, 2 face */
@@ -221,8 +239,8 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
     const size_t isz = 4, frecord = 1 + 3 * isz + frec;
     size_t avail = len - pos;
     if ((vrec && nv > avail / vrec) || nv * vrec + nt * frecord != avail)
-        BAD("%zu bytes of data, expected %" PRIu64 " vertices of %zu bytes and %" PRIu64
-            " triangles of %zu bytes", avail, nv, vrec, nt, frecord);
+        BAD("%zu bytes of data, expected %" PRIu64 " vertices of %zu bytes and %" PRIu64 " triangles of %zu bytes",
+            avail, nv, vrec, nt, frecord);
     m->v = malloc(3 * (nv ? nv : 1) * sizeof *m->v);
     m->n = normals ? malloc(3 * (nv ? nv : 1) * sizeof *m->n) : NULL;
     m->tri = malloc(3 * (nt ? nt : 1) * sizeof *m->tri);
@@ -366,8 +384,10 @@ int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frame
     pfsph_surface_output so = over ? *over : s->output.surface;
     if (s->dim == 2) {
         if (so.ply || so.obj) {
-            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: a 2D run: its outline is written as VTP polylines only "
-                            "(--formats vtp); nothing written", dir);
+            rc = pfsph_fail(err, PFSPH_EINPUT,
+                            "%s: a 2D run: its outline is written as VTP polylines only "
+                            "(--formats vtp); nothing written",
+                            dir);
             free(s);
             return rc;
         }
@@ -462,7 +482,8 @@ int pfsph_write_pvd_collections(const char *dir, double frame_dt, pfsph_error *e
             rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
             break;
         }
-        len += (size_t)snprintf(buf + len, bcap - len, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
+        len += (size_t)snprintf(buf + len, bcap - len,
+                                "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
                                 "version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
         for (size_t i = 0; i < n[k]; i++)
             len += (size_t)snprintf(buf + len, line,

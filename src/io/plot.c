@@ -41,27 +41,20 @@ static const struct {
     char c;
     unsigned char row[7];
 } font[] = {
-    {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},
-    {'2', {14, 17, 1, 2, 4, 8, 31}},     {'3', {31, 2, 4, 2, 1, 17, 14}},
-    {'4', {2, 6, 10, 18, 31, 2, 2}},     {'5', {31, 16, 30, 1, 1, 17, 14}},
-    {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},
-    {'8', {14, 17, 17, 14, 17, 17, 14}}, {'9', {14, 17, 17, 15, 1, 2, 12}},
-    {'.', {0, 0, 0, 0, 0, 12, 12}},      {'-', {0, 0, 0, 31, 0, 0, 0}},
-    {'+', {0, 4, 4, 31, 4, 4, 0}},       {'[', {14, 8, 8, 8, 8, 8, 14}},
-    {']', {14, 2, 2, 2, 2, 2, 14}},      {'(', {2, 4, 8, 8, 8, 4, 2}},
-    {')', {8, 4, 2, 2, 2, 4, 8}},        {'a', {0, 0, 14, 1, 15, 17, 15}},
-    {'b', {16, 16, 22, 25, 17, 17, 30}}, {'c', {0, 0, 14, 16, 16, 17, 14}},
-    {'d', {1, 1, 13, 19, 17, 17, 15}},   {'e', {0, 0, 14, 17, 31, 16, 14}},
-    {'f', {6, 9, 8, 28, 8, 8, 8}},       {'g', {0, 15, 17, 17, 15, 1, 14}},
-    {'i', {4, 0, 12, 4, 4, 4, 14}},      {'k', {16, 16, 18, 20, 24, 20, 18}},
-    {'l', {12, 4, 4, 4, 4, 4, 14}},      {'m', {0, 0, 26, 21, 21, 17, 17}},
-    {'n', {0, 0, 22, 25, 17, 17, 17}},   {'o', {0, 0, 14, 17, 17, 17, 14}},
-    {'p', {0, 0, 30, 17, 30, 16, 16}},   {'r', {0, 0, 22, 25, 16, 16, 16}},
-    {'s', {0, 0, 14, 16, 14, 1, 30}},    {'t', {8, 8, 28, 8, 8, 9, 6}},
-    {'u', {0, 0, 17, 17, 17, 19, 13}},   {'w', {0, 0, 17, 17, 21, 21, 10}},
-    {'y', {0, 0, 17, 17, 15, 1, 14}},    {'M', {17, 27, 21, 21, 17, 17, 17}},
-    {'N', {17, 25, 21, 19, 17, 17, 17}}, {'D', {28, 18, 17, 17, 17, 18, 28}},
-    {'F', {31, 16, 16, 30, 16, 16, 16}}, {'S', {15, 16, 16, 14, 1, 1, 30}},
+    {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},      {'2', {14, 17, 1, 2, 4, 8, 31}},
+    {'3', {31, 2, 4, 2, 1, 17, 14}},     {'4', {2, 6, 10, 18, 31, 2, 2}},     {'5', {31, 16, 30, 1, 1, 17, 14}},
+    {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},       {'8', {14, 17, 17, 14, 17, 17, 14}},
+    {'9', {14, 17, 17, 15, 1, 2, 12}},   {'.', {0, 0, 0, 0, 0, 12, 12}},      {'-', {0, 0, 0, 31, 0, 0, 0}},
+    {'+', {0, 4, 4, 31, 4, 4, 0}},       {'[', {14, 8, 8, 8, 8, 8, 14}},      {']', {14, 2, 2, 2, 2, 2, 14}},
+    {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},        {'a', {0, 0, 14, 1, 15, 17, 15}},
+    {'b', {16, 16, 22, 25, 17, 17, 30}}, {'c', {0, 0, 14, 16, 16, 17, 14}},   {'d', {1, 1, 13, 19, 17, 17, 15}},
+    {'e', {0, 0, 14, 17, 31, 16, 14}},   {'f', {6, 9, 8, 28, 8, 8, 8}},       {'g', {0, 15, 17, 17, 15, 1, 14}},
+    {'i', {4, 0, 12, 4, 4, 4, 14}},      {'k', {16, 16, 18, 20, 24, 20, 18}}, {'l', {12, 4, 4, 4, 4, 4, 14}},
+    {'m', {0, 0, 26, 21, 21, 17, 17}},   {'n', {0, 0, 22, 25, 17, 17, 17}},   {'o', {0, 0, 14, 17, 17, 17, 14}},
+    {'p', {0, 0, 30, 17, 30, 16, 16}},   {'r', {0, 0, 22, 25, 16, 16, 16}},   {'s', {0, 0, 14, 16, 14, 1, 30}},
+    {'t', {8, 8, 28, 8, 8, 9, 6}},       {'u', {0, 0, 17, 17, 17, 19, 13}},   {'w', {0, 0, 17, 17, 21, 21, 10}},
+    {'y', {0, 0, 17, 17, 15, 1, 14}},    {'M', {17, 27, 21, 21, 17, 17, 17}}, {'N', {17, 25, 21, 19, 17, 17, 17}},
+    {'D', {28, 18, 17, 17, 17, 18, 28}}, {'F', {31, 16, 16, 30, 16, 16, 16}}, {'S', {15, 16, 16, 14, 1, 1, 30}},
 };
 
 /* Text at (x, y) = top-left, scale s; returns the width drawn. */
@@ -118,8 +111,8 @@ static int write_png(const char *path, img *im, pfsph_error *err)
         return pfsph_fail(err, PFSPH_EIO, "%s: PNG encoding failed", path);
     }
     png_init_io(png, fp);
-    png_set_IHDR(png, info, W, H, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, W, H, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
     for (int y = 0; y < H; y++) png_write_row(png, im->px + (size_t)y * W * 3);
     png_write_end(png, NULL);
@@ -153,8 +146,7 @@ int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error 
     for (int k = 0; k < 4; k++)
         if (col[k] < 0) {
             fclose(fp);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: no column \"%s\" in the header",
-                              stats_csv, want[k]);
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: no column \"%s\" in the header", stats_csv, want[k]);
         }
     size_t n = 0, cap = 0;
     double *v = NULL; /* n rows x 4 */
@@ -179,8 +171,7 @@ int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error 
             if (col[k] >= nf || end == f[col[k]] || !isfinite(x)) {
                 free(v);
                 fclose(fp);
-                return pfsph_fail(err, PFSPH_EINPUT, "%s:%ld: bad value in column \"%s\"",
-                                  stats_csv, lineno, want[k]);
+                return pfsph_fail(err, PFSPH_EINPUT, "%s:%ld: bad value in column \"%s\"", stats_csv, lineno, want[k]);
             }
             v[4 * n + k] = x;
         }
@@ -206,10 +197,9 @@ int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error 
     }
     memset(im.px, 255, (size_t)W * H * 3);
     const unsigned char black[3] = {0, 0, 0}, grey[3] = {225, 225, 225};
-    const unsigned char colors[4][3] = {{40, 100, 220}, {30, 160, 60}, {220, 60, 40},
-                                        {90, 90, 90}};
+    const unsigned char colors[4][3] = {{40, 100, 220}, {30, 160, 60}, {220, 60, 40}, {90, 90, 90}};
     const int pw = W - ML - MR, ph = H - MT - MB;
-#define PX(t) (ML + (int)lround(((t) - t0) / (t1 - t0) * pw))
+#define PX(t) (ML + (int)lround(((t)-t0) / (t1 - t0) * pw))
 #define PY(c) (MT + ph - (int)lround((c) / ymax * ph))
     char lab[64];
     for (double y = 0; y <= ymax * (1 + 1e-9); y += ystep) {
@@ -234,8 +224,7 @@ int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error 
     }
     for (int k = 3; k >= 0; k--)
         for (size_t i = 1; i < n; i++) {
-            double a = k < 3 ? v[4 * (i - 1) + 1 + k]
-                             : v[4 * (i - 1) + 1] + v[4 * (i - 1) + 2] + v[4 * (i - 1) + 3];
+            double a = k < 3 ? v[4 * (i - 1) + 1 + k] : v[4 * (i - 1) + 1] + v[4 * (i - 1) + 2] + v[4 * (i - 1) + 3];
             double b = k < 3 ? v[4 * i + 1 + k] : v[4 * i + 1] + v[4 * i + 2] + v[4 * i + 3];
             line(&im, PX(v[4 * (i - 1)]), PY(a), PX(v[4 * i]), PY(b), colors[k], 2);
         }

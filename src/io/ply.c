@@ -10,8 +10,7 @@
 
 #define REAL_PLY (sizeof(pfsph_real) == 4 ? "float" : "double")
 
-int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o,
-                    pfsph_error *err)
+int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o, pfsph_error *err)
 {
     pfsph_io_opts def = {.dim = 3};
     if (!o) o = &def;
@@ -75,13 +74,14 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
 
 int pfsph__ply_type(const char *s)
 {
-    static const struct { const char *n; int t; } map[] = {
-        {"char", PFSPH__T_I8},    {"int8", PFSPH__T_I8},       {"uchar", PFSPH__T_U8},
-        {"uint8", PFSPH__T_U8},   {"short", PFSPH__T_I16},     {"int16", PFSPH__T_I16},
-        {"ushort", PFSPH__T_U16}, {"uint16", PFSPH__T_U16},    {"int", PFSPH__T_I32},
-        {"int32", PFSPH__T_I32},  {"uint", PFSPH__T_U32},      {"uint32", PFSPH__T_U32},
-        {"float", PFSPH__T_F32},  {"float32", PFSPH__T_F32},   {"double", PFSPH__T_F64},
-        {"float64", PFSPH__T_F64},
+    static const struct {
+        const char *n;
+        int t;
+    } map[] = {
+        {"char", PFSPH__T_I8},   {"int8", PFSPH__T_I8},     {"uchar", PFSPH__T_U8},   {"uint8", PFSPH__T_U8},
+        {"short", PFSPH__T_I16}, {"int16", PFSPH__T_I16},   {"ushort", PFSPH__T_U16}, {"uint16", PFSPH__T_U16},
+        {"int", PFSPH__T_I32},   {"int32", PFSPH__T_I32},   {"uint", PFSPH__T_U32},   {"uint32", PFSPH__T_U32},
+        {"float", PFSPH__T_F32}, {"float32", PFSPH__T_F32}, {"double", PFSPH__T_F64}, {"float64", PFSPH__T_F64},
     };
     for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
         if (strcmp(s, map[i].n) == 0) return map[i].t;
@@ -125,12 +125,12 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
     size_t len;
     int rc = pfsph__read_file(path, &buf, &len, err);
     if (rc != PFSPH_OK) return rc;
-#define BAD(...)                                                                           \
-    do {                                                                                   \
-        char m_[512];                                                                      \
-        snprintf(m_, sizeof m_, __VA_ARGS__);                                              \
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid PLY file: %s", path, m_);          \
-        goto done;                                                                         \
+#define BAD(...)                                                                  \
+    do {                                                                          \
+        char m_[512];                                                             \
+        snprintf(m_, sizeof m_, __VA_ARGS__);                                     \
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid PLY file: %s", path, m_); \
+        goto done;                                                                \
     } while (0)
     ply_prop props[MAX_PROPS];
     int np = 0;
@@ -165,8 +165,7 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
         } else if (strcmp(w1, "element") == 0) {
             if (nw != 3 || strcmp(w2, "vertex") || have_vertex)
                 BAD("line %zu: only one 'element vertex' is supported", lineno);
-            if (pfsph__parse_u64(w3, &nvert) != 0)
-                BAD("line %zu: bad vertex count", lineno);
+            if (pfsph__parse_u64(w3, &nvert) != 0) BAD("line %zu: bad vertex count", lineno);
             have_vertex = true;
         } else if (strcmp(w1, "property") == 0) {
             if (!have_vertex) BAD("line %zu: property before element", lineno);
@@ -190,10 +189,8 @@ int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_er
     if (rec == 0 && nvert > 0) BAD("vertex element without properties");
     size_t avail = len - pos;
     if (nvert > UINT32_MAX || (rec && nvert > avail / rec))
-        BAD("%" PRIu64 " vertices of %zu bytes need more than the %zu bytes left", nvert, rec,
-            avail);
-    if (nvert * rec != avail)
-        BAD("%zu trailing bytes after %" PRIu64 " vertices", avail - (size_t)nvert * rec, nvert);
+        BAD("%" PRIu64 " vertices of %zu bytes need more than the %zu bytes left", nvert, rec, avail);
+    if (nvert * rec != avail) BAD("%zu trailing bytes after %" PRIu64 " vertices", avail - (size_t)nvert * rec, nvert);
     const size_t n = (size_t)nvert;
     rc = pfsph_particles_init(ps, n ? n : 1);
     if (rc != PFSPH_OK) {

@@ -97,8 +97,8 @@ void pfsph_frame_list_free(frame_list *fl)
     memset(fl, 0, sizeof *fl);
 }
 
-static int read_frame(const char *dir, const char *prefix, int num, bool ply, pfsph_particles *ps,
-                      double *time, pfsph_error *err)
+static int read_frame(const char *dir, const char *prefix, int num, bool ply, pfsph_particles *ps, double *time,
+                      pfsph_error *err)
 {
     char path[PFSPH_PATH_LEN + 64];
     snprintf(path, sizeof path, "%s/%s%05d.%s", dir, prefix, num, ply ? "ply" : "vtp");
@@ -115,10 +115,7 @@ typedef struct cam {
     int w, h;      /* supersampled image size */
 } cam;
 
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
+static double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 static void cross3(const double a[3], const double b[3], double o[3])
 {
@@ -134,8 +131,7 @@ static void norm3(double a[3])
         for (int k = 0; k < 3; k++) a[k] /= l;
 }
 
-static void look_at(cam *c, const double eye[3], const double target[3], const double up[3],
-                    double fov_deg)
+static void look_at(cam *c, const double eye[3], const double target[3], const double up[3], double fov_deg)
 {
     for (int k = 0; k < 3; k++) {
         c->eye[k] = eye[k];
@@ -232,7 +228,7 @@ static void setup_camera(cam *c, const pfsph_scene *s, const box3 *bx)
         if (fabs(up[k]) > fabs(up[a])) a = k;
     double right[3] = {0, 0, 0}, back[3];
     right[a == 0 ? 1 : 0] = 1; /* x, unless x is up: y up gives back = +z, z up back = -y */
-    cross3(right, up, back); /* towards the viewer */
+    cross3(right, up, back);   /* towards the viewer */
     double dir[3];
     for (int k = 0; k < 3; k++) dir[k] = 0.55 * right[k] + 0.6 * up[k] + 1.0 * back[k];
     norm3(dir);
@@ -257,11 +253,11 @@ static void setup_camera(cam *c, const pfsph_scene *s, const box3 *bx)
 /* ---- splatting -------------------------------------------------------------------------- */
 
 typedef struct splat {
-    float sx, sy, r;  /* screen centre and radius, supersampled pixels */
-    float depth, rw;  /* depth of the centre, sphere radius in depth units */
+    float sx, sy, r; /* screen centre and radius, supersampled pixels */
+    float depth, rw; /* depth of the centre, sphere radius in depth units */
     float col[3];
-    float relief;     /* 0..1: how much shading; discs of a pixel or two are drawn flat */
-    uint8_t layer;    /* 0 fluid/diffuse, 1 boundary */
+    float relief;  /* 0..1: how much shading; discs of a pixel or two are drawn flat */
+    uint8_t layer; /* 0 fluid/diffuse, 1 boundary */
 } splat;
 
 /* Supersampled layers (0 fluid and diffuse, 1 boundary): nearest depth and the splat that
@@ -297,8 +293,10 @@ static bool project(const cam *c, const double p[3], double rad, splat *s)
 static void colormap(double t, float out[3])
 {
     /* Viridis, sampled at five stops. */
-    static const float st[5][3] = {{0.267f, 0.005f, 0.329f}, {0.229f, 0.322f, 0.546f},
-                                   {0.128f, 0.567f, 0.551f}, {0.369f, 0.789f, 0.383f},
+    static const float st[5][3] = {{0.267f, 0.005f, 0.329f},
+                                   {0.229f, 0.322f, 0.546f},
+                                   {0.128f, 0.567f, 0.551f},
+                                   {0.369f, 0.789f, 0.383f},
                                    {0.993f, 0.906f, 0.144f}};
     if (!(t > 0)) t = 0;
     if (t > 1) t = 1;
@@ -394,10 +392,9 @@ bool pfsph_cutaway_hides(const pfsph_cutaway *cw, const double eye[3], const dou
     return false;
 }
 
-static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, double rad,
-                   int layer, int kind /* 0 fluid, 1 boundary, 2 diffuse, 3 bodies */,
-                   const pfsph_scene *sc, int by, double vref, int ssf, const pfsph_cutaway *cw,
-                   double range[2])
+static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, double rad, int layer,
+                   int kind /* 0 fluid, 1 boundary, 2 diffuse, 3 bodies */, const pfsph_scene *sc, int by, double vref,
+                   int ssf, const pfsph_cutaway *cw, double range[2])
 {
     if (ss->n + ps->n > ss->cap) {
         size_t cap = ss->n + ps->n;
@@ -423,10 +420,8 @@ static int add_set(splat_set *ss, const cam *c, const pfsph_particles *ps, doubl
         if (kind == 1) {
             /* walls recede in light grey unless their phase asks for a colour */
             int ph = ps->phase[i];
-            if (ph < sc->nphases && sc->phases[ph].color_set)
-                memcpy(s->col, sc->phases[ph].color, sizeof s->col);
-            else
-                s->col[0] = 0.78f, s->col[1] = 0.78f, s->col[2] = 0.80f;
+            if (ph < sc->nphases && sc->phases[ph].color_set) memcpy(s->col, sc->phases[ph].color, sizeof s->col);
+            else s->col[0] = 0.78f, s->col[1] = 0.78f, s->col[2] = 0.80f;
         } else if (kind == 2) {
             int t = ps->phase[i] < 3 ? ps->phase[i] : 0;
             memcpy(s->col, DIFFUSE_COL[t], sizeof s->col);
@@ -615,8 +610,8 @@ static int png_encode(const uint8_t *rgb, int w, int h, membuf *m)
         return -1;
     }
     png_set_write_fn(png, m, png_mem_write, png_mem_flush);
-    png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB,
-                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_compression_level(png, 4);
     png_write_info(png, info);
     for (int y = 0; y < h; y++) png_write_row(png, (png_const_bytep)(rgb + (size_t)3 * w * y));
@@ -630,18 +625,18 @@ static int png_encode(const uint8_t *rgb, int w, int h, membuf *m)
 typedef struct ctx {
     const pfsph_scene *sc;
     cam c;
-    int ss;       /* supersampling factor */
+    int ss; /* supersampling factor */
     int out_w, out_h;
     bool all_walls, no_legend;
     int color_by;
-    double vref;  /* speed colour scale: sqrt(2 g H) of the first frame's fluid, 0 if none */
+    double vref; /* speed colour scale: sqrt(2 g H) of the first frame's fluid, 0 if none */
     image im;
     splat_set sp;
     size_t *bidx; /* band lists */
     size_t *bstart;
     size_t bcap;
     uint8_t *rgb;
-    float *mn;     /* camera-space normals of liquid-mesh pixels (layer 0, id MESH_ID) */
+    float *mn; /* camera-space normals of liquid-mesh pixels (layer 0, id MESH_ID) */
 } ctx;
 
 #define MESH_ID UINT32_MAX
@@ -765,10 +760,9 @@ static void body_color(const pfsph_scene *sc, int b, float col[3])
         memcpy(col, sc->phases[sc->bodies[b].phase].color, 3 * sizeof *col);
 }
 
-static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_particles *bnd,
-                        const pfsph_particles *bod, const pfsph_particles *dif,
-                        const pfsph_surface_mesh *liq, const pfsph_surface_mesh *bmesh, int frame, double time, const char *png_path,
-                        pfsph_error *err)
+static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_particles *bnd, const pfsph_particles *bod,
+                        const pfsph_particles *dif, const pfsph_surface_mesh *liq, const pfsph_surface_mesh *bmesh,
+                        int frame, double time, const char *png_path, pfsph_error *err)
 {
     const pfsph_scene *sc = x->sc;
     const double r = sc->particle_radius > 0 ? sc->particle_radius : 0.01;
@@ -782,22 +776,17 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     pfsph_cutaway cw;
     pfsph_cutaway_init(&cw, sc, x->all_walls ? NULL : bnd);
     double range[2] = {0, 1};
-    if (bnd &&
-        (rc = add_set(&x->sp, &x->c, bnd, d2 ? 0.9 * r : r, 1, 1, sc, COLOR_PHASE, 0, ssf, &cw, NULL)))
-        goto oom;
+    if (bnd && (rc = add_set(&x->sp, &x->c, bnd, d2 ? 0.9 * r : r, 1, 1, sc, COLOR_PHASE, 0, ssf, &cw, NULL))) goto oom;
     const bool mesh = liq && liq->ntris && !d2; /* the liquid's surface instead of its particles */
-    if (!mesh && (rc = add_set(&x->sp, &x->c, fluid, d2 ? 1.3 * r : r, 0, 0, sc, x->color_by, x->vref,
-                               ssf, NULL, range)))
+    if (!mesh &&
+        (rc = add_set(&x->sp, &x->c, fluid, d2 ? 1.3 * r : r, 0, 0, sc, x->color_by, x->vref, ssf, NULL, range)))
         goto oom;
-    if (dif && (rc = add_set(&x->sp, &x->c, dif, 0.4 * r, 0, 2, sc, COLOR_PHASE, 0, ssf, NULL, NULL)))
-        goto oom;
+    if (dif && (rc = add_set(&x->sp, &x->c, dif, 0.4 * r, 0, 2, sc, COLOR_PHASE, 0, ssf, NULL, NULL))) goto oom;
     /* rigid bodies are drawn solid in their phase's colour, not as translucent walls */
     const bool bmeshes = bmesh && bmesh->ntris && !d2; /* the bodies' surfaces instead of their particles */
-    if (bod && !bmeshes && (rc = add_set(&x->sp, &x->c, bod, r, 0, 3, sc, COLOR_PHASE, 0, ssf, NULL, NULL)))
-        goto oom;
+    if (bod && !bmeshes && (rc = add_set(&x->sp, &x->c, bod, r, 0, 3, sc, COLOR_PHASE, 0, ssf, NULL, NULL))) goto oom;
 
-    if (x->sp.n > UINT32_MAX - 512)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: too many particles", png_path);
+    if (x->sp.n > UINT32_MAX - 512) return pfsph_fail(err, PFSPH_EINPUT, "%s: too many particles", png_path);
     /* Bin splats into bands of rows: a splat goes to every band it overlaps. */
     const int W = x->c.w, H = x->c.h, nb = (H + BAND - 1) / BAND;
     size_t *cnt = calloc((size_t)nb + 1, sizeof *cnt);
@@ -848,8 +837,7 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
 #pragma omp parallel for schedule(dynamic, 1)
     for (int b = 0; b < nb; b++) {
         int y0 = b * BAND, y1 = y0 + BAND < H ? y0 + BAND : H;
-        splat_band(&x->im, x->sp.s, x->bidx + x->bstart[b], x->bstart[b + 1] - x->bstart[b], y0,
-                   y1);
+        splat_band(&x->im, x->sp.s, x->bidx + x->bstart[b], x->bstart[b + 1] - x->bstart[b], y0, y1);
     }
     if (mesh || bmeshes) {
         if (!x->mn && !(x->mn = malloc(3 * npix * sizeof *x->mn))) goto oom;
@@ -897,8 +885,7 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
                 }
             }
             for (int k = 0; k < 3; k++)
-                x->rgb[3 * ((size_t)oy * ow + ox) + k] =
-                    (uint8_t)lrint(fmin(1.0, acc[k] / (ss * ss)) * 255.0);
+                x->rgb[3 * ((size_t)oy * ow + ox) + k] = (uint8_t)lrint(fmin(1.0, acc[k] / (ss * ss)) * 255.0);
         }
     }
     char cap[96];
@@ -958,20 +945,33 @@ static int make_video(const char *run_dir, int first, double fps, const pfsph_re
     /* ffmpeg picks the container from the extension, so the temporary name ends in .mp4. */
     snprintf(tmp, sizeof tmp, "%s/frames.tmp.%ld.mp4", run_dir, (long)getpid());
     if (!on_path("ffmpeg"))
-        return pfsph_fail(err, PFSPH_EIO,
-                          "%s: ffmpeg not found on PATH; the PNG frames are in %s/png", out,
-                          run_dir);
+        return pfsph_fail(err, PFSPH_EIO, "%s: ffmpeg not found on PATH; the PNG frames are in %s/png", out, run_dir);
     char rate[32], start[32];
     snprintf(rate, sizeof rate, "%g", fps > 0 ? fps : 25.0);
     snprintf(start, sizeof start, "%d", first);
     const char *codecs[2][4] = {{"-c:v", "libx264", "-crf", "20"}, {"-c:v", "mpeg4", "-q:v", "3"}};
     int st = -1;
     for (int c = 0; c < 2 && st != 0; c++) {
-        char *argv[] = {"ffmpeg", "-y", "-loglevel", "error", "-framerate", rate,
-                        "-start_number", start, "-i", pattern,
-                        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-pix_fmt", "yuv420p",
-                        (char *)codecs[c][0], (char *)codecs[c][1], (char *)codecs[c][2],
-                        (char *)codecs[c][3], tmp, NULL};
+        char *argv[] = {"ffmpeg",
+                        "-y",
+                        "-loglevel",
+                        "error",
+                        "-framerate",
+                        rate,
+                        "-start_number",
+                        start,
+                        "-i",
+                        pattern,
+                        "-vf",
+                        "pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                        "-pix_fmt",
+                        "yuv420p",
+                        (char *)codecs[c][0],
+                        (char *)codecs[c][1],
+                        (char *)codecs[c][2],
+                        (char *)codecs[c][3],
+                        tmp,
+                        NULL};
         st = run_wait(argv);
     }
     if (st != 0) {
@@ -1005,7 +1005,8 @@ static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
     double g = sqrt(g2), lo = DBL_MAX, hi = -DBL_MAX;
     for (size_t i = 0; i < fluid->n; i++) {
         double h = -(fluid->x[i] * sc->gravity[0] + fluid->y[i] * sc->gravity[1] +
-                     (sc->dim == 3 ? fluid->z[i] * sc->gravity[2] : 0.0)) / g;
+                     (sc->dim == 3 ? fluid->z[i] * sc->gravity[2] : 0.0)) /
+            g;
         if (!isfinite(h)) continue;
         if (h < lo) lo = h;
         if (h > hi) hi = h;
@@ -1038,8 +1039,7 @@ int pfsph_frame_list_find(const frame_list *fl, int f)
     return -1;
 }
 
-int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count,
-                     pfsph_error *err)
+int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count, pfsph_error *err)
 {
     pfsph_render_opts def = {.last = -1};
     if (!o) o = &def;
@@ -1070,15 +1070,13 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
     x.all_walls = o->all_walls;
     x.no_legend = o->no_legend;
     if (x.color_by < 0) {
-        rc = pfsph_fail(err, PFSPH_EINPUT,
-                        "color_by '%s': expected phase, speed, density or pressure", cby);
+        rc = pfsph_fail(err, PFSPH_EINPUT, "color_by '%s': expected phase, speed, density or pressure", cby);
         goto out;
     }
     x.out_w = o->width > 0 ? o->width : (sc->camera.width > 0 ? sc->camera.width : 960);
     x.out_h = o->height > 0 ? o->height : (sc->camera.height > 0 ? sc->camera.height : 540);
     if (x.out_w < 8 || x.out_h < 8 || x.out_w > 16384 || x.out_h > 16384) {
-        rc = pfsph_fail(err, PFSPH_EINPUT, "image size %dx%d: expected 8..16384 per side",
-                        x.out_w, x.out_h);
+        rc = pfsph_fail(err, PFSPH_EINPUT, "image size %dx%d: expected 8..16384 per side", x.out_w, x.out_h);
         goto out;
     }
     x.ss = (double)x.out_w * x.out_h <= 4096.0 * 2160.0 ? 2 : 1;
@@ -1120,8 +1118,7 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
             break;
         }
     if (i0 < 0) {
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: no frames in the range %d..%d", fdir, o->first,
-                        o->last);
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: no frames in the range %d..%d", fdir, o->first, o->last);
         goto out;
     }
     int first_num = fl.num[i0];
@@ -1136,8 +1133,7 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
         int bi = newest_le(&bl, f);
         if (bi >= 0 && bl.num[bi] != bnd_loaded) {
             pfsph_particles_free(&bnd);
-            if ((rc = read_frame(fdir, "boundary_", bl.num[bi], bl.ply[bi], &bnd, NULL, err)))
-                goto out;
+            if ((rc = read_frame(fdir, "boundary_", bl.num[bi], bl.ply[bi], &bnd, NULL, err))) goto out;
             bnd_loaded = bl.num[bi];
         }
         /* rigid bodies move: their particles of this frame */
@@ -1146,8 +1142,7 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
         if (ri >= 0 && (rc = read_frame(fdir, "bodies_", f, rl.ply[ri], &both, NULL, err))) goto out;
         int di = pfsph_frame_list_find(&dl, f);
         pfsph_particles_free(&dif);
-        if (di >= 0 && (rc = read_frame(fdir, "diffuse_", f, dl.ply[di], &dif, NULL, err)))
-            goto out;
+        if (di >= 0 && (rc = read_frame(fdir, "diffuse_", f, dl.ply[di], &dif, NULL, err))) goto out;
         if (i == i0) {
             box3 pb;
             box_empty(&pb);
@@ -1202,9 +1197,8 @@ out:
 
 /* ---- for other front ends (the live viewer) ------------------------------------------- */
 
-void pfsph_render_camera_for(const pfsph_scene *s, const pfsph_particles *fluid,
-                             const pfsph_particles *boundary, int w, int h,
-                             pfsph_render_camera *out)
+void pfsph_render_camera_for(const pfsph_scene *s, const pfsph_particles *fluid, const pfsph_particles *boundary, int w,
+                             int h, pfsph_render_camera *out)
 {
     box3 pb;
     box_empty(&pb);

@@ -35,30 +35,27 @@ static void put_reals(pfsph__enc *e, const pfsph_real *a, size_t n)
  * not collide with the fixed fields. */
 int pfsph__check_aux_name(const char *path, const char *name, pfsph_error *err)
 {
-    static const char *const taken[] = {"x", "y", "z", "vx", "vy", "vz", "velocity", "density",
-                                        "pressure", "phase", "type", "id", "speed", "surface_layer", "film", "Points",
-                                        "TimeValue", "connectivity", "offsets"};
+    static const char *const taken[] = {
+        "x",       "y",        "z",         "vx",           "vy",     "vz",    "velocity",
+        "density", "pressure", "phase",     "type",         "id",     "speed", "surface_layer",
+        "film",    "Points",   "TimeValue", "connectivity", "offsets"};
     size_t len = strlen(name);
     if (len == 0 || len > 64)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: aux field name must have 1 to 64 characters",
-                          path);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: aux field name must have 1 to 64 characters", path);
     for (size_t i = 0; i < len; i++) {
         char c = name[i];
-        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-              c == '_' || c == '-' || c == '.'))
-            return pfsph_fail(err, PFSPH_EINPUT,
-                              "%s: aux field name '%s': only letters, digits, '_', '-', '.'",
-                              path, name);
+        if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+              c == '.'))
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: aux field name '%s': only letters, digits, '_', '-', '.'", path,
+                              name);
     }
     for (size_t i = 0; i < sizeof taken / sizeof taken[0]; i++)
         if (strcmp(name, taken[i]) == 0)
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: aux field name '%s' is reserved", path,
-                              name);
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: aux field name '%s' is reserved", path, name);
     return PFSPH_OK;
 }
 
-int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o,
-                    pfsph_error *err)
+int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o, pfsph_error *err)
 {
     pfsph_io_opts def = {.dim = 3};
     if (!o) o = &def;
@@ -98,15 +95,18 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
     /* XML header: every array's offset is the running sum of (8-byte header + data). */
     uint64_t off = 0;
     pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n");
-    pfsph__enc_printf(&e, "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
-         "header_type=\"UInt64\">\n  <PolyData>\n");
+    pfsph__enc_printf(&e,
+                      "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+                      "header_type=\"UInt64\">\n  <PolyData>\n");
     for (int k = 0; k < na; k++) {
         const vtp_array *a = &arr[k];
         switch (a->kind) {
         case A_TIME: pfsph__enc_printf(&e, "    <FieldData>\n"); break;
         case A_VEL:
-            pfsph__enc_printf(&e, "    <Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
-                 "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n", n, n);
+            pfsph__enc_printf(&e,
+                              "    <Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
+                              "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n",
+                              n, n);
             pfsph__enc_printf(&e, "      <PointData Scalars=\"%s\" Vectors=\"velocity\">\n",
                               o->diffuse ? "type" : "density");
             break;
@@ -115,13 +115,15 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
         default: break;
         }
         if (a->kind == A_TIME)
-            pfsph__enc_printf(&e, "      <DataArray type=\"%s\" Name=\"%s\" NumberOfTuples=\"1\" "
-                 "format=\"appended\" offset=\"%" PRIu64 "\"/>\n    </FieldData>\n",
-                 a->type, a->name, off);
+            pfsph__enc_printf(&e,
+                              "      <DataArray type=\"%s\" Name=\"%s\" NumberOfTuples=\"1\" "
+                              "format=\"appended\" offset=\"%" PRIu64 "\"/>\n    </FieldData>\n",
+                              a->type, a->name, off);
         else
-            pfsph__enc_printf(&e, "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" "
-                 "format=\"appended\" offset=\"%" PRIu64 "\"/>\n",
-                 a->type, a->name, a->ncomp, off);
+            pfsph__enc_printf(&e,
+                              "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" "
+                              "format=\"appended\" offset=\"%" PRIu64 "\"/>\n",
+                              a->type, a->name, a->ncomp, off);
         off += 8 + a->nbytes;
     }
     pfsph__enc_printf(&e, "      </Verts>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _");
@@ -208,11 +210,13 @@ typedef struct rd_array {
 
 static int vtk_type(const char *s)
 {
-    static const struct { const char *n; int t; } map[] = {
-        {"Int8", PFSPH__T_I8},     {"UInt8", PFSPH__T_U8},     {"Int16", PFSPH__T_I16},
-        {"UInt16", PFSPH__T_U16},  {"Int32", PFSPH__T_I32},    {"UInt32", PFSPH__T_U32},
-        {"Int64", PFSPH__T_I64},   {"UInt64", PFSPH__T_U64},   {"Float32", PFSPH__T_F32},
-        {"Float64", PFSPH__T_F64},
+    static const struct {
+        const char *n;
+        int t;
+    } map[] = {
+        {"Int8", PFSPH__T_I8},     {"UInt8", PFSPH__T_U8},    {"Int16", PFSPH__T_I16}, {"UInt16", PFSPH__T_U16},
+        {"Int32", PFSPH__T_I32},   {"UInt32", PFSPH__T_U32},  {"Int64", PFSPH__T_I64}, {"UInt64", PFSPH__T_U64},
+        {"Float32", PFSPH__T_F32}, {"Float64", PFSPH__T_F64},
     };
     for (size_t i = 0; i < sizeof map / sizeof map[0]; i++)
         if (strcmp(s, map[i].n) == 0) return map[i].t;
@@ -284,12 +288,12 @@ int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_er
     size_t len;
     int rc = pfsph__read_file(path, &buf, &len, err);
     if (rc != PFSPH_OK) return rc;
-#define BAD(...)                                                                           \
-    do {                                                                                   \
-        char m_[512];                                                                      \
-        snprintf(m_, sizeof m_, __VA_ARGS__);                                              \
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid VTP file: %s", path, m_);          \
-        goto done;                                                                         \
+#define BAD(...)                                                                  \
+    do {                                                                          \
+        char m_[512];                                                             \
+        snprintf(m_, sizeof m_, __VA_ARGS__);                                     \
+        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid VTP file: %s", path, m_); \
+        goto done;                                                                \
     } while (0)
 
     rd_array *ar = calloc(MAX_ARRAYS, sizeof *ar);
@@ -321,32 +325,26 @@ int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_er
         bool closing = *nb == '/';
         if (closing) nb++;
         const char *ne = nb;
-        while (ne < gt && *ne != ' ' && *ne != '\t' && *ne != '\n' && *ne != '\r' &&
-               *ne != '/')
-            ne++;
+        while (ne < gt && *ne != ' ' && *ne != '\t' && *ne != '\n' && *ne != '\r' && *ne != '/') ne++;
         size_t nl = (size_t)(ne - nb);
 #define IS(s) (nl == strlen(s) && memcmp(nb, s, nl) == 0)
         if (IS("VTKFile") && !closing) {
             have_vtkfile = true;
             if (get_attr(ne, gt, "type", val, sizeof val) != 1 || strcmp(val, "PolyData"))
                 BAD("VTKFile type is not PolyData");
-            if (get_attr(ne, gt, "byte_order", val, sizeof val) != 1 ||
-                strcmp(val, "LittleEndian"))
+            if (get_attr(ne, gt, "byte_order", val, sizeof val) != 1 || strcmp(val, "LittleEndian"))
                 BAD("byte_order is not LittleEndian");
-            if (get_attr(ne, gt, "compressor", val, sizeof val) != 0)
-                BAD("compressed data is not supported");
+            if (get_attr(ne, gt, "compressor", val, sizeof val) != 0) BAD("compressed data is not supported");
             int h = get_attr(ne, gt, "header_type", val, sizeof val);
-            if (h < 0 || (h == 1 && strcmp(val, "UInt64") && strcmp(val, "UInt32")))
-                BAD("unsupported header_type");
+            if (h < 0 || (h == 1 && strcmp(val, "UInt64") && strcmp(val, "UInt32"))) BAD("unsupported header_type");
             hsize = (h == 1 && strcmp(val, "UInt64") == 0) ? 8 : 4;
         } else if (IS("Piece") && !closing) {
             if (have_piece) BAD("more than one Piece");
             have_piece = true;
-            if (get_attr(ne, gt, "NumberOfPoints", val, sizeof val) != 1 ||
-                pfsph__parse_u64(val, &npoints) != 0)
+            if (get_attr(ne, gt, "NumberOfPoints", val, sizeof val) != 1 || pfsph__parse_u64(val, &npoints) != 0)
                 BAD("bad NumberOfPoints");
-        } else if (IS("FieldData") || IS("PointData") || IS("Points") || IS("Verts") ||
-                   IS("CellData") || IS("Lines") || IS("Strips") || IS("Polys")) {
+        } else if (IS("FieldData") || IS("PointData") || IS("Points") || IS("Verts") || IS("CellData") || IS("Lines") ||
+                   IS("Strips") || IS("Polys")) {
             if (closing || gt[-1] == '/') section[0] = 0;
             else {
                 memcpy(section, nb, nl);
@@ -357,8 +355,7 @@ int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_er
             rd_array *a = &ar[na++];
             snprintf(a->section, sizeof a->section, "%s", section);
             if (get_attr(ne, gt, "Name", a->name, sizeof a->name) < 0) BAD("bad array name");
-            if (get_attr(ne, gt, "type", val, sizeof val) != 1 ||
-                (a->type = vtk_type(val)) == PFSPH__T_NONE)
+            if (get_attr(ne, gt, "type", val, sizeof val) != 1 || (a->type = vtk_type(val)) == PFSPH__T_NONE)
                 BAD("array '%s': bad type", a->name);
             if (get_attr(ne, gt, "format", val, sizeof val) != 1 || strcmp(val, "appended"))
                 BAD("array '%s': format is not appended", a->name);
@@ -369,11 +366,9 @@ int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_er
             a->ncomp = (int)v;
             v = 0;
             h = get_attr(ne, gt, "NumberOfTuples", val, sizeof val);
-            if (h < 0 || (h == 1 && pfsph__parse_u64(val, &v)))
-                BAD("array '%s': bad NumberOfTuples", a->name);
+            if (h < 0 || (h == 1 && pfsph__parse_u64(val, &v))) BAD("array '%s': bad NumberOfTuples", a->name);
             a->ntuples = v;
-            if (get_attr(ne, gt, "offset", val, sizeof val) != 1 ||
-                pfsph__parse_u64(val, &a->offset))
+            if (get_attr(ne, gt, "offset", val, sizeof val) != 1 || pfsph__parse_u64(val, &a->offset))
                 BAD("array '%s': bad offset", a->name);
         }
 #undef IS
@@ -393,8 +388,7 @@ int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_er
         dlen = (size_t)(end - (u + 1));
     }
     /* Every particle needs at least 3 coordinates of 4 bytes: bounds npoints by the size. */
-    if (npoints > dlen / 12 + 1 || npoints > UINT32_MAX)
-        BAD("NumberOfPoints %" PRIu64 " exceeds the data", npoints);
+    if (npoints > dlen / 12 + 1 || npoints > UINT32_MAX) BAD("NumberOfPoints %" PRIu64 " exceeds the data", npoints);
     const size_t n = (size_t)npoints;
     rc = pfsph_particles_init(ps, n ? n : 1);
     if (rc != PFSPH_OK) {
@@ -424,8 +418,7 @@ int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_er
         if (a->offset + hsize + nbytes > data_end) data_end = a->offset + hsize + nbytes;
         uint64_t count = strcmp(a->section, "FieldData") == 0 ? a->ntuples : npoints;
         uint64_t want = count * (uint64_t)a->ncomp * ts;
-        if (nbytes != want)
-            BAD("array '%s': %" PRIu64 " bytes, expected %" PRIu64, a->name, nbytes, want);
+        if (nbytes != want) BAD("array '%s': %" PRIu64 " bytes, expected %" PRIu64, a->name, nbytes, want);
 
         pfsph_real *dst[3] = {NULL, NULL, NULL};
         uint8_t *dst8 = NULL;

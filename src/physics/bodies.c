@@ -25,14 +25,14 @@ typedef struct body {
     dBodyID id;
     dGeomID geom;
     dTriMeshDataID tmdata;
-    pfsph_mesh mesh;   /* surface in body coordinates (about the centre of mass) */
+    pfsph_mesh mesh;     /* surface in body coordinates (about the centre of mass) */
     double lo[3], hi[3]; /* its bounding box */
     double mass;
-    uint32_t first;    /* first particle, as an index into the body-particle tables */
+    uint32_t first; /* first particle, as an index into the body-particle tables */
     uint32_t n;
     double f[3], tq[3]; /* fluid force and torque of the last step */
-    double vmax;       /* largest particle speed */
-    bool dragged;      /* follows drag_to (pfsph_bodies_drag): kinematic, no keyframes, on a
+    double vmax;        /* largest particle speed */
+    bool dragged;       /* follows drag_to (pfsph_bodies_drag): kinematic, no keyframes, on a
                         * straight line; dynamic, pulled by a damped spring */
     double drag_to[3], drag_vmax;
 } body;
@@ -45,11 +45,11 @@ struct pfsph_bodies {
     dJointGroupID contacts;
     dGeomID *statics;
     int nstatics;
-    uint32_t first_id;  /* boundary ids >= first_id belong to bodies */
-    uint32_t np;        /* body particles */
-    double *local;      /* 3 * np body-frame positions */
-    uint16_t *owner;    /* body of each particle */
-    double *fp;         /* 3 * np fluid force per particle (this step) */
+    uint32_t first_id; /* boundary ids >= first_id belong to bodies */
+    uint32_t np;       /* body particles */
+    double *local;     /* 3 * np body-frame positions */
+    uint16_t *owner;   /* body of each particle */
+    double *fp;        /* 3 * np fluid force per particle (this step) */
     double spacing;
 };
 
@@ -171,7 +171,8 @@ static int body_mesh(const pfsph_scene *s, body *bd, pfsph_error *err)
             snprintf(msg, sizeof msg, "%s", err->msg);
             int bi = 0; /* the body's index, for its JSON path */
             while (bi < s->nbodies - 1 && strcmp(s->bodies[bi].name, d->name) != 0) bi++;
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.bodies[%d].file (body \"%s\"): %s", s->source, bi, d->name, msg);
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.bodies[%d].file (body \"%s\"): %s", s->source, bi, d->name,
+                              msg);
         }
         double vol, com[3], I[9];
         pfsph_mesh_transform(&bd->mesh, d->scale, NULL, NULL);
@@ -188,8 +189,7 @@ static int body_mesh(const pfsph_scene *s, body *bd, pfsph_error *err)
 /* Surface particles of a body in its own frame, d/2 inside the surface as for static solids
  * (their layer then continues the fluid's lattice, and the fluid's particle centres stop d/2
  * outside the surface: displaced volumes come out right). */
-static int body_particles(const pfsph_scene *s, const body *bd, double d, pfsph_particles *ps,
-                          pfsph_error *err)
+static int body_particles(const pfsph_scene *s, const body *bd, double d, pfsph_particles *ps, pfsph_error *err)
 {
     const pfsph_body_def *bdef = &bd->def;
     if (bdef->shape != PFSPH_BODY_MESH) {
@@ -200,9 +200,9 @@ static int body_particles(const pfsph_scene *s, const body *bd, double d, pfsph_
         so.axis = s->dim == 2 ? 2 : bdef->axis;
         so.radius = bdef->radius;
         so.height = bdef->height;
-        so.shape = bdef->shape == PFSPH_BODY_BOX      ? PFSPH_SHAPE_BOX
-                   : bdef->shape == PFSPH_BODY_SPHERE ? PFSPH_SHAPE_SPHERE
-                                                      : PFSPH_SHAPE_CYLINDER;
+        so.shape = bdef->shape == PFSPH_BODY_BOX ? PFSPH_SHAPE_BOX
+            : bdef->shape == PFSPH_BODY_SPHERE   ? PFSPH_SHAPE_SPHERE
+                                                 : PFSPH_SHAPE_CYLINDER;
         for (int a = 0; a < 3; a++) {
             so.min[a] = -bdef->half[a];
             so.max[a] = bdef->half[a];
@@ -272,8 +272,7 @@ static int body_particles(const pfsph_scene *s, const body *bd, double d, pfsph_
 
 /* Akinci volumes over the body's own particles, so that a body's volumes do not depend on
  * what it touches at the start. */
-static int body_volumes(const pfsph_particles *src, int dim, double h,
-                        pfsph_real *vol)
+static int body_volumes(const pfsph_particles *src, int dim, double h, pfsph_real *vol)
 {
     pfsph_particles ps;
     pfsph_grid g;
@@ -393,7 +392,7 @@ static int add_statics(pfsph_bodies *B, const pfsph_scene *s)
         }
         case PFSPH_SHAPE_PLANE: {
             double d = o->normal[0] * o->center[0] + o->normal[1] * o->center[1] +
-                       (s->dim == 3 ? o->normal[2] * o->center[2] : 0);
+                (s->dim == 3 ? o->normal[2] * o->center[2] : 0);
             g = dCreatePlane(B->space, o->normal[0], o->normal[1], s->dim == 3 ? o->normal[2] : 0, d);
             break;
         }
@@ -436,8 +435,8 @@ static void set_mass(body *bd, int dim)
         pfsph_mesh_mass_properties(&bd->mesh, &vol, com, I);
         bd->mass = d->mass > 0 ? d->mass : d->density * vol;
         double rho = bd->mass / vol;
-        dMassSetParameters(&m, bd->mass, 0, 0, 0, rho * I[0], rho * I[4], rho * I[8], rho * I[1],
-                           rho * I[2], rho * I[5]);
+        dMassSetParameters(&m, bd->mass, 0, 0, 0, rho * I[0], rho * I[4], rho * I[8], rho * I[1], rho * I[2],
+                           rho * I[5]);
         break;
     }
     }
@@ -477,8 +476,8 @@ static void make_geom(pfsph_bodies *B, body *bd, int dim)
         break;
     default:
         bd->tmdata = dGeomTriMeshDataCreate();
-        dGeomTriMeshDataBuildDouble(bd->tmdata, bd->mesh.v, 3 * sizeof(double), (int)bd->mesh.nverts,
-                                    bd->mesh.tri, (int)(3 * bd->mesh.ntris), 3 * sizeof(uint32_t));
+        dGeomTriMeshDataBuildDouble(bd->tmdata, bd->mesh.v, 3 * sizeof(double), (int)bd->mesh.nverts, bd->mesh.tri,
+                                    (int)(3 * bd->mesh.ntris), 3 * sizeof(uint32_t));
         bd->geom = dCreateTriMesh(B->space, bd->tmdata, NULL, NULL, NULL);
         dGeomSetBody(bd->geom, bd->id);
         break;
@@ -488,8 +487,8 @@ static void make_geom(pfsph_bodies *B, body *bd, int dim)
 
 /* ------------------------------------------------------------------------------------------ */
 
-int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing,
-                        pfsph_particles *boundary, pfsph_error *err)
+int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing, pfsph_particles *boundary,
+                        pfsph_error *err)
 {
     *out = NULL;
     pfsph_bodies *B = calloc(1, sizeof *B);
@@ -534,8 +533,8 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
         tmp.n = 0;
         if ((rc = body_particles(s, bd, spacing, &tmp, err))) goto fail;
         if (tmp.n == 0) {
-            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: body \"%s\" is too small for the particle spacing %g m",
-                            s->source, bd->def.name, spacing);
+            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: body \"%s\" is too small for the particle spacing %g m", s->source,
+                            bd->def.name, spacing);
             goto fail;
         }
         pfsph_real *vol = malloc(tmp.n * sizeof *vol);
@@ -547,7 +546,8 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
          * lattice (V0); one layer stands for a half-space (Akinci), over the body alone. With
          * one layer a floating box rode 0.22 d too high (submerged fraction 0.454 for 0.5). */
         if (vol && bd->def.layers > 1)
-            for (size_t j = 0; j < tmp.n; j++) vol[j] = (pfsph_real)(s->dim == 2 ? spacing * spacing : spacing * spacing * spacing);
+            for (size_t j = 0; j < tmp.n; j++)
+                vol[j] = (pfsph_real)(s->dim == 2 ? spacing * spacing : spacing * spacing * spacing);
         if (!vol || !loc || !own || (bd->def.layers == 1 && (rc = body_volumes(&tmp, s->dim, h, vol)))) {
             free(vol);
             rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
@@ -623,8 +623,8 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
                                 "%s: $.bodies[%d] (\"%s\") and $.bodies[%d] (\"%s\") overlap at the start (a "
                                 "surface particle of \"%s\" at %.4g %.4g %.4g lies inside \"%s\"); move them "
                                 "apart: overlapping bodies are pushed apart by their contacts",
-                                s->source, lo, B->b[lo].def.name, hi, B->b[hi].def.name, B->b[i].def.name, p[0],
-                                p[1], p[2], B->b[k].def.name);
+                                s->source, lo, B->b[lo].def.name, hi, B->b[hi].def.name, B->b[i].def.name, p[0], p[1],
+                                p[2], B->b[k].def.name);
                 pfsph_bodies_destroy(B);
                 return rc;
             }
@@ -691,8 +691,7 @@ double pfsph_bodies_distance(const pfsph_bodies *B, int i, const double p[3])
         }
         return o > 0 ? sqrt(o) : in;
     }
-    case PFSPH_BODY_SPHERE:
-        return sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) - d->radius;
+    case PFSPH_BODY_SPHERE: return sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]) - d->radius;
     case PFSPH_BODY_CYLINDER: {
         if (B->dim == 2) return sqrt(l[0] * l[0] + l[1] * l[1]) - d->radius;
         double rr = 0;
@@ -720,8 +719,8 @@ double pfsph_bodies_distance(const pfsph_bodies *B, int i, const double p[3])
             const double *A = m->v + 3 * m->tri[3 * t], *Bv = m->v + 3 * m->tri[3 * t + 1],
                          *C = m->v + 3 * m->tri[3 * t + 2];
             /* ray l + s e_x, s > 0, against triangle: solve in the yz plane */
-            double y0 = A[1] - l[1], z0 = A[2] - l[2], y1 = Bv[1] - l[1], z1 = Bv[2] - l[2],
-                   y2 = C[1] - l[1], z2 = C[2] - l[2];
+            double y0 = A[1] - l[1], z0 = A[2] - l[2], y1 = Bv[1] - l[1], z1 = Bv[2] - l[2], y2 = C[1] - l[1],
+                   z2 = C[2] - l[2];
             double w0 = y1 * z2 - z1 * y2, w1 = y2 * z0 - z2 * y0, w2 = y0 * z1 - z0 * y1;
             if ((w0 > 0 && w1 > 0 && w2 > 0) || (w0 < 0 && w1 < 0 && w2 < 0)) {
                 double ws = w0 + w1 + w2;
@@ -730,8 +729,8 @@ double pfsph_bodies_distance(const pfsph_bodies *B, int i, const double p[3])
             }
             for (int k = 0; k < 3; k++) {
                 const double *P = m->v + 3 * m->tri[3 * t + k];
-                double dd = (P[0] - l[0]) * (P[0] - l[0]) + (P[1] - l[1]) * (P[1] - l[1]) +
-                            (P[2] - l[2]) * (P[2] - l[2]);
+                double dd =
+                    (P[0] - l[0]) * (P[0] - l[0]) + (P[1] - l[1]) * (P[1] - l[1]) + (P[2] - l[2]) * (P[2] - l[2]);
                 if (dd < dmin) dmin = dd;
             }
         }
@@ -758,8 +757,7 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
     const pfsph_real R2 = (pfsph_real)(Rk * Rk);
     double cm[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES]; /* c m_a m_b, once per call */
     for (int a = 0; pw_on && a < ctx->nphases; a++)
-        for (int q = 0; q < ctx->nphases; q++)
-            cm[a][q] = pp->c[a][q] * (double)ctx->mass[a] * (double)ctx->mass[q];
+        for (int q = 0; q < ctx->nphases; q++) cm[a][q] = pp->c[a][q] * (double)ctx->mass[a] * (double)ctx->mass[q];
     /* particles dropped from the boundary set (a body that left the grid) must not keep their
      * last force: only the present ones are written below */
     memset(B->fp, 0, 3 * (size_t)B->np * sizeof(double));
@@ -785,8 +783,8 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
                 if (pi > 0) s += pi * inv_v0 * vol * dw; /* pressure: -F_i of Akinci Eq. 10 */
                 const pfsph_real nui = ctx->nu[f->phase[i]];
                 if (nui > 0) {
-                    pfsph_real vdx = (f->vx[i] - b->vx[j]) * dx + (f->vy[i] - b->vy[j]) * dy +
-                                     (f->vz[i] - b->vz[j]) * dz;
+                    pfsph_real vdx =
+                        (f->vx[i] - b->vx[j]) * dx + (f->vy[i] - b->vy[j]) * dy + (f->vz[i] - b->vz[j]) * dz;
                     /* friction: the fluid gains m_i nu visc_c V_b (v_ib . x_ib)/(r^2+eps) grad W */
                     s -= ctx->mass[f->phase[i]] * visc_c * nui * vol * vdx / (r2 + eps) * dw;
                     if (amp > 0 && r2 > 0) {
@@ -842,8 +840,7 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
         for (uint32_t l = bd->first; l < bd->first + bd->n; l++) {
             const double *fl = B->fp + 3 * l, *lc = B->local + 3 * l;
             double rr[3];
-            for (int a = 0; a < 3; a++)
-                rr[a] = Rm[4 * a] * lc[0] + Rm[4 * a + 1] * lc[1] + Rm[4 * a + 2] * lc[2];
+            for (int a = 0; a < 3; a++) rr[a] = Rm[4 * a] * lc[0] + Rm[4 * a + 1] * lc[1] + Rm[4 * a + 2] * lc[2];
             for (int a = 0; a < 3; a++) F[a] += fl[a];
             T[0] += rr[1] * fl[2] - rr[2] * fl[1];
             T[1] += rr[2] * fl[0] - rr[0] * fl[2];
@@ -864,8 +861,7 @@ static void near_cb(void *data, dGeomID g1, dGeomID g2)
     dContactGeom cg[MAX_CONTACTS];
     int n = dCollide(g1, g2, MAX_CONTACTS, cg, sizeof(dContactGeom));
     const body *p1 = b1 ? dGeomGetData(g1) : NULL, *p2 = b2 ? dGeomGetData(g2) : NULL;
-    double mu = p1 && p2 ? sqrt(p1->def.friction * p2->def.friction)
-                         : (p1 ? p1->def.friction : p2->def.friction);
+    double mu = p1 && p2 ? sqrt(p1->def.friction * p2->def.friction) : (p1 ? p1->def.friction : p2->def.friction);
     double e = fmax(p1 ? p1->def.restitution : 0, p2 ? p2->def.restitution : 0);
     for (int i = 0; i < n; i++) {
         dContact c;
@@ -1040,8 +1036,8 @@ double pfsph_bodies_vmax(const pfsph_bodies *B)
 void pfsph_bodies_get_state(const pfsph_bodies *B, int i, pfsph_body_state *st)
 {
     const body *bd = &B->b[i];
-    const dReal *p = dBodyGetPosition(bd->id), *q = dBodyGetQuaternion(bd->id),
-                *v = dBodyGetLinearVel(bd->id), *w = dBodyGetAngularVel(bd->id);
+    const dReal *p = dBodyGetPosition(bd->id), *q = dBodyGetQuaternion(bd->id), *v = dBodyGetLinearVel(bd->id),
+                *w = dBodyGetAngularVel(bd->id);
     for (int a = 0; a < 3; a++) {
         st->x[a] = p[a];
         st->v[a] = v[a];
@@ -1050,8 +1046,7 @@ void pfsph_bodies_get_state(const pfsph_bodies *B, int i, pfsph_body_state *st)
     for (int a = 0; a < 4; a++) st->q[a] = q[a];
 }
 
-void pfsph_bodies_set_state(pfsph_bodies *B, int i, const pfsph_body_state *st,
-                            pfsph_particles *boundary)
+void pfsph_bodies_set_state(pfsph_bodies *B, int i, const pfsph_body_state *st, pfsph_particles *boundary)
 {
     body *bd = &B->b[i];
     dBodySetPosition(bd->id, st->x[0], st->x[1], st->x[2]);

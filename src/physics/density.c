@@ -7,8 +7,8 @@
 #include "core/nlist.h"
 #include "physics/pair_terms.h"
 
-void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
-                           const pfsph_real *z, pfsph_real *nd)
+void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y, const pfsph_real *z,
+                           pfsph_real *nd)
 {
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_real h2 = k->h * k->h;
@@ -26,8 +26,8 @@ void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsp
             pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
             pfsph_real s = 0;
             /* the terms of the grid walk in its order (the hits keep it): the same bits */
-            PFSPH_HITS_WALK(hits, &H, r, x, y, z, xi, yi, zi, h2, UINT32_MAX,
-                            pfsph__terms_w(k, H.n, H.r2, H.t0); for (int e = 0; e < H.n; e++) s += H.t0[e]);
+            PFSPH_HITS_WALK(hits, &H, r, x, y, z, xi, yi, zi, h2, UINT32_MAX, pfsph__terms_w(k, H.n, H.r2, H.t0);
+                            for (int e = 0; e < H.n; e++) s += H.t0[e]);
             if (b->n) {
                 pfsph_real sb = 0;
                 pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
@@ -65,33 +65,33 @@ static void density_list_block(const pfsph_ctx *ctx, pfsph_real *nd, pfsph_nlist
         pfsph_real s = 0;
         const size_t p0 = pos;
         /* i itself is a hit (W(0) counts in delta_i) but no entry */
-        PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, UINT32_MAX,
-                        pfsph__terms_w(k, H.n, H.r2, H.t0); pfsph__terms_dwr(k, H.n, H.r2, H.t1);
-                        for (int e = 0; e < H.n; e++) {
-                            s += H.t0[e];
-                            if (H.j[e] != i) {
-                                if (pos < re) {
-                                    idx[pos] = H.j[e];
-                                    dw[pos] = H.t1[e];
-                                }
-                                pos++;
-                            }
-                        });
+        PFSPH_HITS_WALK(
+            hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, UINT32_MAX, pfsph__terms_w(k, H.n, H.r2, H.t0);
+            pfsph__terms_dwr(k, H.n, H.r2, H.t1); for (int e = 0; e < H.n; e++) {
+                s += H.t0[e];
+                if (H.j[e] != i) {
+                    if (pos < re) {
+                        idx[pos] = H.j[e];
+                        dw[pos] = H.t1[e];
+                    }
+                    pos++;
+                }
+            });
         cnt[i] = (uint32_t)(pos - p0);
         const size_t b0 = bpos;
         if (b->n) {
             pfsph_real sb = 0;
             pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-            PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX,
-                            pfsph__terms_w(k, H.n, H.r2, H.t0); pfsph__terms_dwr(k, H.n, H.r2, H.t1);
-                            for (int e = 0; e < H.n; e++) {
-                                sb += b->aux[H.j[e]] * H.t0[e];
-                                if (bpos < bre) {
-                                    bidx[bpos] = H.j[e];
-                                    bdw[bpos] = H.t1[e];
-                                }
-                                bpos++;
-                            });
+            PFSPH_HITS_WALK(
+                hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX, pfsph__terms_w(k, H.n, H.r2, H.t0);
+                pfsph__terms_dwr(k, H.n, H.r2, H.t1); for (int e = 0; e < H.n; e++) {
+                    sb += b->aux[H.j[e]] * H.t0[e];
+                    if (bpos < bre) {
+                        bidx[bpos] = H.j[e];
+                        bdw[bpos] = H.t1[e];
+                    }
+                    bpos++;
+                });
             s += sb * inv_v0;
         }
         bcnt[i] = (uint32_t)(bpos - b0);

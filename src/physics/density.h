@@ -6,8 +6,8 @@
 
 /* Number density delta_i = sum_j W_ij + (1/V0) sum_b V_b W_ib (PF Eq. 23 with Akinci 2012
  * boundaries), at positions (x, y, z) of the fluid (the current or the predicted ones). */
-void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y,
-                           const pfsph_real *z, pfsph_real *nd);
+void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y, const pfsph_real *z,
+                           pfsph_real *nd);
 
 /* The same at the fluid's positions, and in the same walk each fluid particle's lists of
  * fluid neighbours (l: j != i within h) and boundary neighbours (lb: within h), with the

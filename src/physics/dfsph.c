@@ -124,8 +124,8 @@ static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph
 /* The residual of particle i: density mode (predicted delta - delta0) or divergence mode
  * (dt D delta / Dt, none for a deficient neighbourhood), a compression over the step [1/m^d],
  * and the factor that turns it into a pressure update. */
-static inline double residual_of(const pfsph_ctx *c, int divergence, const pfsph_real *rate,
-                                 const pfsph_real *fac, size_t i, double *fi)
+static inline double residual_of(const pfsph_ctx *c, int divergence, const pfsph_real *rate, const pfsph_real *fac,
+                                 size_t i, double *fi)
 {
     const double f = fac[i];
     if (divergence) {
@@ -157,9 +157,9 @@ static inline pfsph_real updated(const pfsph_ctx *c, int divergence, const pfsph
  * xq) and v4 = v + dt (a_extra + a). One parallel region: a barrier fewer per iteration matters on
  * a loaded machine. */
 static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, const pfsph_real *rate,
-                               const pfsph_real *fac, pfsph_real *p, const pfsph_real *ex,
-                               const pfsph_real *ey, const pfsph_real *ez, pfsph_real *const bsum[4],
-                               pfsph_real *xq, pfsph_real *const *a, pfsph_real *v4)
+                               const pfsph_real *fac, pfsph_real *p, const pfsph_real *ex, const pfsph_real *ey,
+                               const pfsph_real *ez, pfsph_real *const bsum[4], pfsph_real *xq, pfsph_real *const *a,
+                               pfsph_real *v4)
 {
     const pfsph_particles *f = c->fluid;
     const pfsph_nlist *nl = c->nlist;
@@ -240,11 +240,10 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *xq, const pfsph_r
  * dt a_p) until the mean residual is within tol after at least min_it updates, or max_it
  * updates were made. On return ap (when not NULL) and v4 belong to the final p. Returns the updates
  * made; *avg the last mean residual. */
-static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const *ap,
-                   pfsph_real *const *scr, double tol, int min_it, int max_it, double *avg)
+static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const *ap, pfsph_real *const *scr,
+                   double tol, int min_it, int max_it, double *avg)
 {
-    const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay,
-                     *ez = divergence ? NULL : c->az;
+    const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay, *ez = divergence ? NULL : c->az;
     const size_t n = c->fluid->n;
     pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
     for (int it = 0;; it++) {

@@ -19,36 +19,34 @@
 
 struct pfsph_diffuse {
     pfsph_diffuse_params p;
-    int foam_min, foam_max;   /* resolved thresholds (NOTES 18) */
+    int foam_min, foam_max;        /* resolved thresholds (NOTES 18) */
     bool liquid[PFSPH_MAX_PHASES]; /* fluid phases that emit and couple (gas phases do not) */
-    bool all_liquid;          /* no gas phase: the per-neighbour phase test can go */
+    bool all_liquid;               /* no gas phase: the per-neighbour phase test can go */
     pfsph_particles ps;
     uint64_t created, refused;
-    uint32_t *emit;    /* per fluid particle: count, then exclusive prefix (scratch) */
+    uint32_t *emit; /* per fluid particle: count, then exclusive prefix (scratch) */
     size_t emit_cap;
-    uint8_t *keep;     /* per diffuse particle (scratch) */
+    uint8_t *keep; /* per diffuse particle (scratch) */
     size_t keep_cap;
     pfsph_real *ox, *oy, *oz; /* per fluid particle: start-of-step positions (scratch) */
     size_t old_cap;
-    uint32_t *perm, *key;     /* per diffuse particle: spatial sort (scratch) */
+    uint32_t *perm, *key; /* per diffuse particle: spatial sort (scratch) */
     size_t perm_cap;
-    uint32_t *bins;           /* per grid cell + 1: counting sort (scratch) */
+    uint32_t *bins; /* per grid cell + 1: counting sort (scratch) */
     size_t bins_cap;
-    void *tmp;                /* permutation scratch, 4 bytes per diffuse particle */
+    void *tmp; /* permutation scratch, 4 bytes per diffuse particle */
     size_t tmp_cap;
 };
 
 int pfsph_diffuse_create(pfsph_diffuse **out, const pfsph_ctx *ctx, pfsph_error *err)
 {
     *out = NULL;
-    if (!ctx || !ctx->diffuse)
-        return pfsph_fail(err, PFSPH_EINPUT, "diffuse: no scene in the context");
+    if (!ctx || !ctx->diffuse) return pfsph_fail(err, PFSPH_EINPUT, "diffuse: no scene in the context");
     pfsph_diffuse *d = calloc(1, sizeof(*d));
     if (!d) return pfsph_fail(err, PFSPH_ENOMEM, "diffuse: out of memory");
     d->p = *ctx->diffuse;
     if (d->p.max_particles < 0) d->p.max_particles = 0;
-    pfsph_diffuse_thresholds(&d->p, ctx->dim, (double)ctx->h, (double)ctx->spacing,
-                             &d->foam_min, &d->foam_max);
+    pfsph_diffuse_thresholds(&d->p, ctx->dim, (double)ctx->h, (double)ctx->spacing, &d->foam_min, &d->foam_max);
     for (int k = 0; k < PFSPH_MAX_PHASES; k++)
         d->liquid[k] = k >= ctx->nphases || ctx->phases[k].kind != PFSPH_PHASE_GAS;
     d->all_liquid = true;
@@ -93,11 +91,9 @@ void pfsph_diffuse_totals(const pfsph_diffuse *d, uint64_t *created, uint64_t *r
     if (refused) *refused = d->refused;
 }
 
-long pfsph_diffuse_add(pfsph_diffuse *d, const pfsph_real x[3], const pfsph_real v[3], int type,
-                       pfsph_real lifetime)
+long pfsph_diffuse_add(pfsph_diffuse *d, const pfsph_real x[3], const pfsph_real v[3], int type, pfsph_real lifetime)
 {
-    if ((long)d->ps.n >= d->p.max_particles || type < 0 || type >= PFSPH_DIFFUSE_NTYPES)
-        return -1;
+    if ((long)d->ps.n >= d->p.max_particles || type < 0 || type >= PFSPH_DIFFUSE_NTYPES) return -1;
     long i = pfsph_particles_push(&d->ps, x, v, (uint8_t)type);
     if (i < 0) return -1;
     d->ps.aux[i] = lifetime;
@@ -115,8 +111,8 @@ static inline int classify(const pfsph_diffuse *d, int count)
 /* Fluid positions at the start of the step: the integrator moved x by dt v (symplectic Euler),
  * so x(t) = x(t+dt) - dt v(t+dt), the positions the grid was built from (NOTES 19). Stored once
  * per step in d->ox.. (pfsph_diffuse_step); `old` false selects the current positions. */
-static inline void fluid_pos(const pfsph_diffuse *d, const pfsph_particles *f, bool old,
-                             const pfsph_real **x, const pfsph_real **y, const pfsph_real **z)
+static inline void fluid_pos(const pfsph_diffuse *d, const pfsph_particles *f, bool old, const pfsph_real **x,
+                             const pfsph_real **y, const pfsph_real **z)
 {
     *x = old ? d->ox : f->x;
     *y = old ? d->oy : f->y;
@@ -126,8 +122,7 @@ static inline void fluid_pos(const pfsph_diffuse *d, const pfsph_particles *f, b
 /* Eq. 13 with lambda = 1 - vhat_ij . xhat_ij (NOTES 13) and W^D of Eq. 11, over liquid
  * neighbours at the start-of-step positions; stops early once the sum reaches `stop` (phi of
  * Eq. 14 saturates there, so the result of Eq. 15 is unchanged). */
-static double velocity_difference(const pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i,
-                                  double stop)
+static double velocity_difference(const pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i, double stop)
 {
     const pfsph_particles *f = ctx->fluid;
     const pfsph_real *X, *Y, *Z;
@@ -162,15 +157,14 @@ static inline double kinetic_energy(const pfsph_diffuse *d, const pfsph_ctx *ctx
 {
     const pfsph_particles *f = ctx->fluid;
     double m = d->p.energy_mass > 0 ? d->p.energy_mass : (double)ctx->mass[f->phase[i]];
-    double v2 = (double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] +
-                (double)f->vz[i] * f->vz[i];
+    double v2 = (double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] + (double)f->vz[i] * f->vz[i];
     return 0.5 * m * v2; /* Eq. 9 */
 }
 
 static int prepare_old(pfsph_diffuse *d, const pfsph_ctx *ctx);
 
-void pfsph_diffuse_potentials(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i,
-                              double *v_diff, double *energy, double *rate)
+void pfsph_diffuse_potentials(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i, double *v_diff, double *energy,
+                              double *rate)
 {
     if (prepare_old(d, ctx) != PFSPH_OK) {
         *v_diff = *energy = *rate = 0;
@@ -181,10 +175,9 @@ void pfsph_diffuse_potentials(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i,
     if (v_diff) *v_diff = v;
     if (energy) *energy = e;
     if (rate)
-        *rate = d->liquid[ctx->fluid->phase[i]]
-                    ? pfsph_diffuse_phi(v, d->p.phi_v_min, d->p.phi_v_max) *
-                          pfsph_diffuse_phi(e, d->p.phi_e_min, d->p.phi_e_max)
-                    : 0.0; /* Eq. 15 */
+        *rate = d->liquid[ctx->fluid->phase[i]] ? pfsph_diffuse_phi(v, d->p.phi_v_min, d->p.phi_v_max) *
+                pfsph_diffuse_phi(e, d->p.phi_e_min, d->p.phi_e_max)
+                                                : 0.0; /* Eq. 15 */
 }
 
 /* Number of particles fluid particle i emits this step: Eq. 16 with stochastic rounding. */
@@ -241,14 +234,12 @@ static void emit_one(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i, uint32_t 
         double ax[3] = {0, 0, 0};
         double m0 = fabs(vh[0]), m1 = fabs(vh[1]), m2 = fabs(vh[2]);
         ax[m0 <= m1 && m0 <= m2 ? 0 : (m1 <= m2 ? 1 : 2)] = 1.0;
-        double e1[3] = {vh[1] * ax[2] - vh[2] * ax[1], vh[2] * ax[0] - vh[0] * ax[2],
-                        vh[0] * ax[1] - vh[1] * ax[0]};
+        double e1[3] = {vh[1] * ax[2] - vh[2] * ax[1], vh[2] * ax[0] - vh[0] * ax[2], vh[0] * ax[1] - vh[1] * ax[0]};
         double n1 = sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
         for (int a = 0; a < 3; a++) e1[a] /= n1;
-        double e2[3] = {vh[1] * e1[2] - vh[2] * e1[1], vh[2] * e1[0] - vh[0] * e1[2],
-                        vh[0] * e1[1] - vh[1] * e1[0]};
-        double ri = R * sqrt(u[0]);  /* Eq. 19, sqrt: uniform over the disc */
-        double th = TWO_PI * u[1];   /* Eq. 18 */
+        double e2[3] = {vh[1] * e1[2] - vh[2] * e1[1], vh[2] * e1[0] - vh[0] * e1[2], vh[0] * e1[1] - vh[1] * e1[0]};
+        double ri = R * sqrt(u[0]); /* Eq. 19, sqrt: uniform over the disc */
+        double th = TWO_PI * u[1];  /* Eq. 18 */
         double c = ri * cos(th), sn = ri * sin(th);
         for (int a = 0; a < 3; a++) off[a] = c * e1[a] + sn * e2[a];
     }
@@ -271,8 +262,8 @@ static void emit_one(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i, uint32_t 
 
 /* Liquid neighbours within h of (x, y, z) and the kernel sums of Eq. 23. `old` selects the
  * start-of-step fluid positions (exact for the grid) or the current ones. */
-static int fluid_sample(const pfsph_diffuse *d, const pfsph_ctx *ctx, const pfsph_real xd[3],
-                        bool old, double *sw, double sv[3])
+static int fluid_sample(const pfsph_diffuse *d, const pfsph_ctx *ctx, const pfsph_real xd[3], bool old, double *sw,
+                        double sv[3])
 {
     const pfsph_particles *f = ctx->fluid;
     const pfsph_real *X, *Y, *Z;
@@ -470,8 +461,7 @@ static void generate(pfsph_diffuse *d, const pfsph_ctx *ctx)
 #pragma omp parallel for schedule(dynamic, 512)
     for (long i = 0; i < nf; i++) {
         uint32_t b = cnt[i], e = i + 1 < nf ? cnt[i + 1] : (uint32_t)total;
-        for (uint32_t k = 0; b + k < e && (size_t)(b + k) < add; k++)
-            emit_one(d, ctx, (size_t)i, k, base + b + k);
+        for (uint32_t k = 0; b + k < e && (size_t)(b + k) < add; k++) emit_one(d, ctx, (size_t)i, k, base + b + k);
     }
     pfsph_particles *ps = &d->ps;
     /* Label the new particles at their own position (current fluid positions; the next step
@@ -526,8 +516,7 @@ static void sort_spatially(pfsph_diffuse *d, const pfsph_grid *g)
     pc = d->perm_cap;
     d->key = ensure(d->key, &pc, n, sizeof(uint32_t), &ok2);
     d->bins = ensure(d->bins, &d->bins_cap, g->ncells + 1, sizeof(uint32_t), &ok3);
-    d->tmp = ensure(d->tmp, &d->tmp_cap, n, sizeof(pfsph_real) > 4 ? sizeof(pfsph_real) : 4,
-                    &ok4);
+    d->tmp = ensure(d->tmp, &d->tmp_cap, n, sizeof(pfsph_real) > 4 ? sizeof(pfsph_real) : 4, &ok4);
     if (!ok1 || !ok2 || !ok3 || !ok4) return; /* unsorted is still correct */
     d->perm_cap = pc;
 #pragma omp parallel for schedule(static)
@@ -560,8 +549,7 @@ void pfsph_diffuse_step(pfsph_diffuse *d, const pfsph_ctx *ctx)
     generate(d, ctx);
 }
 
-int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created,
-                         uint64_t refused)
+int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created, uint64_t refused)
 {
     if ((long)ps->n > d->p.max_particles) return PFSPH_EINPUT;
     for (size_t i = 0; i < ps->n; i++)

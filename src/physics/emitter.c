@@ -16,8 +16,8 @@
 typedef struct nozzle {
     pfsph_emitter_params p;
     pfsph_emitter_info info;
-    double step[3];    /* displacement per unit of layer travelled: d direction / |direction[axis]| */
-    double *site;      /* 3 per site: the exit plane's lattice sites */
+    double step[3];      /* displacement per unit of layer travelled: d direction / |direction[axis]| */
+    double *site;        /* 3 per site: the exit plane's lattice sites */
     double lo[3], hi[3]; /* bounding box of the sites */
     pfsph_emitter_state st;
 } nozzle;
@@ -59,7 +59,8 @@ static size_t sample(const pfsph_emitter_params *p, int dim, double d, const dou
             bool in;
             if (p->shape == PFSPH_NOZZLE_DISC) in = u * u + w * w <= p->radius * p->radius + tiny * p->radius;
             else /* [c - s/2, c + s/2), as a box block takes its sites */
-                in = u >= -half[0] - tiny && u < half[0] - tiny && (nt < 2 || (w >= -half[1] - tiny && w < half[1] - tiny));
+                in = u >= -half[0] - tiny && u < half[0] - tiny &&
+                    (nt < 2 || (w >= -half[1] - tiny && w < half[1] - tiny));
             /* the site and a layer's travel from it inside the domain (the grid removes what
              * leaves it) */
             for (int c = 0; c < dim && in; c++)
@@ -91,10 +92,11 @@ int pfsph_emitters_create(pfsph_emitters **out, const pfsph_emitter_params *p, i
         size_t ns = sample(&z->p, ctx->dim, d, ctx->domain_min, ctx->domain_max, z->step, keep, user, NULL);
         if (!ns) {
             pfsph_emitters_destroy(em);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.emitters[%d]: the nozzle holds no lattice site inside the "
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: $.emitters[%d]: the nozzle holds no lattice site inside the "
                               "domain and at least 0.4 d from the solids (sites lie at (k + 1/2) d, d = %g m; widen "
-                              "the opening or move it)", source, i,
-                              d);
+                              "the opening or move it)",
+                              source, i, d);
         }
         z->site = malloc(3 * ns * sizeof(double));
         if (!z->site) {
@@ -114,9 +116,10 @@ int pfsph_emitters_create(pfsph_emitters **out, const pfsph_emitter_params *p, i
         if (!(z->info.speed <= 1e3)) {
             double sp = z->info.speed;
             pfsph_emitters_destroy(em);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.emitters[%d].rate: %g through %zu sites needs an entry speed "
-                              "of %g m/s, above 1000 m/s; widen the opening or lower the rate", source, i, p[i].rate,
-                              ns, sp);
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: $.emitters[%d].rate: %g through %zu sites needs an entry speed "
+                              "of %g m/s, above 1000 m/s; widen the opening or lower the rate",
+                              source, i, p[i].rate, ns, sp);
         }
         z->info.layer_rate = z->info.speed * dn / d;
         z->info.rate = z->info.layer_rate * layer_v;
@@ -145,10 +148,7 @@ void pfsph_emitters_destroy(pfsph_emitters *em)
 
 int pfsph_emitters_count(const pfsph_emitters *em) { return em ? em->n : 0; }
 
-void pfsph_emitters_info(const pfsph_emitters *em, int i, pfsph_emitter_info *info)
-{
-    *info = em->z[i].info;
-}
+void pfsph_emitters_info(const pfsph_emitters *em, int i, pfsph_emitter_info *info) { *info = em->z[i].info; }
 
 /* Seconds of [t0, t1] during which nozzle z is open. */
 static double open_for(const nozzle *z, double t0, double t1)
@@ -308,10 +308,7 @@ size_t pfsph_emitters_step(pfsph_emitters *em, pfsph_particles *f, const pfsph_c
     return added;
 }
 
-void pfsph_emitters_get_state(const pfsph_emitters *em, int i, pfsph_emitter_state *st)
-{
-    *st = em->z[i].st;
-}
+void pfsph_emitters_get_state(const pfsph_emitters *em, int i, pfsph_emitter_state *st) { *st = em->z[i].st; }
 
 int pfsph_emitters_check_state(const pfsph_emitters *em, int i, const pfsph_emitter_state *st, double t,
                                pfsph_error *err)
@@ -322,9 +319,11 @@ int pfsph_emitters_check_state(const pfsph_emitters *em, int i, const pfsph_emit
     const double most = floor(z->info.layer_rate * open_for(z, 0, t) * (1 + 1e-9)) + 1;
     if (!(st->debt >= 0 && st->debt < 1) || made < st->emitted || made % z->info.sites != 0 ||
         (double)(made / z->info.sites) > most)
-        return pfsph_fail(err, PFSPH_EINPUT, "emitter %d: state (%g layers owed, %llu emitted, %llu refused) is not "
-                          "one this nozzle of %zu sites reaches by t = %g s", i, st->debt,
-                          (unsigned long long)st->emitted, (unsigned long long)st->refused, z->info.sites, t);
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "emitter %d: state (%g layers owed, %llu emitted, %llu refused) is not "
+                          "one this nozzle of %zu sites reaches by t = %g s",
+                          i, st->debt, (unsigned long long)st->emitted, (unsigned long long)st->refused, z->info.sites,
+                          t);
     return PFSPH_OK;
 }
 

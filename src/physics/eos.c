@@ -3,8 +3,7 @@
 
 #include <math.h>
 
-void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double gamma,
-                 double rho_common, pfsph_real *p)
+void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double gamma, double rho_common, pfsph_real *p)
 {
     const pfsph_particles *f = ctx->fluid;
     const double inv_nd0 = 1.0 / (double)ctx->nd0;
@@ -16,8 +15,7 @@ void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double ga
         if (gamma == 7) {
             double r2 = ratio * ratio, r4 = r2 * r2;
             pw = r4 * r2 * ratio;
-        } else
-            pw = pow(ratio, gamma);
+        } else pw = pow(ratio, gamma);
         /* rho_common > 0: one pressure scale for all phases (scene.h, pfsph_pressure_scale) */
         double rho0 = rho_common > 0 ? rho_common : (double)ctx->rest_density[f->phase[i]];
         double pr = ratio > 1 ? B * rho0 * (pw - 1) : 0;

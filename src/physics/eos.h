@@ -5,7 +5,6 @@
 #include "pfsph/ctx.h"
 
 /* Tait equation (DF Eq. 3 with NOTES item 12), negative pressures clamped to zero. */
-void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double gamma,
-                 double rho_common, pfsph_real *p);
+void pfsph__tait(const pfsph_ctx *ctx, const pfsph_real *nd, double B, double gamma, double rho_common, pfsph_real *p);
 
 #endif

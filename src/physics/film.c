@@ -42,8 +42,8 @@ static void detect(pfsph_film *fm, const pfsph_ctx *ctx)
         if (f->bubble[i] && fm->layer[i] == 1) fm->ns[f->bubble[i] - 1]++;
 }
 
-int pfsph_film_create(pfsph_film **out, const pfsph_ctx *ctx, pfsph_film_params *fp,
-                      const char *source, pfsph_error *err)
+int pfsph_film_create(pfsph_film **out, const pfsph_ctx *ctx, pfsph_film_params *fp, const char *source,
+                      pfsph_error *err)
 {
     *out = NULL;
     pfsph_film *fm = calloc(1, sizeof *fm);
@@ -57,15 +57,18 @@ int pfsph_film_create(pfsph_film **out, const pfsph_ctx *ctx, pfsph_film_params 
     for (int k = 0; k < fm->nb; k++) {
         if (fm->ns[k] == 0) {
             pfsph_film_destroy(fm);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.fluid[%d].bubble: the bubble holds no particle "
-                              "(carved away by a later block, a solid or a body)", source, fp->block[k]);
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: $.fluid[%d].bubble: the bubble holds no particle "
+                              "(carved away by a later block, a solid or a body)",
+                              source, fp->block[k]);
         }
         if (fp->thickness[k] > 0) /* a(0) = t / d: the film's area is N_s d^(dim-1) */
             fp->volume[k] = fp->thickness[k] * pow(d, ctx->dim - 1) * (double)fm->ns[k];
         const long ns = fm->ns[k];
         if (fp->volume[k] / ((double)ns * V0) > 1) {
             pfsph_film_destroy(fm);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.fluid[%d].bubble.liquid_volume: %g m^%d is more than its "
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: $.fluid[%d].bubble.liquid_volume: %g m^%d is more than its "
                               "%ld surface particles hold (%g m^%d, a film one particle thick); give at most that",
                               source, fp->block[k], fp->volume[k], ctx->dim, ns, (double)ns * V0, ctx->dim);
         }
@@ -98,8 +101,7 @@ int pfsph_film_update(pfsph_film *fm, const pfsph_ctx *ctx)
     }
     const uint8_t *L = fm->layer;
 #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++)
-        f->film[i] = f->bubble[i] && L[i] == 1 ? (pfsph_real)fm->frac[f->bubble[i] - 1] : 0;
+    for (size_t i = 0; i < n; i++) f->film[i] = f->bubble[i] && L[i] == 1 ? (pfsph_real)fm->frac[f->bubble[i] - 1] : 0;
     return held;
 }
 

@@ -37,8 +37,8 @@ void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r
 PFSPH__CLONES
 void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const uint32_t *restrict jj,
                                 const pfsph_real *restrict dx, const pfsph_real *restrict dy,
-                                const pfsph_real *restrict dz, const pfsph_real *restrict r2,
-                                pfsph_real *restrict dw, pfsph_real *restrict sv, pfsph_real *restrict sp)
+                                const pfsph_real *restrict dz, const pfsph_real *restrict r2, pfsph_real *restrict dw,
+                                pfsph_real *restrict sv, pfsph_real *restrict sp)
 {
     const pfsph_kernel K = in->k;
     const pfsph_real *restrict vx = in->vx, *restrict vy = in->vy, *restrict vz = in->vz, *restrict nd = in->nd,
@@ -121,11 +121,11 @@ typedef double pf__v4d __attribute__((vector_size(32)));
 #else
 typedef float pf__v4f __attribute__((vector_size(16)));
 /* four floats as doubles (exact) */
-#define LD4R(v, p)                                                                                                    \
-    do {                                                                                                               \
-        pf__v4f f_;                                                                                                    \
-        __builtin_memcpy(&f_, (p), sizeof f_);                                                                         \
-        (v) = __builtin_convertvector(f_, pf__v4d);                                                                    \
+#define LD4R(v, p)                                  \
+    do {                                            \
+        pf__v4f f_;                                 \
+        __builtin_memcpy(&f_, (p), sizeof f_);      \
+        (v) = __builtin_convertvector(f_, pf__v4d); \
     } while (0)
 #endif
 

@@ -23,8 +23,8 @@ typedef struct pfsph_pair_in {
  * (p_i / delta_i^2 + p_j / delta_j^2) dW/r (pressure.c); the terms are sv x_ij, sp x_ij. */
 void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const uint32_t *restrict jj,
                                 const pfsph_real *restrict dx, const pfsph_real *restrict dy,
-                                const pfsph_real *restrict dz, const pfsph_real *restrict r2,
-                                pfsph_real *restrict dw, pfsph_real *restrict sv, pfsph_real *restrict sp);
+                                const pfsph_real *restrict dz, const pfsph_real *restrict r2, pfsph_real *restrict dw,
+                                pfsph_real *restrict sv, pfsph_real *restrict sp);
 
 /* Per fluid hit e of the thermostat (thermostat.h): t[e] = pfsph__thermo_fluid(amp_ts[e], nu[e],
  * mi, mj[e], ndi, ndj[e], r2[e], dw[e], eps, sqrt(r2[e]), theta[e]), the noise force over r,
@@ -65,7 +65,8 @@ static inline float pfsph__cos_pair(float x)
     const float y = (x - q * 1.5703125f) - q * 4.83826795e-4f;
     const float y2 = y * y;
     const float c = 1.0f + y2 * (-0.5f + y2 * (4.16666667e-2f + y2 * (-1.38888889e-3f + y2 * 2.48015873e-5f)));
-    const float s = y + y * y2 * (-1.66666667e-1f + y2 * (8.33333333e-3f + y2 * (-1.98412698e-4f + y2 * 2.75573192e-6f)));
+    const float s =
+        y + y * y2 * (-1.66666667e-1f + y2 * (8.33333333e-3f + y2 * (-1.98412698e-4f + y2 * 2.75573192e-6f)));
     const float v = q == 1.0f || q == 3.0f ? s : c;
     return q == 1.0f || q == 2.0f ? -v : v;
 }

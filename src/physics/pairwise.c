@@ -17,15 +17,14 @@ static const double PI = 3.14159265358979323846;
 
 struct pfsph_pairwise {
     int dim;
-    double R; /* k h */
+    double R;                 /* k h */
     pfsph_real *sx, *sy, *sz; /* shifting scratch */
     size_t cap;
     double shift_max; /* largest shift of the last step [m] */
     double amax;      /* largest pair-force acceleration of the last apply [m/s^2] */
 };
 
-void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, double eps_min,
-                                  double T[3][3])
+void pfsph_pairwise_filter_matrix(int dim, const double C[3][3], double eta, double eps_min, double T[3][3])
 {
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++) T[a][b] = a == b ? 1.0 : 0.0;
@@ -137,13 +136,13 @@ void pfsph_pairwise_shift(pfsph_pairwise *pw, const pfsph_ctx *ctx)
 typedef struct pw_job {
     const pfsph_ctx *ctx;
     double coef[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES]; /* c[a][b] m_b: acceleration per unit f */
-    bool two_phase;  /* bubbles in air: film fractions enter through Eq. 24 */
-    const double (*c)[PFSPH_MAX_PHASES]; /* the raw matrix, for Eq. 24 */
-    const int *film; /* film phase of each gas phase */
+    bool two_phase;                                  /* bubbles in air: film fractions enter through Eq. 24 */
+    const double (*c)[PFSPH_MAX_PHASES];             /* the raw matrix, for Eq. 24 */
+    const int *film;                                 /* film phase of each gas phase */
     double mass[PFSPH_MAX_PHASES];
     pfsph_real R, R2;
-    double U_R;      /* 3 pi / (2 R) */
-    pfsph_kernel kk; /* cubic spline with support k h, for Eq. 7 (NOTES item 2) */
+    double U_R;        /* 3 pi / (2 R) */
+    pfsph_kernel kk;   /* cubic spline with support k h, for Eq. 7 (NOTES item 2) */
     pfsph_real inv_v0; /* 1 / V0: the walls' density term, as density.c scales it */
     bool filter;
     double eta, eps_min;
@@ -157,11 +156,10 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx, bool sorted)
     const pfsph_pairwise_params *pp = ctx->pairwise;
     J->ctx = ctx;
     for (int a = 0; a < PFSPH_MAX_PHASES; a++)
-        for (int b = 0; b < PFSPH_MAX_PHASES; b++)
-            J->coef[a][b] = pp->c[a][b] * (double)ctx->mass[b];
+        for (int b = 0; b < PFSPH_MAX_PHASES; b++) J->coef[a][b] = pp->c[a][b] * (double)ctx->mass[b];
     for (int b = 0; b < PFSPH_MAX_PHASES; b++) J->mass[b] = (double)ctx->mass[b];
     J->two_phase = ctx->film && ctx->film->nbubbles > 0;
-    J->c = (const double (*)[PFSPH_MAX_PHASES])pp->c;
+    J->c = (const double(*)[PFSPH_MAX_PHASES])pp->c;
     J->film = ctx->film ? ctx->film->film : NULL;
     double R = pp->k * (double)ctx->h;
     J->R = (pfsph_real)R;
@@ -219,8 +217,8 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
             const int bj = ps->bubble[j];
             const bool apart = bi && bj && bi != bj;
             const double cf = ai > 0 || aj > 0 || apart
-                                  ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
-                                  : coef[pb];
+                ? pfsph_film_pair_c(J->c, J->film, pa, ai, pb, aj, apart) * J->mass[pb]
+                : coef[pb];
             /* as pfsph__terms_pair_sc */
             const bool live = H->r2[e] > 0;
             W->sc[e] = live && cf != 0.0 ? cf * W->cr[e] : 0.0;
@@ -240,9 +238,9 @@ static inline double lanes(const double l[4]) { return (l[0] + l[1]) + (l[2] + l
 
 /* Sums over one particle set for fluid particle i at (xi, yi, zi) of phase pa: the pairs within
  * k h of a grid walk, filtered in SIMD (core/hits.h), in the walk's order. */
-static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g, size_t self,
-                           pfsph_real xi, pfsph_real yi, pfsph_real zi, int pa, double ai, int bi, bool want_vir,
-                           pfsph_pair_sums *P, pw_scratch *W, pfsph_real *ds)
+static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g, size_t self, pfsph_real xi,
+                           pfsph_real yi, pfsph_real zi, int pa, double ai, int bi, bool want_vir, pfsph_pair_sums *P,
+                           pw_scratch *W, pfsph_real *ds)
 {
     pfsph_ranges rg;
     if (J->trim) pfsph_grid_ranges_radius(g, xi, yi, zi, J->R, &rg);
@@ -253,8 +251,8 @@ static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfs
 
 /* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial,
  * T_i itself and (nd not NULL) the number density delta_i of Eq. 23 into nd[i]. */
-static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir,
-                            double *vir, double Tout[9], double Wout[9], pw_scratch *W, pfsph_real *nd)
+static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir, double *vir, double Tout[9],
+                            double Wout[9], pw_scratch *W, pfsph_real *nd)
 {
     const pfsph_ctx *ctx = J->ctx;
     const pfsph_particles *f = ctx->fluid;
@@ -379,8 +377,7 @@ void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *v
     pfsph_pairwise_diagnose_tensor(pw, ctx, vir, T, NULL);
 }
 
-void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir,
-                                    double *T, double *W)
+void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T, double *W)
 {
     (void)pw;
     pw_job J;
@@ -402,9 +399,8 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
     }
 }
 
-
-void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, const pfsph_real *p,
-                                        double *vir, pfsph_real *out)
+void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, const pfsph_real *p, double *vir,
+                                        pfsph_real *out)
 {
     const pfsph_particles *f = ctx->fluid;
     if (!p) p = f->p;
@@ -431,7 +427,7 @@ void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx
                 double w = (double)pfsph_kernel_w(k, rr);
                 /* r_ij . F_ij of the pressure force (pressure.c) */
                 pv -= (pi + (double)p[j] / ((double)ctx->nd[j] * (double)ctx->nd[j])) * (double)r2 *
-                      (double)pfsph_kernel_dw_r(k, rr);
+                    (double)pfsph_kernel_dw_r(k, rr);
                 sw += w;
                 sw2 += w * w;
                 m[0] += w * f->vx[j];
@@ -442,7 +438,7 @@ void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx
         if (sw > 0) {
             double ux = f->vx[i] - m[0] / sw, uy = f->vy[i] - m[1] / sw, uz = f->vz[i] - m[2] / sw;
             kin = (double)ctx->mass[f->phase[i]] * (ux * ux + uy * uy + (dim == 3 ? uz * uz : 0)) /
-                  (1.0 + sw2 / (sw * sw));
+                (1.0 + sw2 / (sw * sw));
         }
         const pfsph_particles *b = ctx->boundary;
         if (b && b->n && pi > 0) { /* the Akinci wall term of the pressure force */
@@ -453,7 +449,7 @@ void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx
                     pfsph_real r2 = dx * dx + dy * dy + dz * dz;
                     if (r2 >= h2) continue;
                     pv -= (double)b->aux[j] / (double)ctx->V0 * pi * (double)r2 *
-                          (double)pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
+                        (double)pfsph_kernel_dw_r(k, pfsph_sqrt(r2));
                 }
         }
         /* virial pressure of particle i's volume 1 / n_i: (m u^2 + 1/2 sum_j r_ij . F_ij) / (dim V_i),

@@ -142,8 +142,7 @@ static double prototype(const pfsph_kernel *k, int dim, pfsph_real spacing)
     for (int a = -m; a <= m; a++)
         for (int b = -m; b <= m; b++)
             for (int c = -mz; c <= mz; c++) {
-                double dx = -a * (double)spacing, dy = -b * (double)spacing,
-                       dz = -c * (double)spacing;
+                double dx = -a * (double)spacing, dy = -b * (double)spacing, dz = -c * (double)spacing;
                 double r = sqrt(dx * dx + dy * dy + dz * dz);
                 if (r <= 0 || r >= k->h) continue;
                 double f = pfsph_kernel_dw_r(k, (pfsph_real)r);

@@ -8,15 +8,13 @@
 
 #include <math.h>
 
-
 #define ANTI_CLUMP_R 0.2
 
 /* C_i and grad C_i (anti-clumping weighted) of fluid particle i at (xi, yi, zi); if nk is
  * not NULL, also the gradient of the concentration over nk's (wider) support in gn[3], whose
  * direction is the surface normal (inwards). */
-static double concentration(const pfsph_ctx *ctx, size_t i, pfsph_real xi, pfsph_real yi,
-                            pfsph_real zi, double inv_wd, double g[3], const pfsph_kernel *nk,
-                            double gn[3])
+static double concentration(const pfsph_ctx *ctx, size_t i, pfsph_real xi, pfsph_real yi, pfsph_real zi, double inv_wd,
+                            double g[3], const pfsph_kernel *nk, double gn[3])
 {
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_real h2 = k->h * k->h;
@@ -48,8 +46,7 @@ static double concentration(const pfsph_ctx *ctx, size_t i, pfsph_real xi, pfsph
                 if (!set && (size_t)j == i) continue;
                 if (r2 <= 0) continue;
                 double t = w * inv_wd, t2 = t * t;
-                double s = V * (1.0 + ANTI_CLUMP_R * t2 * t2) *
-                           (double)pfsph_kernel_dw_r(k, (pfsph_real)rr);
+                double s = V * (1.0 + ANTI_CLUMP_R * t2 * t2) * (double)pfsph_kernel_dw_r(k, (pfsph_real)rr);
                 gx += s * dx;
                 gy += s * dy;
                 gz += s * dz;
@@ -73,8 +70,8 @@ double pfsph_shift_concentration(const pfsph_ctx *ctx, size_t i, double g[3])
     return concentration(ctx, i, f->x[i], f->y[i], f->z[i], inv_wd, g, NULL, NULL);
 }
 
-double pfsph_shift_apply(const pfsph_ctx *ctx, const pfsph_shift_params *p, double dt,
-                         double normal_radius, pfsph_real *sx, pfsph_real *sy, pfsph_real *sz)
+double pfsph_shift_apply(const pfsph_ctx *ctx, const pfsph_shift_params *p, double dt, double normal_radius,
+                         pfsph_real *sx, pfsph_real *sy, pfsph_real *sz)
 {
     pfsph_particles *f = ctx->fluid;
     const size_t n = f->n;
@@ -83,15 +80,13 @@ double pfsph_shift_apply(const pfsph_ctx *ctx, const pfsph_shift_params *p, doub
     const double cap = p->max_frac * (double)ctx->spacing;
     const double inv_wd = 1.0 / (double)pfsph_kernel_w(&ctx->kern, ctx->spacing);
     pfsph_kernel nk;
-    pfsph_kernel_init(&nk, ctx->dim,
-                      (pfsph_real)(normal_radius > (double)ctx->h ? normal_radius : (double)ctx->h));
+    pfsph_kernel_init(&nk, ctx->dim, (pfsph_real)(normal_radius > (double)ctx->h ? normal_radius : (double)ctx->h));
     double smax = 0;
 #pragma omp parallel for schedule(static) reduction(max : smax)
     for (size_t i = 0; i < n; i++) {
         double g[3], gw[3];
         double c = concentration(ctx, i, f->x[i], f->y[i], f->z[i], inv_wd, g, &nk, gw);
-        double v = sqrt((double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] +
-                        (double)f->vz[i] * f->vz[i]);
+        double v = sqrt((double)f->vx[i] * f->vx[i] + (double)f->vy[i] * f->vy[i] + (double)f->vz[i] * f->vz[i]);
         double Ddt = (p->D + Ah * v) * dt;
         double s[3] = {-Ddt * g[0], -Ddt * g[1], -Ddt * g[2]};
         if (c < p->surface) {

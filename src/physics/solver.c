@@ -4,8 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-static const pfsph_solver_ops *const solvers[] = {&pfsph_solver_wcsph, &pfsph_solver_pcisph,
-                                                  &pfsph_solver_dfsph, NULL};
+static const pfsph_solver_ops *const solvers[] = {&pfsph_solver_wcsph, &pfsph_solver_pcisph, &pfsph_solver_dfsph, NULL};
 
 const pfsph_solver_ops *pfsph_solver_find(const char *name)
 {

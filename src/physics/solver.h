@@ -28,9 +28,9 @@ typedef struct pfsph_solve_stats {
 } pfsph_solve_stats;
 
 typedef struct pfsph_solver_ops {
-    const char *name;      /* as in the scene's solver.type */
-    int nscratch;          /* per-fluid-particle scratch arrays the solver needs */
-    int nscratch4;         /* the last nscratch4 of them hold 4 values per particle (packed x, y, z, w) */
+    const char *name; /* as in the scene's solver.type */
+    int nscratch;     /* per-fluid-particle scratch arrays the solver needs */
+    int nscratch4;    /* the last nscratch4 of them hold 4 values per particle (packed x, y, z, w) */
     /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
      * solver that walks the neighbours many times per step (memory: src/core/nlist.h). */
     int neighbour_lists;
@@ -45,18 +45,16 @@ typedef struct pfsph_solver_ops {
      * solve, which then finds ap filled. */
     void (*eos)(void *state, const pfsph_ctx *ctx);
     /* Solver state for the fluid of ctx; NULL state is allowed. */
-    int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg,
-                  pfsph_error *err);
+    int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg, pfsph_error *err);
     void (*destroy)(void *state); /* NULL is a no-op */
     /* Optional (may be NULL): called after the density stage and the choice of ctx->dt, before
      * the non-pressure forces: where a divergence-free solver (DFSPH) corrects the velocities. */
-    void (*pre_forces)(void *state, const pfsph_ctx *ctx, pfsph_real *const *scratch,
-                       pfsph_solve_stats *out);
+    void (*pre_forces)(void *state, const pfsph_ctx *ctx, pfsph_real *const *scratch, pfsph_solve_stats *out);
     /* Pressure accelerations a_p for the step ctx->dt, given ctx->nd (number density at x),
      * ctx->ax.. (non-pressure accelerations); writes fluid->p and ap[0..2]; the integrator then
      * applies v += dt (a + a_p), x += dt v. */
-    void (*solve)(void *state, const pfsph_ctx *ctx, pfsph_real *const ap[3],
-                  pfsph_real *const *scratch, pfsph_solve_stats *out);
+    void (*solve)(void *state, const pfsph_ctx *ctx, pfsph_real *const ap[3], pfsph_real *const *scratch,
+                  pfsph_solve_stats *out);
     /* Optional (may be NULL: fluid->p): the pressure whose wall term (Akinci 2012) the fluid
      * felt this step, for the reaction on rigid bodies; called after solve. DFSPH returns the
      * sum of its divergence and density pressures. */
@@ -64,8 +62,7 @@ typedef struct pfsph_solver_ops {
     /* Largest time step the solver allows [s], from the largest speed vmax of the fluid and
      * bodies [m/s] and last step's largest total and non-pressure accelerations [m/s^2]. The
      * simulation adds dt_max, viscous diffusion and the landing on frame times. */
-    double (*dt_limit)(const void *state, const pfsph_ctx *ctx, double vmax, double amax,
-                       double amax_np);
+    double (*dt_limit)(const void *state, const pfsph_ctx *ctx, double vmax, double amax, double amax_np);
     /* Speeds above this are a blow-up [m/s], for the step ctx->dt (0 before the first). */
     double (*speed_bound)(const void *state, const pfsph_ctx *ctx);
     /* The likely cause of a blow-up under this solver at ctx's step, for the message. */

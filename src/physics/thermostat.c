@@ -42,10 +42,9 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
                 double nu = 0.5 * (nui + (double)ctx->nu[pb]);
                 if (!(nu > 0)) continue;
                 double rr = sqrt((double)r2);
-                double s = pfsph__thermo_fluid(amp * ts[pa][pb], nu, mi, (double)ctx->mass[pb], ndi,
-                                               (double)ctx->nd[j], (double)r2,
-                                               (double)pfsph_kernel_dw_r(k, (pfsph_real)rr), (double)eps, rr,
-                                               pfsph_thermo_theta(key, idi, f->id[j]));
+                double s = pfsph__thermo_fluid(amp * ts[pa][pb], nu, mi, (double)ctx->mass[pb], ndi, (double)ctx->nd[j],
+                                               (double)r2, (double)pfsph_kernel_dw_r(k, (pfsph_real)rr), (double)eps,
+                                               rr, pfsph_thermo_theta(key, idi, f->id[j]));
                 fx += s * (double)dx;
                 fy += s * (double)dy;
                 fz += s * (double)dz;
@@ -60,7 +59,8 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
                     double rr = sqrt((double)r2);
                     /* nu_w: the wall's friction viscosity (viscosity.c: free slip 0, no slip nu_i
                      * or the solid's own) */
-                    const double nuw = mixed ? (double)ctx->wall_scale[b->wall[j]] * nui + (double)ctx->wall_nu[b->wall[j]] : nui;
+                    const double nuw =
+                        mixed ? (double)ctx->wall_scale[b->wall[j]] * nui + (double)ctx->wall_nu[b->wall[j]] : nui;
                     double s = pfsph__thermo_wall(amp * ts[pa][pa], nuw, mi, (double)b->aux[j], (double)r2,
                                                   (double)pfsph_kernel_dw_r(k, (pfsph_real)rr), (double)eps, rr,
                                                   pfsph_thermo_theta(wkey, idi, b->id[j]));

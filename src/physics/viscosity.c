@@ -24,9 +24,8 @@ typedef struct visc_acc {
 /* Fluid neighbour j's Morris viscosity term (and with thermo its thermostat force) on i, added
  * to acc; x_ij = (dx, dy, dz), r2 = |x_ij|^2 < h^2, dwr = pfsph_kernel_dw_r(|x_ij|). */
 static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, pfsph_real dx, pfsph_real dy,
-                             pfsph_real dz, pfsph_real r2, pfsph_real dwr, pfsph_real eps, const int thermo,
-                             double amp, const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key,
-                             visc_acc *acc)
+                             pfsph_real dz, pfsph_real r2, pfsph_real dwr, pfsph_real eps, const int thermo, double amp,
+                             const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, visc_acc *acc)
 {
     const pfsph_particles *f = ctx->fluid;
     pfsph_real nu = (pfsph_real)0.5 * (I->nu + ctx->nu[f->phase[j]]);
@@ -41,9 +40,9 @@ static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
         if (nud > 0 && r2 > 0) {
             const double rd = sqrt((double)r2);
             /* dwr, not dw_r((real) rd): (real) sqrt((double) r2) is pfsph_sqrt(r2), so the same bits */
-            const double t = pfsph__thermo_fluid(amp * ts[I->phase][pb], nud, I->m, (double)ctx->mass[pb], I->nd,
-                                                 (double)ctx->nd[j], (double)r2, (double)dwr, (double)eps, rd,
-                                                 pfsph_thermo_theta(key, I->id, f->id[j]));
+            const double t =
+                pfsph__thermo_fluid(amp * ts[I->phase][pb], nud, I->m, (double)ctx->mass[pb], I->nd, (double)ctx->nd[j],
+                                    (double)r2, (double)dwr, (double)eps, rd, pfsph_thermo_theta(key, I->id, f->id[j]));
             acc->fx += t * (double)dx;
             acc->fy += t * (double)dy;
             acc->fz += t * (double)dz;
@@ -56,8 +55,8 @@ static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
  * derivative. The friction sum is scaled by the fluid's viscosity by the caller unless the
  * wall table is in use (ctx.h). */
 static inline void wall_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, pfsph_real dx, pfsph_real dy,
-                             pfsph_real dz, pfsph_real r2, pfsph_real dwr, pfsph_real eps, const int thermo, double ampw,
-                             uint64_t wkey, visc_acc *acc)
+                             pfsph_real dz, pfsph_real r2, pfsph_real dwr, pfsph_real eps, const int thermo,
+                             double ampw, uint64_t wkey, visc_acc *acc)
 {
     const pfsph_particles *b = ctx->boundary;
     const int mixed = ctx->nwalls > 1;
@@ -70,11 +69,12 @@ static inline void wall_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
     acc->az += s * dz;
     if (thermo && r2 > 0) {
         const double rd = sqrt((double)r2);
-        const double nuw = mixed ? (double)ctx->wall_scale[b->wall[j]] * (double)I->nu + (double)ctx->wall_nu[b->wall[j]]
-                                 : (double)I->nu;
+        const double nuw = mixed
+            ? (double)ctx->wall_scale[b->wall[j]] * (double)I->nu + (double)ctx->wall_nu[b->wall[j]]
+            : (double)I->nu;
         /* dwr, not dw_r((real) rd): (real) sqrt((double) r2) is pfsph_sqrt(r2), so the same bits */
-        const double t = pfsph__thermo_wall(ampw, nuw, I->m, (double)b->aux[j], (double)r2, (double)dwr, (double)eps, rd,
-                                            pfsph_thermo_theta(wkey, I->id, b->id[j]));
+        const double t = pfsph__thermo_wall(ampw, nuw, I->m, (double)b->aux[j], (double)r2, (double)dwr, (double)eps,
+                                            rd, pfsph_thermo_theta(wkey, I->id, b->id[j]));
         acc->fx += t * (double)dx;
         acc->fy += t * (double)dy;
         acc->fz += t * (double)dz;
@@ -178,8 +178,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
     const pfsph_real h2 = k->h * k->h, eps = (pfsph_real)0.01 * h2;
-    const pfsph_real gx = (pfsph_real)ctx->gravity[0],
-                     gy = (pfsph_real)ctx->gravity[1],
+    const pfsph_real gx = (pfsph_real)ctx->gravity[0], gy = (pfsph_real)ctx->gravity[1],
                      gz = (pfsph_real)ctx->gravity[2];
     /* Morris et al. 1997 / SPlisHSPlasH "standard" viscosity: 2(d+2) nu sum_j (m_j/rho_j)
      * (v_ij . x_ij)/(|x_ij|^2 + 0.01 h^2) grad W_ij, with m_j/rho_j = 1/delta_j. */
@@ -217,7 +216,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
             const uint32_t idi = f->id[i];
             const pfsph_real pi = fused ? p[i] / (nd[i] * nd[i]) : 0;
             pfsph_real pax = 0, pay = 0, paz = 0; /* pressure (fused) */
-            double fx = 0, fy = 0, fz = 0; /* thermostat */
+            double fx = 0, fy = 0, fz = 0;        /* thermostat */
             pfsph_real ax = 0, ay = 0, az = 0;
             pfsph_ranges r;
             /* the same terms in the same order from a list or a grid walk: the same bits */
@@ -227,14 +226,15 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
                     const uint32_t j = nl->idx[e];
                     pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-                    visc_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, nl->dw[e], eps, thermo, amp, ts, key,
-                              &acc);
+                    visc_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, nl->dw[e], eps, thermo, amp, ts,
+                              key, &acc);
                 }
             } else {
                 pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
                 /* the pairs within h of the grid walk, in its order */
                 if (thermo) {
-                    const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
+                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi,
+                                              vyi, vzi,   nui,   pi,    eps};
                     pfsph_real pa3[3] = {0, 0, 0};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i,
                                     thermo_hits(ctx, &vi, &H, X, &in, eps, amp, ts, key, fused, one_phase, &acc, pa3));
@@ -242,7 +242,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 } else {
                     /* the factors of visc_pair and of the pressure term in vector code
                      * (pair_terms.c), added in order: the same bits */
-                    const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi, vyi, vzi, nui, pi, eps};
+                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi,
+                                              vyi, vzi,   nui,   pi,    eps};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
                         for (int e = 0; e < H.n; e++) H.t3[e] = ctx->nu[f->phase[H.j[e]]];
                         pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);
@@ -273,7 +274,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
                     const uint32_t j = bl->idx[e];
                     pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-                    wall_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, bl->dw[e], eps, thermo, ampw, wkey, &w);
+                    wall_pair(ctx, &vi, j, dx, dy, dz, dx * dx + dy * dy + dz * dz, bl->dw[e], eps, thermo, ampw, wkey,
+                              &w);
                 }
                 fx = w.fx, fy = w.fy, fz = w.fz;
                 const pfsph_real nub = mixed ? (pfsph_real)1 : nui;
@@ -288,18 +290,20 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 const double ampw = thermo ? amp * ts[pa][pa] : 0;
                 const int wall_p = fused && pi > 0;
                 pfsph_grid_ranges(ctx->bgrid, xi, yi, zi, &r);
-                PFSPH_HITS_WALK(hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX, for (int e = 0; e < H.n; e++) {
-                    const uint32_t j = H.j[e];
-                    const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
-                    if (wall_visc)
-                        wall_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, ampw, wkey, &w);
-                    if (wall_p) {
-                        const pfsph_real sb = b->aux[j] * dwr;
-                        bx += sb * H.dx[e];
-                        by += sb * H.dy[e];
-                        bz += sb * H.dz[e];
-                    }
-                });
+                PFSPH_HITS_WALK(
+                    hits, &H, r, b->x, b->y, b->z, xi, yi, zi, h2, UINT32_MAX, for (int e = 0; e < H.n; e++) {
+                        const uint32_t j = H.j[e];
+                        const pfsph_real dwr = pfsph_kernel_dw_r(k, pfsph_sqrt(H.r2[e]));
+                        if (wall_visc)
+                            wall_pair(ctx, &vi, j, H.dx[e], H.dy[e], H.dz[e], H.r2[e], dwr, eps, thermo, ampw, wkey,
+                                      &w);
+                        if (wall_p) {
+                            const pfsph_real sb = b->aux[j] * dwr;
+                            bx += sb * H.dx[e];
+                            by += sb * H.dy[e];
+                            bz += sb * H.dz[e];
+                        }
+                    });
                 if (wall_visc) {
                     fx = w.fx, fy = w.fy, fz = w.fz;
                     const pfsph_real nub = mixed ? (pfsph_real)1 : nui;

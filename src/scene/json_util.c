@@ -59,35 +59,37 @@ static void child_path(char *out, size_t cap, const char *path, const char *key)
     snprintf(out, cap, "%s.%s", path && path[0] ? path : "$", key);
 }
 
-int pfsph__json_check_keys(const cJSON *obj, const char *path, const char *const *allowed,
-                           pfsph_jctx *ctx)
+int pfsph__json_check_keys(const cJSON *obj, const char *path, const char *const *allowed, pfsph_jctx *ctx)
 {
-    if (!cJSON_IsObject(obj))
-        return pfsph__json_fail(ctx, path, "expected an object, got %s", type_name(obj));
+    if (!cJSON_IsObject(obj)) return pfsph__json_fail(ctx, path, "expected an object, got %s", type_name(obj));
     for (const cJSON *c = obj->child; c; c = c->next) {
         const char *key = c->string ? c->string : "";
         char kp[512];
         child_path(kp, sizeof kp, path, key);
         /* cJSON keeps duplicate keys and lookups return the first: a silent trap. */
         for (const cJSON *d = obj->child; d != c; d = d->next)
-            if (d->string && strcmp(d->string, key) == 0)
-                return pfsph__json_fail(ctx, kp, "duplicate key \"%s\"", key);
+            if (d->string && strcmp(d->string, key) == 0) return pfsph__json_fail(ctx, kp, "duplicate key \"%s\"", key);
         bool ok = false;
         for (const char *const *a = allowed; *a; a++)
-            if (strcmp(*a, key) == 0) { ok = true; break; }
+            if (strcmp(*a, key) == 0) {
+                ok = true;
+                break;
+            }
         if (ok) continue;
         /* Suggest the closest valid key when it is close enough to be a typo. */
         const char *best = NULL;
         int bestd = 1 << 30;
         for (const char *const *a = allowed; *a; a++) {
             int d = edit_distance(key, *a);
-            if (d < bestd) { bestd = d; best = *a; }
+            if (d < bestd) {
+                bestd = d;
+                best = *a;
+            }
         }
         int limit = (int)strlen(key) / 3;
         if (limit < 2) limit = 2;
         if (best && bestd <= limit)
-            return pfsph__json_fail(ctx, kp, "unknown key \"%s\" (did you mean \"%s\"?)", key,
-                                    best);
+            return pfsph__json_fail(ctx, kp, "unknown key \"%s\" (did you mean \"%s\"?)", key, best);
         char list[400];
         size_t n = 0;
         list[0] = 0;
@@ -107,21 +109,18 @@ static const cJSON *get(const cJSON *obj, const char *key)
     return cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, key) : NULL;
 }
 
-static int check_number(const cJSON *v, const char *path, double lo, double hi, double *out,
-                        pfsph_jctx *ctx)
+static int check_number(const cJSON *v, const char *path, double lo, double hi, double *out, pfsph_jctx *ctx)
 {
-    if (!cJSON_IsNumber(v))
-        return pfsph__json_fail(ctx, path, "expected a number, got %s", type_name(v));
+    if (!cJSON_IsNumber(v)) return pfsph__json_fail(ctx, path, "expected a number, got %s", type_name(v));
     double x = v->valuedouble;
     if (!isfinite(x)) return pfsph__json_fail(ctx, path, "value is not a finite number");
-    if (x < lo || x > hi)
-        return pfsph__json_fail(ctx, path, "value %g is out of range [%g, %g]", x, lo, hi);
+    if (x < lo || x > hi) return pfsph__json_fail(ctx, path, "value %g is out of range [%g, %g]", x, lo, hi);
     *out = x;
     return PFSPH_OK;
 }
 
-int pfsph__json_number(const cJSON *obj, const char *path, const char *key, double lo, double hi,
-                       double *out, pfsph_jctx *ctx)
+int pfsph__json_number(const cJSON *obj, const char *path, const char *key, double lo, double hi, double *out,
+                       pfsph_jctx *ctx)
 {
     const cJSON *v = get(obj, key);
     if (!v) return PFSPH_OK;
@@ -130,39 +129,33 @@ int pfsph__json_number(const cJSON *obj, const char *path, const char *key, doub
     return check_number(v, kp, lo, hi, out, ctx);
 }
 
-int pfsph__json_int(const cJSON *obj, const char *path, const char *key, long lo, long hi,
-                    int *out, pfsph_jctx *ctx)
+int pfsph__json_int(const cJSON *obj, const char *path, const char *key, long lo, long hi, int *out, pfsph_jctx *ctx)
 {
     const cJSON *v = get(obj, key);
     if (!v) return PFSPH_OK;
     char kp[512];
     child_path(kp, sizeof kp, path, key);
-    if (!cJSON_IsNumber(v))
-        return pfsph__json_fail(ctx, kp, "expected an integer, got %s", type_name(v));
+    if (!cJSON_IsNumber(v)) return pfsph__json_fail(ctx, kp, "expected an integer, got %s", type_name(v));
     double x = v->valuedouble;
-    if (!isfinite(x) || x != floor(x))
-        return pfsph__json_fail(ctx, kp, "expected an integer, got %g", x);
+    if (!isfinite(x) || x != floor(x)) return pfsph__json_fail(ctx, kp, "expected an integer, got %g", x);
     if (x < (double)lo || x > (double)hi)
         return pfsph__json_fail(ctx, kp, "value %g is out of range [%ld, %ld]", x, lo, hi);
     *out = (int)x;
     return PFSPH_OK;
 }
 
-int pfsph__json_bool(const cJSON *obj, const char *path, const char *key, bool *out,
-                     pfsph_jctx *ctx)
+int pfsph__json_bool(const cJSON *obj, const char *path, const char *key, bool *out, pfsph_jctx *ctx)
 {
     const cJSON *v = get(obj, key);
     if (!v) return PFSPH_OK;
     char kp[512];
     child_path(kp, sizeof kp, path, key);
-    if (!cJSON_IsBool(v))
-        return pfsph__json_fail(ctx, kp, "expected true or false, got %s", type_name(v));
+    if (!cJSON_IsBool(v)) return pfsph__json_fail(ctx, kp, "expected true or false, got %s", type_name(v));
     *out = cJSON_IsTrue(v);
     return PFSPH_OK;
 }
 
-int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char *out,
-                       size_t cap, pfsph_jctx *ctx)
+int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char *out, size_t cap, pfsph_jctx *ctx)
 {
     const cJSON *v = get(obj, key);
     if (!v) return PFSPH_OK;
@@ -171,28 +164,23 @@ int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char
     if (!cJSON_IsString(v) || !v->valuestring)
         return pfsph__json_fail(ctx, kp, "expected a string, got %s", type_name(v));
     size_t n = strlen(v->valuestring);
-    if (n >= cap)
-        return pfsph__json_fail(ctx, kp, "string is too long (%zu characters, at most %zu)", n,
-                                cap - 1);
+    if (n >= cap) return pfsph__json_fail(ctx, kp, "string is too long (%zu characters, at most %zu)", n, cap - 1);
     memcpy(out, v->valuestring, n + 1);
     return PFSPH_OK;
 }
 
-int pfsph__json_vec(const cJSON *obj, const char *path, const char *key, int n, double lo,
-                    double hi, double *out, pfsph_jctx *ctx)
+int pfsph__json_vec(const cJSON *obj, const char *path, const char *key, int n, double lo, double hi, double *out,
+                    pfsph_jctx *ctx)
 {
     const cJSON *v = get(obj, key);
     if (!v) return PFSPH_OK;
     char kp[512];
     child_path(kp, sizeof kp, path, key);
-    if (!cJSON_IsArray(v))
-        return pfsph__json_fail(ctx, kp, "expected an array of %d numbers, got %s", n,
-                                type_name(v));
+    if (!cJSON_IsArray(v)) return pfsph__json_fail(ctx, kp, "expected an array of %d numbers, got %s", n, type_name(v));
     int len = cJSON_GetArraySize(v);
     if (len != n)
         return pfsph__json_fail(ctx, kp, "expected %d numbers, got %d%s", n, len,
-                                n == 2 ? " (2D scenes use [x, y])"
-                                       : (n == 3 ? " (3D scenes use [x, y, z])" : ""));
+                                n == 2 ? " (2D scenes use [x, y])" : (n == 3 ? " (3D scenes use [x, y, z])" : ""));
     double tmp[16];
     if (n > 16) return pfsph__json_fail(ctx, kp, "vector too long");
     int i = 0;

@@ -16,19 +16,15 @@ typedef struct pfsph_jctx {
 } pfsph_jctx;
 
 /* Error unless obj is an object whose keys are all in `allowed` (NULL-terminated). */
-int pfsph__json_check_keys(const cJSON *obj, const char *path, const char *const *allowed,
-                           pfsph_jctx *ctx);
-int pfsph__json_number(const cJSON *obj, const char *path, const char *key, double lo, double hi,
-                       double *out, pfsph_jctx *ctx);
-int pfsph__json_int(const cJSON *obj, const char *path, const char *key, long lo, long hi,
-                    int *out, pfsph_jctx *ctx);
-int pfsph__json_bool(const cJSON *obj, const char *path, const char *key, bool *out,
-                     pfsph_jctx *ctx);
-int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char *out,
-                       size_t cap, pfsph_jctx *ctx);
+int pfsph__json_check_keys(const cJSON *obj, const char *path, const char *const *allowed, pfsph_jctx *ctx);
+int pfsph__json_number(const cJSON *obj, const char *path, const char *key, double lo, double hi, double *out,
+                       pfsph_jctx *ctx);
+int pfsph__json_int(const cJSON *obj, const char *path, const char *key, long lo, long hi, int *out, pfsph_jctx *ctx);
+int pfsph__json_bool(const cJSON *obj, const char *path, const char *key, bool *out, pfsph_jctx *ctx);
+int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char *out, size_t cap, pfsph_jctx *ctx);
 /* An array of exactly n numbers, each in [lo, hi]. */
-int pfsph__json_vec(const cJSON *obj, const char *path, const char *key, int n, double lo,
-                    double hi, double *out, pfsph_jctx *ctx);
+int pfsph__json_vec(const cJSON *obj, const char *path, const char *key, int n, double lo, double hi, double *out,
+                    pfsph_jctx *ctx);
 /* Error "<source>: <path>: <reason>" (printf-style reason); returns PFSPH_EINPUT. */
 int pfsph__json_fail(pfsph_jctx *ctx, const char *path, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -38,15 +34,11 @@ int pfsph__json_fail(pfsph_jctx *ctx, const char *path, const char *fmt, ...)
 
 /* Sub-parsers owned by their modules (src/scene/scene_pairwise.c, scene_diffuse.c). Called
  * after phases are parsed, with the object under "pairwise" / "diffuse" and its path. */
-int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene *s,
-                                pfsph_jctx *ctx);
-int pfsph__scene_parse_diffuse(const cJSON *node, const char *path, pfsph_scene *s,
-                               pfsph_jctx *ctx);
+int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene *s, pfsph_jctx *ctx);
+int pfsph__scene_parse_diffuse(const cJSON *node, const char *path, pfsph_scene *s, pfsph_jctx *ctx);
 /* The "bodies" array (src/scene/scene_bodies.c), after solids and fluid. */
-int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s,
-                              pfsph_jctx *ctx);
+int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s, pfsph_jctx *ctx);
 /* The "emitters" array (src/scene/scene_emitters.c), after the fluid blocks and solids. */
-int pfsph__scene_parse_emitters(const cJSON *arr, const char *path, pfsph_scene *s,
-                                pfsph_jctx *ctx);
+int pfsph__scene_parse_emitters(const cJSON *arr, const char *path, pfsph_scene *s, pfsph_jctx *ctx);
 
 #endif

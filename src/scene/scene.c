@@ -14,9 +14,9 @@
 
 /* ---------------------------------------------------------------------------------------- */
 /* Limits of the accepted ranges (documented in docs/scene-format.md). */
-#define COORD_MAX 1e6     /* m */
-#define VEL_MAX 1e3       /* m/s */
-#define GRAVITY_MAX 1e3   /* m/s^2 */
+#define COORD_MAX 1e6               /* m */
+#define VEL_MAX 1e3                 /* m/s */
+#define GRAVITY_MAX 1e3             /* m/s^2 */
 #define SEED_MAX 9007199254740992.0 /* 2^53: integers a JSON double holds exactly */
 
 static const float palette[][3] = {
@@ -30,31 +30,25 @@ typedef struct parser {
     pfsph_jctx ctx;
 } parser;
 
-#define TRY(expr)                                                                          \
-    do {                                                                                   \
-        int rc_ = (expr);                                                                  \
-        if (rc_) return rc_;                                                               \
+#define TRY(expr)            \
+    do {                     \
+        int rc_ = (expr);    \
+        if (rc_) return rc_; \
     } while (0)
 
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 static const char *const kind_names[] = {"fluid", "gas", "solid", NULL};
 static const char *const solver_names[] = {"wcsph", "pcisph", "dfsph", NULL}; /* enum order */
-static const char *const pressure_scale_names[] = {"phase", "common", NULL}; /* enum order */
+static const char *const pressure_scale_names[] = {"phase", "common", NULL};  /* enum order */
 
 static void path_key(char *out, size_t cap, const char *path, const char *key)
 {
     snprintf(out, cap, "%s.%s", path, key);
 }
 
-static void path_index(char *out, size_t cap, const char *path, int i)
-{
-    snprintf(out, cap, "%s[%d]", path, i);
-}
+static void path_index(char *out, size_t cap, const char *path, int i) { snprintf(out, cap, "%s[%d]", path, i); }
 
-static const cJSON *get(const cJSON *obj, const char *key)
-{
-    return cJSON_GetObjectItemCaseSensitive(obj, key);
-}
+static const cJSON *get(const cJSON *obj, const char *key) { return cJSON_GetObjectItemCaseSensitive(obj, key); }
 
 static int require(parser *p, const cJSON *obj, const char *path, const char *key)
 {
@@ -65,8 +59,7 @@ static int require(parser *p, const cJSON *obj, const char *path, const char *ke
 }
 
 /* A vector with as many components as the scene has dimensions; z = 0 in 2D. */
-static int vecd(parser *p, const cJSON *obj, const char *path, const char *key, double lo,
-                double hi, double *out)
+static int vecd(parser *p, const cJSON *obj, const char *path, const char *key, double lo, double hi, double *out)
 {
     if (!get(obj, key)) return PFSPH_OK;
     TRY(pfsph__json_vec(obj, path, key, p->s->dim, lo, hi, out, &p->ctx));
@@ -75,8 +68,7 @@ static int vecd(parser *p, const cJSON *obj, const char *path, const char *key, 
 }
 
 /* A string that must be one of names (NULL-terminated); *out becomes its index. */
-static int json_enum(parser *p, const cJSON *obj, const char *path, const char *key,
-                     const char *const *names, int *out)
+static int json_enum(parser *p, const cJSON *obj, const char *path, const char *key, const char *const *names, int *out)
 {
     const cJSON *v = get(obj, key);
     if (!v) return PFSPH_OK;
@@ -95,29 +87,25 @@ static int json_enum(parser *p, const cJSON *obj, const char *path, const char *
             *out = i;
             return PFSPH_OK;
         }
-    return pfsph__json_fail(&p->ctx, kp, "unknown value \"%.60s\" (expected one of %s)",
-                            v->valuestring, list);
+    return pfsph__json_fail(&p->ctx, kp, "unknown value \"%.60s\" (expected one of %s)", v->valuestring, list);
 }
 
 /* A number that must be strictly positive (the helpers check closed ranges only). */
-static int positive(parser *p, const cJSON *obj, const char *path, const char *key, double hi,
-                    double *out)
+static int positive(parser *p, const cJSON *obj, const char *path, const char *key, double hi, double *out)
 {
     double v = *out;
     TRY(pfsph__json_number(obj, path, key, -HUGE_VAL, hi, &v, &p->ctx));
     if (!(v > 0.0)) {
         char kp[512];
         path_key(kp, sizeof kp, path, key);
-        return pfsph__json_fail(&p->ctx, kp, "value %g is out of range: must be > 0 and <= %g",
-                                v, hi);
+        return pfsph__json_fail(&p->ctx, kp, "value %g is out of range: must be > 0 and <= %g", v, hi);
     }
     *out = v;
     return PFSPH_OK;
 }
 
 /* An array (possibly absent); error when it is not an array or has more than max entries. */
-static int array_of(parser *p, const cJSON *root, const char *path, const char *key, int max,
-                    const cJSON **out)
+static int array_of(parser *p, const cJSON *root, const char *path, const char *key, int max, const cJSON **out)
 {
     const cJSON *v = get(root, key);
     *out = NULL;
@@ -128,8 +116,7 @@ static int array_of(parser *p, const cJSON *root, const char *path, const char *
         return pfsph__json_fail(&p->ctx, kp, "expected an array, got %s",
                                 cJSON_IsObject(v) ? "an object" : "a single value");
     int n = cJSON_GetArraySize(v);
-    if (n > max)
-        return pfsph__json_fail(&p->ctx, kp, "too many entries (%d, at most %d)", n, max);
+    if (n > max) return pfsph__json_fail(&p->ctx, kp, "too many entries (%d, at most %d)", n, max);
     *out = v;
     return PFSPH_OK;
 }
@@ -147,8 +134,8 @@ typedef struct geo {
     double min[3], max[3], center[3], radius, height;
 } geo;
 
-static geo geo_of(int dim, int shape, const double *min, const double *max, const double *center,
-                  double radius, double height, int axis)
+static geo geo_of(int dim, int shape, const double *min, const double *max, const double *center, double radius,
+                  double height, int axis)
 {
     geo g;
     memset(&g, 0, sizeof g);
@@ -233,8 +220,7 @@ static bool geo_overlap(const geo *a, const geo *b, double spacing)
     if (a->shape == PFSPH_SHAPE_BOX && b->shape == PFSPH_SHAPE_BOX) return true;
     if (a->shape == PFSPH_SHAPE_SPHERE && b->shape == PFSPH_SHAPE_SPHERE) {
         double r2 = 0;
-        for (int k = 0; k < dim; k++)
-            r2 += (a->center[k] - b->center[k]) * (a->center[k] - b->center[k]);
+        for (int k = 0; k < dim; k++) r2 += (a->center[k] - b->center[k]) * (a->center[k] - b->center[k]);
         return sqrt(r2) < a->radius + b->radius - 2.0 * d;
     }
     if ((a->shape == PFSPH_SHAPE_BOX && b->shape == PFSPH_SHAPE_SPHERE) ||
@@ -260,8 +246,7 @@ static bool geo_overlap(const geo *a, const geo *b, double spacing)
         for (int j = 0; j <= n[1]; j++)
             for (int l = 0; l <= (dim == 3 ? n[2] : 0); l++) {
                 int idx[3] = {i, j, l};
-                for (int k = 0; k < dim; k++)
-                    x[k] = lo[k] + (hi[k] - lo[k]) * (double)idx[k] / (double)n[k];
+                for (int k = 0; k < dim; k++) x[k] = lo[k] + (hi[k] - lo[k]) * (double)idx[k] / (double)n[k];
                 if (geo_inside(a, x, d) && geo_inside(b, x, d)) return true;
             }
     return false;
@@ -289,8 +274,7 @@ static int parse_domain(parser *p, const cJSON *root)
     TRY(vecd(p, d, "$.domain", "max", -COORD_MAX, COORD_MAX, s->domain_max));
     for (int k = 0; k < s->dim; k++)
         if (!(s->domain_min[k] < s->domain_max[k]))
-            return pfsph__json_fail(&p->ctx, "$.domain",
-                                    "min[%d] = %g must be less than max[%d] = %g", k,
+            return pfsph__json_fail(&p->ctx, "$.domain", "min[%d] = %g must be less than max[%d] = %g", k,
                                     s->domain_min[k], k, s->domain_max[k]);
     return PFSPH_OK;
 }
@@ -300,9 +284,16 @@ static int parse_solver(parser *p, const cJSON *root)
     pfsph_scene *s = p->s;
     const cJSON *o = get(root, "solver");
     if (!o) return PFSPH_OK;
-    static const char *const keys[] = {"type", "tolerance", "min_iterations", "max_iterations",
-                                       "sound_speed", "gamma", "pressure_scale",
-                                       "divergence_tolerance", "divergence_max_iterations", NULL};
+    static const char *const keys[] = {"type",
+                                       "tolerance",
+                                       "min_iterations",
+                                       "max_iterations",
+                                       "sound_speed",
+                                       "gamma",
+                                       "pressure_scale",
+                                       "divergence_tolerance",
+                                       "divergence_max_iterations",
+                                       NULL};
     const char *P = "$.solver";
     TRY(pfsph__json_check_keys(o, P, keys, &p->ctx));
     TRY(json_enum(p, o, P, "type", solver_names, &s->solver));
@@ -319,8 +310,8 @@ static int parse_solver(parser *p, const cJSON *root)
     TRY(pfsph__json_int(o, P, "max_iterations", 1, 10000, &s->pcisph_max_iter, &p->ctx));
     if (s->pcisph_min_iter > s->pcisph_max_iter)
         return pfsph__json_fail(&p->ctx, "$.solver.min_iterations",
-                                "min_iterations (%d) is greater than max_iterations (%d)",
-                                s->pcisph_min_iter, s->pcisph_max_iter);
+                                "min_iterations (%d) is greater than max_iterations (%d)", s->pcisph_min_iter,
+                                s->pcisph_max_iter);
     TRY(pfsph__json_number(o, P, "sound_speed", 0.0, 1e5, &s->sound_speed, &p->ctx));
     TRY(pfsph__json_number(o, P, "gamma", 1.0, 10.0, &s->gamma, &p->ctx));
     TRY(json_enum(p, o, P, "pressure_scale", pressure_scale_names, &s->pressure_scale));
@@ -343,13 +334,13 @@ static int parse_time(parser *p, const cJSON *root)
     TRY(positive(p, o, P, "dt_min", 1.0, &s->dt_min));
     TRY(positive(p, o, P, "dt_max", 1.0, &s->dt_max));
     if (s->dt_min > s->dt_max)
-        return pfsph__json_fail(&p->ctx, "$.time.dt_min",
-                                "dt_min (%g s) is greater than dt_max (%g s)", s->dt_min,
+        return pfsph__json_fail(&p->ctx, "$.time.dt_min", "dt_min (%g s) is greater than dt_max (%g s)", s->dt_min,
                                 s->dt_max);
     if (s->end_time * s->fps > PFSPH_MAX_FRAMES)
         return pfsph__json_fail(&p->ctx, "$.time.end",
                                 "end %g s at %g fps makes %.3g frames, more than the %d one run "
-                                "holds", s->end_time, s->fps, s->end_time * s->fps, PFSPH_MAX_FRAMES);
+                                "holds",
+                                s->end_time, s->fps, s->end_time * s->fps, PFSPH_MAX_FRAMES);
     return PFSPH_OK;
 }
 
@@ -370,8 +361,7 @@ static int parse_phases(parser *p, const cJSON *root)
         memcpy(ph->color, palette[0], sizeof ph->color);
         return PFSPH_OK;
     }
-    static const char *const keys[] = {"name", "kind", "rest_density", "viscosity", "color",
-                                       "comment", NULL};
+    static const char *const keys[] = {"name", "kind", "rest_density", "viscosity", "color", "comment", NULL};
     int i = 0;
     for (const cJSON *e = arr->child; e; e = e->next, i++) {
         char P[128];
@@ -386,8 +376,7 @@ static int parse_phases(parser *p, const cJSON *root)
         if (!ph->name[0]) return pfsph__json_fail(&p->ctx, kp, "a phase name must not be empty");
         for (int j = 0; j < i; j++)
             if (strcmp(s->phases[j].name, ph->name) == 0)
-                return pfsph__json_fail(
-                    &p->ctx, kp, "duplicate phase name \"%s\" (also $.phases[%d])", ph->name, j);
+                return pfsph__json_fail(&p->ctx, kp, "duplicate phase name \"%s\" (also $.phases[%d])", ph->name, j);
         ph->kind = PFSPH_PHASE_FLUID;
         TRY(json_enum(p, e, P, "kind", kind_names, &ph->kind));
         /* Defaults by kind: water for liquids and walls, air for gas; viscosity see docs. */
@@ -414,24 +403,20 @@ static int phase_ref(parser *p, const cJSON *obj, const char *path, bool want_so
     char kp[160];
     path_key(kp, sizeof kp, path, "phase");
     if (!v) return PFSPH_OK;
-    if (!cJSON_IsString(v) || !v->valuestring)
-        return pfsph__json_fail(&p->ctx, kp, "expected a phase name (string)");
+    if (!cJSON_IsString(v) || !v->valuestring) return pfsph__json_fail(&p->ctx, kp, "expected a phase name (string)");
     int idx = pfsph_scene_phase_index(p->s, v->valuestring);
     if (idx < 0) {
         char list[400] = "";
         size_t n = 0;
         for (int i = 0; i < p->s->nphases; i++) {
-            int w = snprintf(list + n, sizeof list - n, "%s\"%s\"", i ? ", " : "",
-                             p->s->phases[i].name);
+            int w = snprintf(list + n, sizeof list - n, "%s\"%s\"", i ? ", " : "", p->s->phases[i].name);
             if (w > 0 && (size_t)w < sizeof list - n) n += (size_t)w;
         }
-        return pfsph__json_fail(&p->ctx, kp, "unknown phase \"%.64s\" (phases: %s)",
-                                v->valuestring, list);
+        return pfsph__json_fail(&p->ctx, kp, "unknown phase \"%.64s\" (phases: %s)", v->valuestring, list);
     }
     int kind = p->s->phases[idx].kind;
     if (want_solid && kind != PFSPH_PHASE_SOLID)
-        return pfsph__json_fail(&p->ctx, kp,
-                                "phase \"%s\" is a %s phase; solids need a phase of kind \"solid\"",
+        return pfsph__json_fail(&p->ctx, kp, "phase \"%s\" is a %s phase; solids need a phase of kind \"solid\"",
                                 p->s->phases[idx].name, kind_names[kind]);
     if (!want_solid && kind == PFSPH_PHASE_SOLID)
         return pfsph__json_fail(&p->ctx, kp,
@@ -443,8 +428,8 @@ static int phase_ref(parser *p, const cJSON *obj, const char *path, bool want_so
 }
 
 /* Shape-specific geometry keys shared by fluid blocks and solids. */
-static int parse_geometry(parser *p, const cJSON *e, const char *P, int shape, double *min,
-                          double *max, double *center, double *radius, double *height, int *axis)
+static int parse_geometry(parser *p, const cJSON *e, const char *P, int shape, double *min, double *max, double *center,
+                          double *radius, double *height, int *axis)
 {
     pfsph_scene *s = p->s;
     if (shape == PFSPH_SHAPE_BOX || shape == PFSPH_SHAPE_CONTAINER) {
@@ -456,9 +441,8 @@ static int parse_geometry(parser *p, const cJSON *e, const char *P, int shape, d
             if (!(min[k] < max[k])) {
                 char kp[160];
                 path_key(kp, sizeof kp, P, "max");
-                return pfsph__json_fail(&p->ctx, kp,
-                                        "max[%d] = %g must be greater than min[%d] = %g", k, max[k],
-                                        k, min[k]);
+                return pfsph__json_fail(&p->ctx, kp, "max[%d] = %g must be greater than min[%d] = %g", k, max[k], k,
+                                        min[k]);
             }
         return PFSPH_OK;
     }
@@ -474,8 +458,9 @@ static int parse_geometry(parser *p, const cJSON *e, const char *P, int shape, d
         TRY(axis_index(P, p, e, axis));
         path_key(kp, sizeof kp, P, "axis");
         if (*axis != 2)
-            return pfsph__json_fail(&p->ctx, kp, "in 2D a cylinder's axis must be \"z\" (it is a "
-                                                 "disc in the xy plane)");
+            return pfsph__json_fail(&p->ctx, kp,
+                                    "in 2D a cylinder's axis must be \"z\" (it is a "
+                                    "disc in the xy plane)");
         if (get(e, "height")) {
             path_key(kp, sizeof kp, P, "height");
             return pfsph__json_fail(&p->ctx, kp, "not used in 2D (a 2D cylinder is a disc)");
@@ -490,8 +475,8 @@ static int parse_geometry(parser *p, const cJSON *e, const char *P, int shape, d
     return PFSPH_OK;
 }
 
-static const char *const solid_shapes[] = {"box", "sphere", "cylinder", "container", "plane",
-                                           NULL}; /* enum pfsph_shape order */
+static const char *const solid_shapes[] = {"box",       "sphere", "cylinder",
+                                           "container", "plane",  NULL}; /* enum pfsph_shape order */
 static const char *const block_shapes[] = {"box", "sphere", "cylinder", NULL};
 
 static int parse_solids(parser *p, const cJSON *root)
@@ -503,32 +488,34 @@ static int parse_solids(parser *p, const cJSON *root)
     /* Default phase of a solid: the first solid phase, else one named "solid" made on demand. */
     int def = -1;
     for (int i = 0; i < s->nphases; i++)
-        if (s->phases[i].kind == PFSPH_PHASE_SOLID) { def = i; break; }
+        if (s->phases[i].kind == PFSPH_PHASE_SOLID) {
+            def = i;
+            break;
+        }
     int i = 0;
     for (const cJSON *e = arr->child; e; e = e->next, i++) {
         char P[128];
         path_index(P, sizeof P, "$.solids", i);
-        if (!cJSON_IsObject(e))
-            return pfsph__json_fail(&p->ctx, P, "expected an object");
+        if (!cJSON_IsObject(e)) return pfsph__json_fail(&p->ctx, P, "expected an object");
         TRY(require(p, e, P, "shape"));
         pfsph_solid *so = &s->solids[i];
         memset(so, 0, sizeof *so);
         TRY(json_enum(p, e, P, "shape", solid_shapes, &so->shape));
-        static const char *const k_box[] = {"shape", "phase", "layers", "slip", "viscosity", "min", "max", "comment",
-                                            NULL};
-        static const char *const k_cont[] = {"shape", "phase", "layers", "slip", "viscosity", "min", "max",
-                                             "open_top", "comment", NULL};
-        static const char *const k_sph[] = {"shape", "phase", "layers", "slip", "viscosity", "center", "radius",
-                                            "comment", NULL};
-        static const char *const k_cyl[] = {"shape", "phase", "layers", "slip", "viscosity", "center", "radius",
-                                            "height", "axis", "comment", NULL};
-        static const char *const k_plane[] = {"shape", "phase", "layers", "slip", "viscosity", "point", "normal",
-                                              "comment", NULL};
-        const char *const *keys = so->shape == PFSPH_SHAPE_BOX        ? k_box
-                                  : so->shape == PFSPH_SHAPE_CONTAINER ? k_cont
-                                  : so->shape == PFSPH_SHAPE_SPHERE    ? k_sph
-                                  : so->shape == PFSPH_SHAPE_CYLINDER  ? k_cyl
-                                                                       : k_plane;
+        static const char *const k_box[] = {"shape", "phase", "layers",  "slip", "viscosity",
+                                            "min",   "max",   "comment", NULL};
+        static const char *const k_cont[] = {"shape", "phase", "layers",   "slip",    "viscosity",
+                                             "min",   "max",   "open_top", "comment", NULL};
+        static const char *const k_sph[] = {"shape",  "phase",  "layers",  "slip", "viscosity",
+                                            "center", "radius", "comment", NULL};
+        static const char *const k_cyl[] = {"shape",  "phase",  "layers", "slip",    "viscosity", "center",
+                                            "radius", "height", "axis",   "comment", NULL};
+        static const char *const k_plane[] = {"shape", "phase",  "layers",  "slip", "viscosity",
+                                              "point", "normal", "comment", NULL};
+        const char *const *keys = so->shape == PFSPH_SHAPE_BOX ? k_box
+            : so->shape == PFSPH_SHAPE_CONTAINER               ? k_cont
+            : so->shape == PFSPH_SHAPE_SPHERE                  ? k_sph
+            : so->shape == PFSPH_SHAPE_CYLINDER                ? k_cyl
+                                                               : k_plane;
         TRY(pfsph__json_check_keys(e, P, keys, &p->ctx));
         so->layers = 2;
         TRY(pfsph__json_int(e, P, "layers", 1, 10, &so->layers, &p->ctx));
@@ -559,8 +546,7 @@ static int parse_solids(parser *p, const cJSON *root)
             /* Bounding box for the domain check: the point itself. */
             for (int k = 0; k < 3; k++) so->min[k] = so->max[k] = so->center[k];
         } else {
-            TRY(parse_geometry(p, e, P, so->shape, so->min, so->max, so->center, &so->radius,
-                               &so->height, &so->axis));
+            TRY(parse_geometry(p, e, P, so->shape, so->min, so->max, so->center, &so->radius, &so->height, &so->axis));
         }
         /* Phase. */
         if (get(e, "phase")) {
@@ -593,8 +579,8 @@ static int parse_solids(parser *p, const cJSON *root)
             so->phase = def;
         }
         /* A solid wholly outside the domain is certainly a mistake. */
-        geo g = geo_of(s->dim, so->shape == PFSPH_SHAPE_CONTAINER ? PFSPH_SHAPE_BOX : so->shape,
-                       so->min, so->max, so->center, so->radius, so->height, so->axis);
+        geo g = geo_of(s->dim, so->shape == PFSPH_SHAPE_CONTAINER ? PFSPH_SHAPE_BOX : so->shape, so->min, so->max,
+                       so->center, so->radius, so->height, so->axis);
         for (int k = 0; k < s->dim; k++)
             if (g.max[k] < s->domain_min[k] || g.min[k] > s->domain_max[k]) {
                 char a[96], b[96];
@@ -615,7 +601,8 @@ static int parse_bubble(parser *p, const cJSON *e, const char *P, int index, pfs
     char BP[160], kp[200];
     path_key(BP, sizeof BP, P, "bubble");
     const cJSON *o = get(e, "bubble");
-    if (!cJSON_IsObject(o)) return pfsph__json_fail(&p->ctx, BP, "expected an object {\"film\": phase, \"thickness\": m}");
+    if (!cJSON_IsObject(o))
+        return pfsph__json_fail(&p->ctx, BP, "expected an object {\"film\": phase, \"thickness\": m}");
     static const char *const keys[] = {"film", "thickness", "liquid_volume", "comment", NULL};
     TRY(pfsph__json_check_keys(o, BP, keys, &p->ctx));
     TRY(require(p, o, BP, "film"));
@@ -623,19 +610,23 @@ static int parse_bubble(parser *p, const cJSON *e, const char *P, int index, pfs
         return pfsph__json_fail(&p->ctx, BP, "too many bubbles (at most %d)", PFSPH_MAX_BUBBLES);
     path_key(kp, sizeof kp, P, "phase");
     if (s->phases[b->phase].kind != PFSPH_PHASE_GAS)
-        return pfsph__json_fail(&p->ctx, kp, "phase \"%s\" is a %s phase; a bubble's block is its gas: give a phase "
-                                "of kind \"gas\"", s->phases[b->phase].name, kind_names[s->phases[b->phase].kind]);
+        return pfsph__json_fail(&p->ctx, kp,
+                                "phase \"%s\" is a %s phase; a bubble's block is its gas: give a phase "
+                                "of kind \"gas\"",
+                                s->phases[b->phase].name, kind_names[s->phases[b->phase].kind]);
     char name[PFSPH_NAME_LEN];
     TRY(pfsph__json_string(o, BP, "film", name, sizeof name, &p->ctx));
     path_key(kp, sizeof kp, BP, "film");
     const int film = pfsph_scene_phase_index(s, name);
     if (film < 0) return pfsph__json_fail(&p->ctx, kp, "unknown phase \"%.64s\"", name);
     if (s->phases[film].kind != PFSPH_PHASE_FLUID)
-        return pfsph__json_fail(&p->ctx, kp, "phase \"%s\" is a %s phase; a film is a liquid (kind \"fluid\")",
-                                name, kind_names[s->phases[film].kind]);
+        return pfsph__json_fail(&p->ctx, kp, "phase \"%s\" is a %s phase; a film is a liquid (kind \"fluid\")", name,
+                                kind_names[s->phases[film].kind]);
     if (s->film.film[b->phase] >= 0 && s->film.film[b->phase] != film)
-        return pfsph__json_fail(&p->ctx, kp, "gas \"%s\" already has the film \"%s\" (one film liquid per gas "
-                                "phase)", s->phases[b->phase].name, s->phases[s->film.film[b->phase]].name);
+        return pfsph__json_fail(&p->ctx, kp,
+                                "gas \"%s\" already has the film \"%s\" (one film liquid per gas "
+                                "phase)",
+                                s->phases[b->phase].name, s->phases[s->film.film[b->phase]].name);
     const bool th = get(o, "thickness") != NULL, vol = get(o, "liquid_volume") != NULL;
     if (th == vol)
         return pfsph__json_fail(&p->ctx, BP, "give exactly one of \"thickness\" (m) and \"liquid_volume\" (m^%d)",
@@ -677,7 +668,10 @@ static int parse_fluid(parser *p, const cJSON *root)
     if (!arr) return PFSPH_OK;
     int def = -1;
     for (int i = 0; i < s->nphases; i++)
-        if (s->phases[i].kind != PFSPH_PHASE_SOLID) { def = i; break; }
+        if (s->phases[i].kind != PFSPH_PHASE_SOLID) {
+            def = i;
+            break;
+        }
     int i = 0;
     for (const cJSON *e = arr->child; e; e = e->next, i++) {
         char P[128];
@@ -687,18 +681,15 @@ static int parse_fluid(parser *p, const cJSON *root)
         pfsph_block *b = &s->blocks[i];
         memset(b, 0, sizeof *b);
         TRY(json_enum(p, e, P, "shape", block_shapes, &b->shape));
-        static const char *const k_box[] = {"shape", "phase", "velocity", "jitter", "min", "max",
-                                            "bubble", "comment", NULL};
-        static const char *const k_sph[] = {"shape", "phase", "velocity", "jitter", "center",
-                                            "radius", "bubble", "comment", NULL};
-        static const char *const k_cyl[] = {"shape", "phase", "velocity", "jitter", "center",
-                                            "radius", "height", "axis", "bubble", "comment", NULL};
-        const char *const *keys = b->shape == PFSPH_SHAPE_BOX      ? k_box
-                                  : b->shape == PFSPH_SHAPE_SPHERE ? k_sph
-                                                                   : k_cyl;
+        static const char *const k_box[] = {"shape", "phase",  "velocity", "jitter", "min",
+                                            "max",   "bubble", "comment",  NULL};
+        static const char *const k_sph[] = {"shape",  "phase",  "velocity", "jitter", "center",
+                                            "radius", "bubble", "comment",  NULL};
+        static const char *const k_cyl[] = {"shape",  "phase", "velocity", "jitter",  "center", "radius",
+                                            "height", "axis",  "bubble",   "comment", NULL};
+        const char *const *keys = b->shape == PFSPH_SHAPE_BOX ? k_box : b->shape == PFSPH_SHAPE_SPHERE ? k_sph : k_cyl;
         TRY(pfsph__json_check_keys(e, P, keys, &p->ctx));
-        TRY(parse_geometry(p, e, P, b->shape, b->min, b->max, b->center, &b->radius, &b->height,
-                           &b->axis));
+        TRY(parse_geometry(p, e, P, b->shape, b->min, b->max, b->center, &b->radius, &b->height, &b->axis));
         TRY(vecd(p, e, P, "velocity", -VEL_MAX, VEL_MAX, b->velocity));
         TRY(pfsph__json_number(e, P, "jitter", 0.0, 0.5, &b->jitter, &p->ctx));
         b->phase = def;
@@ -714,7 +705,10 @@ static int parse_fluid(parser *p, const cJSON *root)
          * the checks below). */
         geo g = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
         if (b->shape != PFSPH_SHAPE_BOX)
-            for (int k = 0; k < 3; k++) { b->min[k] = g.min[k]; b->max[k] = g.max[k]; }
+            for (int k = 0; k < 3; k++) {
+                b->min[k] = g.min[k];
+                b->max[k] = g.max[k];
+            }
     }
     s->nblocks = i;
     return PFSPH_OK;
@@ -736,12 +730,11 @@ static int check_blocks(parser *p)
             for (int k = 0; k < s->dim; k++)
                 if (b->max[k] - b->min[k] < sp - tiny) {
                     path_key(kp, sizeof kp, P, "max");
-                    return pfsph__json_fail(
-                        &p->ctx, kp,
-                        "block is %g m wide along %s, less than one particle "
-                        "spacing (%g m = 2 x particle_radius): it would hold no "
-                        "particle",
-                        b->max[k] - b->min[k], axis_names[k], sp);
+                    return pfsph__json_fail(&p->ctx, kp,
+                                            "block is %g m wide along %s, less than one particle "
+                                            "spacing (%g m = 2 x particle_radius): it would hold no "
+                                            "particle",
+                                            b->max[k] - b->min[k], axis_names[k], sp);
                 }
         } else {
             if (b->radius < sp - tiny) {
@@ -753,28 +746,24 @@ static int check_blocks(parser *p)
             }
             if (b->shape == PFSPH_SHAPE_CYLINDER && s->dim == 3 && b->height < sp - tiny) {
                 path_key(kp, sizeof kp, P, "height");
-                return pfsph__json_fail(&p->ctx, kp,
-                                        "height %g m is less than one particle spacing (%g m)",
-                                        b->height, sp);
+                return pfsph__json_fail(&p->ctx, kp, "height %g m is less than one particle spacing (%g m)", b->height,
+                                        sp);
             }
         }
         /* Inside the domain. */
         for (int k = 0; k < s->dim; k++) {
             double scale = fmax(1.0, fabs(s->domain_max[k] - s->domain_min[k]));
-            if (gb.min[k] < s->domain_min[k] - 1e-9 * scale ||
-                gb.max[k] > s->domain_max[k] + 1e-9 * scale) {
+            if (gb.min[k] < s->domain_min[k] - 1e-9 * scale || gb.max[k] > s->domain_max[k] + 1e-9 * scale) {
                 char a[96], c[96], lo[96], hi[96];
                 fmt_vec(a, sizeof a, s->dim, s->domain_min);
                 fmt_vec(c, sizeof c, s->dim, s->domain_max);
                 fmt_vec(lo, sizeof lo, s->dim, gb.min);
                 fmt_vec(hi, sizeof hi, s->dim, gb.max);
-                const char *key = b->shape != PFSPH_SHAPE_BOX
-                                      ? "center"
-                                      : (gb.min[k] < s->domain_min[k] ? "min" : "max");
+                const char *key =
+                    b->shape != PFSPH_SHAPE_BOX ? "center" : (gb.min[k] < s->domain_min[k] ? "min" : "max");
                 path_key(kp, sizeof kp, P, key);
-                return pfsph__json_fail(
-                    &p->ctx, kp, "block %s .. %s extends outside the domain %s .. %s along %s", lo,
-                    hi, a, c, axis_names[k]);
+                return pfsph__json_fail(&p->ctx, kp, "block %s .. %s extends outside the domain %s .. %s along %s", lo,
+                                        hi, a, c, axis_names[k]);
             }
         }
         /* Solids: obstacles must not start inside fluid; container walls must not cut blocks. */
@@ -792,19 +781,15 @@ static int check_blocks(parser *p)
                     if (!top && gb.max[k] > so->max[k] + 0.5 * sp) inside = false;
                 }
                 if (touches && !inside)
-                    return pfsph__json_fail(&p->ctx, P,
-                                            "block crosses the walls of the container $.solids[%d]",
-                                            j);
+                    return pfsph__json_fail(&p->ctx, P, "block crosses the walls of the container $.solids[%d]", j);
                 continue;
             }
-            geo g = geo_of(s->dim, so->shape, so->min, so->max, so->center, so->radius,
-                           so->height, so->axis);
+            geo g = geo_of(s->dim, so->shape, so->min, so->max, so->center, so->radius, so->height, so->axis);
             if (geo_overlap(&g, &gb, sp))
-                return pfsph__json_fail(
-                    &p->ctx, P,
-                    "overlaps the solid $.solids[%d]; fluid particles would start "
-                    "inside it",
-                    j);
+                return pfsph__json_fail(&p->ctx, P,
+                                        "overlaps the solid $.solids[%d]; fluid particles would start "
+                                        "inside it",
+                                        j);
         }
         /* Overlaps with later blocks are what carving is for (shapes.c); a block they cover
          * wholly adds nothing, which is an ordering mistake (a tank listed after its bubble). */
@@ -867,14 +852,13 @@ static int parse_output(parser *p, const cJSON *root)
     pfsph_output *o = &p->s->output;
     const cJSON *v = get(root, "output");
     if (!v) return PFSPH_OK;
-    static const char *const keys[] = {"directory", "formats", "fields", "boundary",
-                                       "frame_interval", "checkpoint_interval", "surface", NULL};
+    static const char *const keys[] = {"directory",           "formats", "fields", "boundary", "frame_interval",
+                                       "checkpoint_interval", "surface", NULL};
     const char *P = "$.output";
     TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
     TRY(parse_surface(p, get(v, "surface")));
     TRY(pfsph__json_string(v, P, "directory", o->dir, sizeof o->dir, &p->ctx));
-    if (get(v, "directory") && !o->dir[0])
-        return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
+    if (get(v, "directory") && !o->dir[0]) return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
     TRY(pfsph__json_bool(v, P, "boundary", &o->write_boundary, &p->ctx));
     TRY(pfsph__json_int(v, P, "frame_interval", 1, 1000000, &o->frame_interval, &p->ctx));
     TRY(pfsph__json_int(v, P, "checkpoint_interval", 0, 1000000, &o->checkpoint_interval, &p->ctx));
@@ -882,8 +866,7 @@ static int parse_output(parser *p, const cJSON *root)
     if (f) {
         static const char *const names[] = {"vtp", "ply", NULL};
         if (!cJSON_IsArray(f))
-            return pfsph__json_fail(&p->ctx, "$.output.formats",
-                                    "expected an array of strings (\"vtp\", \"ply\")");
+            return pfsph__json_fail(&p->ctx, "$.output.formats", "expected an array of strings (\"vtp\", \"ply\")");
         o->vtp = o->ply = false;
         int i = 0;
         for (const cJSON *e = f->child; e; e = e->next, i++) {
@@ -892,9 +875,7 @@ static int parse_output(parser *p, const cJSON *root)
             int idx = -1;
             for (int k = 0; names[k] && cJSON_IsString(e); k++)
                 if (strcmp(e->valuestring, names[k]) == 0) idx = k;
-            if (idx < 0)
-                return pfsph__json_fail(&p->ctx, ep,
-                                        "unknown format (expected \"vtp\" or \"ply\")");
+            if (idx < 0) return pfsph__json_fail(&p->ctx, ep, "unknown format (expected \"vtp\" or \"ply\")");
             if (idx == 0) o->vtp = true;
             else o->ply = true;
         }
@@ -904,8 +885,7 @@ static int parse_output(parser *p, const cJSON *root)
         static const char *const names[] = {"id", "speed", NULL};
         static const unsigned bits[] = {PFSPH_OUT_ID, PFSPH_OUT_SPEED};
         if (!cJSON_IsArray(fl))
-            return pfsph__json_fail(&p->ctx, "$.output.fields",
-                                    "expected an array of strings (\"id\", \"speed\")");
+            return pfsph__json_fail(&p->ctx, "$.output.fields", "expected an array of strings (\"id\", \"speed\")");
         o->fields = 0;
         int i = 0;
         for (const cJSON *e = fl->child; e; e = e->next, i++) {
@@ -914,9 +894,7 @@ static int parse_output(parser *p, const cJSON *root)
             int idx = -1;
             for (int k = 0; names[k] && cJSON_IsString(e); k++)
                 if (strcmp(e->valuestring, names[k]) == 0) idx = k;
-            if (idx < 0)
-                return pfsph__json_fail(&p->ctx, ep,
-                                        "unknown field (expected \"id\" or \"speed\")");
+            if (idx < 0) return pfsph__json_fail(&p->ctx, ep, "unknown field (expected \"id\" or \"speed\")");
             o->fields |= bits[idx];
         }
     }
@@ -928,8 +906,7 @@ static int parse_camera(parser *p, const cJSON *root)
     pfsph_camera *c = &p->s->camera;
     const cJSON *v = get(root, "camera");
     if (!v) return PFSPH_OK;
-    static const char *const keys[] = {"eye", "target", "up", "fov", "width", "height",
-                                       "color_by", NULL};
+    static const char *const keys[] = {"eye", "target", "up", "fov", "width", "height", "color_by", NULL};
     const char *P = "$.camera";
     TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
     c->set = true;
@@ -955,8 +932,7 @@ static int parse_camera(parser *p, const cJSON *root)
                     d[0] * c->up[1] - d[1] * c->up[0]};
     for (int k = 0; k < 3; k++) cr2 += cr[k] * cr[k];
     if (!(u2 > 0) || !(cr2 > 1e-12 * d2 * u2))
-        return pfsph__json_fail(&p->ctx, "$.camera.up",
-                                "up must be non-zero and not parallel to the view direction");
+        return pfsph__json_fail(&p->ctx, "$.camera.up", "up must be non-zero and not parallel to the view direction");
     return PFSPH_OK;
 }
 
@@ -992,8 +968,8 @@ static void source_stem(const char *source, char *out, size_t cap)
     size_t m = 0;
     for (size_t i = 0; i < n && m + 1 < cap; i++) {
         char ch = b[i];
-        bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
-                  (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' || ch == '.';
+        bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' ||
+            ch == '-' || ch == '.';
         if (ok) out[m++] = ch;
     }
     out[m] = 0;
@@ -1076,12 +1052,11 @@ int pfsph_scene_density_range(const pfsph_scene *s, double *lo, double *hi)
 static int parse_root(parser *p, const cJSON *root)
 {
     pfsph_scene *s = p->s;
-    static const char *const keys[] = {"name", "dimension", "particle_radius", "support_factor",
-                                       "gravity", "domain", "solver", "time", "seed", "threads",
-                                       "phases", "fluid", "solids", "bodies", "emitters", "pairwise", "diffuse",
-                                       "output", "camera", "comment", NULL};
-    if (!cJSON_IsObject(root))
-        return pfsph__json_fail(&p->ctx, "$", "a scene must be a JSON object { ... }");
+    static const char *const keys[] = {
+        "name",     "dimension", "particle_radius", "support_factor", "gravity", "domain",  "solver",
+        "time",     "seed",      "threads",         "phases",         "fluid",   "solids",  "bodies",
+        "emitters", "pairwise",  "diffuse",         "output",         "camera",  "comment", NULL};
+    if (!cJSON_IsObject(root)) return pfsph__json_fail(&p->ctx, "$", "a scene must be a JSON object { ... }");
     TRY(pfsph__json_check_keys(root, "$", keys, &p->ctx));
     /* Dimension first: it decides how many components every vector has. */
     const cJSON *dv = get(root, "dimension");
@@ -1092,14 +1067,12 @@ static int parse_root(parser *p, const cJSON *root)
     const cJSON *nv = get(root, "name");
     TRY(pfsph__json_string(root, "$", "name", s->name, sizeof s->name, &p->ctx));
     if (nv && !s->name[0]) return pfsph__json_fail(&p->ctx, "$.name", "must not be empty");
-    TRY(pfsph__json_number(root, "$", "particle_radius", 1e-5, 10.0, &s->particle_radius,
-                           &p->ctx));
+    TRY(pfsph__json_number(root, "$", "particle_radius", 1e-5, 10.0, &s->particle_radius, &p->ctx));
     TRY(pfsph__json_number(root, "$", "support_factor", 1.0, 4.0, &s->support_factor, &p->ctx));
     TRY(vecd(p, root, "$", "gravity", -GRAVITY_MAX, GRAVITY_MAX, s->gravity));
     double seed = (double)s->seed;
     TRY(pfsph__json_number(root, "$", "seed", 0.0, SEED_MAX, &seed, &p->ctx));
-    if (seed != floor(seed))
-        return pfsph__json_fail(&p->ctx, "$.seed", "expected an integer, got %g", seed);
+    if (seed != floor(seed)) return pfsph__json_fail(&p->ctx, "$.seed", "expected an integer, got %g", seed);
     s->seed = (uint64_t)seed;
     TRY(pfsph__json_int(root, "$", "threads", 0, 4096, &s->threads, &p->ctx));
     TRY(parse_domain(p, root));
@@ -1115,14 +1088,12 @@ static int parse_root(parser *p, const cJSON *root)
     /* Sub-parsers of other modules see every phase, the default solid phase included. */
     const cJSON *pw = get(root, "pairwise");
     if (pw) {
-        if (!cJSON_IsObject(pw))
-            return pfsph__json_fail(&p->ctx, "$.pairwise", "expected an object");
+        if (!cJSON_IsObject(pw)) return pfsph__json_fail(&p->ctx, "$.pairwise", "expected an object");
         TRY(pfsph__scene_parse_pairwise(pw, "$.pairwise", s, &p->ctx));
     }
     const cJSON *df = get(root, "diffuse");
     if (df) {
-        if (!cJSON_IsObject(df))
-            return pfsph__json_fail(&p->ctx, "$.diffuse", "expected an object");
+        if (!cJSON_IsObject(df)) return pfsph__json_fail(&p->ctx, "$.diffuse", "expected an object");
         TRY(pfsph__scene_parse_diffuse(df, "$.diffuse", s, &p->ctx));
     }
     auto_camera(s);
@@ -1137,8 +1108,10 @@ static void line_col(const char *text, const char *pos, int *line, int *col)
     *line = 1;
     *col = 1;
     for (const char *c = text; *c && c < pos; c++) {
-        if (*c == '\n') { (*line)++; *col = 1; }
-        else (*col)++;
+        if (*c == '\n') {
+            (*line)++;
+            *col = 1;
+        } else (*col)++;
     }
 }
 
@@ -1192,22 +1165,26 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
         }
         free(s);
         if (depth >= CJSON_NESTING_LIMIT)
-            return pfsph__json_fail(&ctx, "$", "JSON nested too deep: more than %d arrays and objects within "
-                                    "each other at line %d, column %d", CJSON_NESTING_LIMIT, line, col);
+            return pfsph__json_fail(&ctx, "$",
+                                    "JSON nested too deep: more than %d arrays and objects within "
+                                    "each other at line %d, column %d",
+                                    CJSON_NESTING_LIMIT, line, col);
         if (!*pos)
             return pfsph__json_fail(&ctx, "$",
                                     "invalid JSON: unexpected end of text at line %d, column %d "
                                     "(missing '}' or ']'?)",
                                     line, col);
-        return pfsph__json_fail(&ctx, "$", "invalid JSON at line %d, column %d, near \"%s\"", line,
-                                col, near);
+        return pfsph__json_fail(&ctx, "$", "invalid JSON at line %d, column %d, near \"%s\"", line, col, near);
     }
     parser p = {s, ctx};
     int rc = parse_root(&p, root);
     cJSON_Delete(root);
     if (rc == PFSPH_OK) {
         memcpy(out, s, sizeof *s);
-        if (err) { err->code = PFSPH_OK; err->msg[0] = 0; }
+        if (err) {
+            err->code = PFSPH_OK;
+            err->msg[0] = 0;
+        }
     }
     free(s);
     return rc;
@@ -1231,8 +1208,7 @@ int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err)
             if (size >= cap) {
                 free(buf);
                 fclose(f);
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "%s: $: file is larger than %zu MiB; not a scene", path,
+                return pfsph_fail(err, PFSPH_EINPUT, "%s: $: file is larger than %zu MiB; not a scene", path,
                                   cap >> 20);
             }
             char *nb = realloc(buf, size * 2);
@@ -1257,8 +1233,7 @@ int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err)
     buf[n] = 0;
     if (strlen(buf) != n) {
         free(buf);
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: $: file contains a NUL byte; not a JSON scene",
-                          path);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: $: file contains a NUL byte; not a JSON scene", path);
     }
     int rc = pfsph_scene_parse(s, buf, path, err);
     free(buf);

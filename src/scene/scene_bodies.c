@@ -13,8 +13,7 @@
 static const char *const shape_names[] = {"box", "sphere", "cylinder", "mesh", NULL};
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 
-static int enum_key(const cJSON *e, const char *P, const char *key, const char *const *names,
-                    int *out, pfsph_jctx *ctx)
+static int enum_key(const cJSON *e, const char *P, const char *key, const char *const *names, int *out, pfsph_jctx *ctx)
 {
     const cJSON *v = cJSON_GetObjectItemCaseSensitive(e, key);
     if (!v) return PFSPH_OK;
@@ -36,8 +35,8 @@ static int enum_key(const cJSON *e, const char *P, const char *key, const char *
 }
 
 /* A vector of dim components (z = 0 in 2D), or of 3 when `full`. */
-static int vec(const cJSON *e, const char *P, const char *key, int n, double lo, double hi,
-               double *out, pfsph_jctx *ctx)
+static int vec(const cJSON *e, const char *P, const char *key, int n, double lo, double hi, double *out,
+               pfsph_jctx *ctx)
 {
     if (!cJSON_GetObjectItemCaseSensitive(e, key)) return PFSPH_OK;
     int rc = pfsph__json_vec(e, P, key, n, lo, hi, out, ctx);
@@ -82,24 +81,20 @@ static int require(const cJSON *e, const char *P, const char *key, pfsph_jctx *c
 }
 
 /* The mesh path relative to the scene file's directory (absolute paths are kept). */
-static int resolve_mesh(const pfsph_scene *s, const char *P, const char *file, char *out,
-                        size_t cap, pfsph_jctx *ctx)
+static int resolve_mesh(const pfsph_scene *s, const char *P, const char *file, char *out, size_t cap, pfsph_jctx *ctx)
 {
     char kp[192];
     snprintf(kp, sizeof kp, "%s.file", P);
     if (!file[0]) return pfsph__json_fail(ctx, kp, "must not be empty");
     const char *slash = strrchr(s->source, '/');
     int w;
-    if (file[0] == '/' || !slash || s->source[0] == '<')
-        w = snprintf(out, cap, "%s", file);
-    else
-        w = snprintf(out, cap, "%.*s/%s", (int)(slash - s->source), s->source, file);
+    if (file[0] == '/' || !slash || s->source[0] == '<') w = snprintf(out, cap, "%s", file);
+    else w = snprintf(out, cap, "%.*s/%s", (int)(slash - s->source), s->source, file);
     if (w < 0 || (size_t)w >= cap) return pfsph__json_fail(ctx, kp, "path too long");
     return PFSPH_OK;
 }
 
-static int parse_keys(const cJSON *arr, const char *P, const pfsph_scene *s, pfsph_body_def *b,
-                      pfsph_jctx *ctx)
+static int parse_keys(const cJSON *arr, const char *P, const pfsph_scene *s, pfsph_body_def *b, pfsph_jctx *ctx)
 {
     const int dim = s->dim;
     char kp[192];
@@ -121,8 +116,7 @@ static int parse_keys(const cJSON *arr, const char *P, const pfsph_scene *s, pfs
         const pfsph_keyframe *prev = i ? &b->keys[i - 1] : NULL;
         memcpy(f->position, prev ? prev->position : b->position, sizeof f->position);
         memcpy(f->rotation, prev ? prev->rotation : b->rotation, sizeof f->rotation);
-        if ((rc = require(k, Q, "t", ctx)) ||
-            (rc = pfsph__json_number(k, Q, "t", 0, 1e9, &f->t, ctx)) ||
+        if ((rc = require(k, Q, "t", ctx)) || (rc = pfsph__json_number(k, Q, "t", 0, 1e9, &f->t, ctx)) ||
             (rc = vec(k, Q, "position", dim, -COORD_MAX, COORD_MAX, f->position, ctx)) ||
             (rc = rotation(k, Q, dim, f->rotation, ctx)))
             return rc;
@@ -130,7 +124,8 @@ static int parse_keys(const cJSON *arr, const char *P, const pfsph_scene *s, pfs
             if (f->position[a] < s->domain_min[a] || f->position[a] > s->domain_max[a]) {
                 char T[240];
                 snprintf(T, sizeof T, "%s.position", Q);
-                return pfsph__json_fail(ctx, T, "lies outside the domain (a body outside the grid loses its particles)");
+                return pfsph__json_fail(ctx, T,
+                                        "lies outside the domain (a body outside the grid loses its particles)");
             }
         if (prev && !(f->t > prev->t)) {
             char T[240];
@@ -150,16 +145,19 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
         return pfsph__json_fail(ctx, path, "too many bodies (%d, at most %d)", n, PFSPH_MAX_BODIES);
     int def = -1; /* default phase: the first solid phase */
     for (int i = 0; i < s->nphases; i++)
-        if (s->phases[i].kind == PFSPH_PHASE_SOLID) { def = i; break; }
+        if (s->phases[i].kind == PFSPH_PHASE_SOLID) {
+            def = i;
+            break;
+        }
     int i = 0;
     for (const cJSON *e = arr->child; e; e = e->next, i++) {
         char P[96];
         snprintf(P, sizeof P, "%s[%d]", path, i);
         if (!cJSON_IsObject(e)) return pfsph__json_fail(ctx, P, "expected an object");
         static const char *const keys[] = {
-            "name", "shape", "phase", "half_extents", "radius", "height", "axis", "file", "scale",
-            "position", "rotation", "velocity", "angular_velocity", "density", "mass", "inertia", "friction",
-            "restitution", "layers", "kinematic", "keyframes", "comment", NULL};
+            "name",     "shape",       "phase",    "half_extents", "radius",           "height",  "axis", "file",
+            "scale",    "position",    "rotation", "velocity",     "angular_velocity", "density", "mass", "inertia",
+            "friction", "restitution", "layers",   "kinematic",    "keyframes",        "comment", NULL};
         int rc;
         if ((rc = pfsph__json_check_keys(e, P, keys, ctx))) return rc;
         pfsph_body_def *b = &s->bodies[i];
@@ -169,8 +167,7 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
         b->friction = 0.5;
         b->layers = 2;
         b->axis = s->dim == 2 ? 2 : 1;
-        if ((rc = require(e, P, "shape", ctx)) ||
-            (rc = enum_key(e, P, "shape", shape_names, &b->shape, ctx)) ||
+        if ((rc = require(e, P, "shape", ctx)) || (rc = enum_key(e, P, "shape", shape_names, &b->shape, ctx)) ||
             (rc = pfsph__json_string(e, P, "name", b->name, sizeof b->name, ctx)) ||
             (rc = require(e, P, "position", ctx)) ||
             (rc = vec(e, P, "position", s->dim, -COORD_MAX, COORD_MAX, b->position, ctx)) ||
@@ -182,12 +179,14 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
             (rc = pfsph__json_bool(e, P, "kinematic", &b->kinematic, ctx)))
             return rc;
         for (const char *q = b->name; *q; q++)
-            if (!((*q >= 'a' && *q <= 'z') || (*q >= 'A' && *q <= 'Z') || (*q >= '0' && *q <= '9') ||
-                  *q == '_' || *q == '-' || *q == '.')) {
+            if (!((*q >= 'a' && *q <= 'z') || (*q >= 'A' && *q <= 'Z') || (*q >= '0' && *q <= '9') || *q == '_' ||
+                  *q == '-' || *q == '.')) {
                 char kp[128];
                 snprintf(kp, sizeof kp, "%s.name", P);
-                return pfsph__json_fail(ctx, kp, "\"%s\": use letters, digits, '_', '-' and '.' only "
-                                                 "(the name is a column of bodies.csv)", b->name);
+                return pfsph__json_fail(ctx, kp,
+                                        "\"%s\": use letters, digits, '_', '-' and '.' only "
+                                        "(the name is a column of bodies.csv)",
+                                        b->name);
             }
         for (int j = 0; j < i; j++)
             if (strcmp(s->bodies[j].name, b->name) == 0) {
@@ -198,8 +197,7 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
         if (s->dim == 2) {
             b->angular_velocity[0] = b->angular_velocity[1] = 0;
             rc = pfsph__json_number(e, P, "angular_velocity", -1e4, 1e4, &b->angular_velocity[2], ctx);
-        } else
-            rc = vec(e, P, "angular_velocity", 3, -1e4, 1e4, b->angular_velocity, ctx);
+        } else rc = vec(e, P, "angular_velocity", 3, -1e4, 1e4, b->angular_velocity, ctx);
         if (rc) return rc;
         char kp[192];
         switch (b->shape) {
@@ -215,15 +213,12 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
             if (s->dim == 2) b->half[2] = 0.5; /* unit depth: 2D masses are per metre */
             break;
         case PFSPH_BODY_SPHERE:
-            if ((rc = require(e, P, "radius", ctx)) || (rc = positive(e, P, "radius", &b->radius, ctx)))
-                return rc;
+            if ((rc = require(e, P, "radius", ctx)) || (rc = positive(e, P, "radius", &b->radius, ctx))) return rc;
             break;
         case PFSPH_BODY_CYLINDER:
-            if ((rc = require(e, P, "radius", ctx)) || (rc = positive(e, P, "radius", &b->radius, ctx)))
-                return rc;
+            if ((rc = require(e, P, "radius", ctx)) || (rc = positive(e, P, "radius", &b->radius, ctx))) return rc;
             if (s->dim == 3) {
-                if ((rc = require(e, P, "height", ctx)) ||
-                    (rc = positive(e, P, "height", &b->height, ctx)) ||
+                if ((rc = require(e, P, "height", ctx)) || (rc = positive(e, P, "height", &b->height, ctx)) ||
                     (rc = enum_key(e, P, "axis", axis_names, &b->axis, ctx)))
                     return rc;
             } else if (cJSON_GetObjectItemCaseSensitive(e, "height")) {
@@ -237,29 +232,29 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
                 return pfsph__json_fail(ctx, kp, "mesh bodies need a 3D scene");
             }
             char file[PFSPH_PATH_LEN] = "";
-            if ((rc = require(e, P, "file", ctx)) ||
-                (rc = pfsph__json_string(e, P, "file", file, sizeof file, ctx)) ||
+            if ((rc = require(e, P, "file", ctx)) || (rc = pfsph__json_string(e, P, "file", file, sizeof file, ctx)) ||
                 (rc = resolve_mesh(s, P, file, b->mesh, sizeof b->mesh, ctx)) ||
                 (rc = positive(e, P, "scale", &b->scale, ctx)))
                 return rc;
             break;
         }
         }
-        if ((rc = positive(e, P, "density", &b->density, ctx)) ||
-            (rc = positive(e, P, "mass", &b->mass, ctx)))
+        if ((rc = positive(e, P, "density", &b->density, ctx)) || (rc = positive(e, P, "mass", &b->mass, ctx)))
             return rc;
         if (cJSON_GetObjectItemCaseSensitive(e, "inertia")) {
             if (s->dim == 2) {
                 rc = positive(e, P, "inertia", &b->inertia[2], ctx);
             } else {
                 rc = pfsph__json_vec(e, P, "inertia", 3, 0, 1e12, b->inertia, ctx);
-                if (!rc && !(b->inertia[0] > 0 && b->inertia[1] > 0 && b->inertia[2] > 0 &&
-                             b->inertia[0] + b->inertia[1] >= b->inertia[2] &&
-                             b->inertia[1] + b->inertia[2] >= b->inertia[0] &&
-                             b->inertia[0] + b->inertia[2] >= b->inertia[1])) {
+                if (!rc &&
+                    !(b->inertia[0] > 0 && b->inertia[1] > 0 && b->inertia[2] > 0 &&
+                      b->inertia[0] + b->inertia[1] >= b->inertia[2] &&
+                      b->inertia[1] + b->inertia[2] >= b->inertia[0] &&
+                      b->inertia[0] + b->inertia[2] >= b->inertia[1])) {
                     snprintf(kp, sizeof kp, "%s.inertia", P);
-                    return pfsph__json_fail(ctx, kp, "principal moments must be > 0 and each at most the sum of "
-                                                     "the other two (a rigid body's)");
+                    return pfsph__json_fail(ctx, kp,
+                                            "principal moments must be > 0 and each at most the sum of "
+                                            "the other two (a rigid body's)");
                 }
             }
             if (rc) return rc;
@@ -275,13 +270,12 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
             int idx = cJSON_IsString(ph) && ph->valuestring ? pfsph_scene_phase_index(s, ph->valuestring) : -1;
             if (idx < 0) return pfsph__json_fail(ctx, kp, "expected the name of a phase of the scene");
             if (s->phases[idx].kind != PFSPH_PHASE_SOLID)
-                return pfsph__json_fail(ctx, kp, "phase \"%s\" is not a solid phase; bodies need a phase of kind \"solid\"",
+                return pfsph__json_fail(ctx, kp,
+                                        "phase \"%s\" is not a solid phase; bodies need a phase of kind \"solid\"",
                                         s->phases[idx].name);
             b->phase = idx;
-        } else if (def >= 0)
-            b->phase = def;
-        else
-            return pfsph__json_fail(ctx, kp, "the scene has no solid phase: add one to \"phases\" and name it here");
+        } else if (def >= 0) b->phase = def;
+        else return pfsph__json_fail(ctx, kp, "the scene has no solid phase: add one to \"phases\" and name it here");
         if (!(b->density > 0) && !(b->mass > 0)) b->density = s->phases[b->phase].rest_density;
         if (!(b->density > 0) && !(b->mass > 0))
             return pfsph__json_fail(ctx, P, "give \"density\" or \"mass\" (phase \"%s\" has no rest_density)",

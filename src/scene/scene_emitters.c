@@ -42,8 +42,8 @@ static int positive(const cJSON *e, const char *P, const char *key, double hi, d
 
 static int parse_one(const cJSON *e, const char *P, pfsph_scene *s, pfsph_emitter_params *m, pfsph_jctx *ctx)
 {
-    static const char *const keys[] = {"shape", "phase", "center", "direction", "radius", "size", "width",
-                                       "speed", "rate", "start", "stop", "bubble", "comment", NULL};
+    static const char *const keys[] = {"shape", "phase", "center", "direction", "radius", "size",    "width",
+                                       "speed", "rate",  "start",  "stop",      "bubble", "comment", NULL};
     int rc;
     char kp[192];
     if (!cJSON_IsObject(e)) return pfsph__json_fail(ctx, P, "expected an object");
@@ -76,8 +76,10 @@ static int parse_one(const cJSON *e, const char *P, pfsph_scene *s, pfsph_emitte
         int idx = pfsph_scene_phase_index(s, pv->valuestring);
         if (idx < 0) return pfsph__json_fail(ctx, kp, "unknown phase \"%.64s\"", pv->valuestring);
         if (s->phases[idx].kind == PFSPH_PHASE_SOLID)
-            return pfsph__json_fail(ctx, kp, "phase \"%s\" is a solid phase; an emitter needs a phase of kind "
-                                    "\"fluid\" or \"gas\"", s->phases[idx].name);
+            return pfsph__json_fail(ctx, kp,
+                                    "phase \"%s\" is a solid phase; an emitter needs a phase of kind "
+                                    "\"fluid\" or \"gas\"",
+                                    s->phases[idx].name);
         m->phase = idx;
     }
     /* bubble: the fluid block (index into $.fluid) of a bubble that the gas is blown into; its
@@ -99,9 +101,10 @@ static int parse_one(const cJSON *e, const char *P, pfsph_scene *s, pfsph_emitte
         const int gas = s->film.gas[b->bubble];
         if (!pv) m->phase = gas;
         else if (m->phase != gas)
-            return pfsph__json_fail(ctx, kp, "%d: the emitter's phase \"%s\" is not the gas \"%s\" of bubble "
-                                    "$.fluid[%d]; blow that gas (or leave \"phase\" out)", bi,
-                                    s->phases[m->phase].name, s->phases[gas].name, bi);
+            return pfsph__json_fail(ctx, kp,
+                                    "%d: the emitter's phase \"%s\" is not the gas \"%s\" of bubble "
+                                    "$.fluid[%d]; blow that gas (or leave \"phase\" out)",
+                                    bi, s->phases[m->phase].name, s->phases[gas].name, bi);
         m->bubble = b->bubble + 1;
     }
     if (m->phase < 0) return pfsph__json_fail(ctx, kp, "no fluid or gas phase is defined in $.phases");
@@ -111,8 +114,10 @@ static int parse_one(const cJSON *e, const char *P, pfsph_scene *s, pfsph_emitte
     for (int a = 0; a < s->dim; a++)
         if (!(m->center[a] > s->domain_min[a] && m->center[a] < s->domain_max[a])) {
             snprintf(kp, sizeof kp, "%s.center", P);
-            return pfsph__json_fail(ctx, kp, "the nozzle's centre lies outside the domain (component %d = %g, "
-                                    "domain %g .. %g)", a, m->center[a], s->domain_min[a], s->domain_max[a]);
+            return pfsph__json_fail(ctx, kp,
+                                    "the nozzle's centre lies outside the domain (component %d = %g, "
+                                    "domain %g .. %g)",
+                                    a, m->center[a], s->domain_min[a], s->domain_max[a]);
         }
     if ((rc = pfsph__json_vec(e, P, "direction", s->dim, -1e6, 1e6, m->direction, ctx))) return rc;
     double n2 = 0, big = 0;
@@ -156,9 +161,10 @@ static int parse_one(const cJSON *e, const char *P, pfsph_scene *s, pfsph_emitte
     bool hs = has(e, "speed"), hr = has(e, "rate");
     if (hs == hr) {
         snprintf(kp, sizeof kp, "%s.%s", P, hs ? "rate" : "speed");
-        return pfsph__json_fail(ctx, kp, hs ? "give \"speed\" or \"rate\", not both (the rate follows from the speed "
-                                              "and the nozzle's lattice sites, and the other way round)"
-                                            : "missing required key \"speed\" (m/s) or \"rate\" (volume per second)");
+        return pfsph__json_fail(ctx, kp,
+                                hs ? "give \"speed\" or \"rate\", not both (the rate follows from the speed "
+                                     "and the nozzle's lattice sites, and the other way round)"
+                                   : "missing required key \"speed\" (m/s) or \"rate\" (volume per second)");
     }
     if (hs && (rc = positive(e, P, "speed", SPEED_MAX, &m->speed, ctx))) return rc;
     if (hr && (rc = positive(e, P, "rate", RATE_MAX, &m->rate, ctx))) return rc;

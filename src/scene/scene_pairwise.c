@@ -8,8 +8,8 @@
 
 #include "scene/json_util.h"
 
-#define C_MAX 1e30       /* coefficient: any finite value >= 0 (units depend on the scale) */
-#define SIGMA_MAX 1e6    /* N/m */
+#define C_MAX 1e30    /* coefficient: any finite value >= 0 (units depend on the scale) */
+#define SIGMA_MAX 1e6 /* N/m */
 
 static const char *const center_names[] = {"particle", "mean", NULL}; /* enum order */
 
@@ -30,21 +30,18 @@ static int parse_entry(const cJSON *e, const char *path, pfsph_scene *s, pfsph_j
     for (const cJSON *n = ph->child; n; n = n->next, i++) {
         char np[620];
         snprintf(np, sizeof np, "%s[%d]", pph, i);
-        if (!cJSON_IsString(n) || !n->valuestring)
-            return pfsph__json_fail(ctx, np, "expected a phase name (string)");
+        if (!cJSON_IsString(n) || !n->valuestring) return pfsph__json_fail(ctx, np, "expected a phase name (string)");
         idx[i] = pfsph_scene_phase_index(s, n->valuestring);
         if (idx[i] < 0) {
             char list[400];
             size_t len = 0;
             list[0] = 0;
             for (int a = 0; a < s->nphases && len + 1 < sizeof list; a++) {
-                int w = snprintf(list + len, sizeof list - len, "%s\"%s\"", a ? ", " : "",
-                                 s->phases[a].name);
+                int w = snprintf(list + len, sizeof list - len, "%s\"%s\"", a ? ", " : "", s->phases[a].name);
                 if (w < 0) break;
                 len += (size_t)w;
             }
-            return pfsph__json_fail(ctx, np, "unknown phase \"%s\" (phases: %s)", n->valuestring,
-                                    list);
+            return pfsph__json_fail(ctx, np, "unknown phase \"%s\" (phases: %s)", n->valuestring, list);
         }
     }
     int a = idx[0] < idx[1] ? idx[0] : idx[1], b = idx[0] < idx[1] ? idx[1] : idx[0];
@@ -52,11 +49,10 @@ static int parse_entry(const cJSON *e, const char *path, pfsph_scene *s, pfsph_j
     const bool has_s = cJSON_GetObjectItemCaseSensitive(e, "sigma") != NULL;
     const bool has_t = cJSON_GetObjectItemCaseSensitive(e, "contact_angle") != NULL;
     if ((int)has_c + (int)has_s + (int)has_t != 1)
-        return pfsph__json_fail(ctx, path,
-                                "give exactly one of \"c\", \"sigma\", \"contact_angle\"");
+        return pfsph__json_fail(ctx, path, "give exactly one of \"c\", \"sigma\", \"contact_angle\"");
     if (pp->c_set[a][b] || pp->sigma_set[a][b] || pp->angle_set[a][b])
-        return pfsph__json_fail(ctx, path, "phases \"%s\" and \"%s\" are already given",
-                                s->phases[a].name, s->phases[b].name);
+        return pfsph__json_fail(ctx, path, "phases \"%s\" and \"%s\" are already given", s->phases[a].name,
+                                s->phases[b].name);
     const bool sa = s->phases[a].kind == PFSPH_PHASE_SOLID;
     const bool sb = s->phases[b].kind == PFSPH_PHASE_SOLID;
     if (has_c) {
@@ -92,12 +88,12 @@ static int parse_entry(const cJSON *e, const char *path, pfsph_scene *s, pfsph_j
     return PFSPH_OK;
 }
 
-int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene *s,
-                                pfsph_jctx *ctx)
+int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene *s, pfsph_jctx *ctx)
 {
-    static const char *const keys[] = {"enabled", "k", "filter", "eta", "eps_min", "center",
-                                       "shifting", "thermostat", "viscosity_correction", "coefficients",
-                                       "comment", NULL};
+    static const char *const keys[] = {"enabled",      "k",          "filter",
+                                       "eta",          "eps_min",    "center",
+                                       "shifting",     "thermostat", "viscosity_correction",
+                                       "coefficients", "comment",    NULL};
     pfsph_pairwise_params *pp = &s->pairwise;
     int rc = pfsph__json_check_keys(node, path, keys, ctx);
     if (rc) return rc;
@@ -117,27 +113,20 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
         if (cJSON_IsString(cv) && cv->valuestring)
             for (int i = 0; center_names[i]; i++)
                 if (strcmp(cv->valuestring, center_names[i]) == 0) found = i;
-        if (found < 0)
-            return pfsph__json_fail(ctx, kp, "expected \"particle\" or \"mean\"");
+        if (found < 0) return pfsph__json_fail(ctx, kp, "expected \"particle\" or \"mean\"");
         pp->center = found;
     }
     const cJSON *sh = cJSON_GetObjectItemCaseSensitive(node, "shifting");
     if (sh) {
-        static const char *const skeys[] = {"diffusivity", "speed_factor", "surface",
-                                            "max_step", "comment", NULL};
+        static const char *const skeys[] = {"diffusivity", "speed_factor", "surface", "max_step", "comment", NULL};
         char sp[600];
         snprintf(sp, sizeof sp, "%s.shifting", path);
-        if (!cJSON_IsObject(sh))
-            return pfsph__json_fail(ctx, sp, "expected an object {\"diffusivity\": D, ...}");
+        if (!cJSON_IsObject(sh)) return pfsph__json_fail(ctx, sp, "expected an object {\"diffusivity\": D, ...}");
         if ((rc = pfsph__json_check_keys(sh, sp, skeys, ctx))) return rc;
-        if ((rc = pfsph__json_number(sh, sp, "diffusivity", 0.0, 10.0, &pp->shift.D, ctx)))
-            return rc;
-        if ((rc = pfsph__json_number(sh, sp, "speed_factor", 0.0, 100.0, &pp->shift.A, ctx)))
-            return rc;
-        if ((rc = pfsph__json_number(sh, sp, "surface", 0.0, 1.0, &pp->shift.surface, ctx)))
-            return rc;
-        if ((rc = pfsph__json_number(sh, sp, "max_step", 0.0, 0.25, &pp->shift.max_frac, ctx)))
-            return rc;
+        if ((rc = pfsph__json_number(sh, sp, "diffusivity", 0.0, 10.0, &pp->shift.D, ctx))) return rc;
+        if ((rc = pfsph__json_number(sh, sp, "speed_factor", 0.0, 100.0, &pp->shift.A, ctx))) return rc;
+        if ((rc = pfsph__json_number(sh, sp, "surface", 0.0, 1.0, &pp->shift.surface, ctx))) return rc;
+        if ((rc = pfsph__json_number(sh, sp, "max_step", 0.0, 0.25, &pp->shift.max_frac, ctx))) return rc;
     }
     const cJSON *th = cJSON_GetObjectItemCaseSensitive(node, "thermostat");
     if (th) {
@@ -152,8 +141,7 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
             if ((rc = pfsph__json_check_keys(th, tp, tkeys, ctx))) return rc;
             if ((rc = pfsph__json_bool(th, tp, "enabled", &pp->thermo.enabled, ctx))) return rc;
             if ((rc = pfsph__json_number(th, tp, "kT", 0.0, 1e6, &pp->thermo.kT, ctx))) return rc;
-            if ((rc = pfsph__json_number(th, tp, "reduced_temperature", 0.0, 10.0,
-                                         &pp->thermo.reduced, ctx)))
+            if ((rc = pfsph__json_number(th, tp, "reduced_temperature", 0.0, 10.0, &pp->thermo.reduced, ctx)))
                 return rc;
             if (cJSON_GetObjectItemCaseSensitive(th, "kT") &&
                 cJSON_GetObjectItemCaseSensitive(th, "reduced_temperature")) {
@@ -167,8 +155,7 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
     if (co) {
         char cp[600];
         snprintf(cp, sizeof cp, "%s.coefficients", path);
-        if (!cJSON_IsArray(co))
-            return pfsph__json_fail(ctx, cp, "expected an array of {\"phases\": [a, b], ...}");
+        if (!cJSON_IsArray(co)) return pfsph__json_fail(ctx, cp, "expected an array of {\"phases\": [a, b], ...}");
         int i = 0;
         for (const cJSON *e = co->child; e; e = e->next, i++) {
             char ep[620];
@@ -181,8 +168,6 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
 
 /* ---- targets -> coefficients, once the spacing and h are known ---- */
 
-
-
 pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h)
 {
     if (!s->pairwise.enabled) return 0;
@@ -193,8 +178,7 @@ static bool is_solid(const pfsph_scene *s, int a) { return s->phases[a].kind == 
 
 /* Steps 1-3 of the conversion: targets -> coefficients with the tension constant lam_t (Eq. 13's
  * lambda times the factor of the tension at temperature). Coefficients the scene gave are kept. */
-static int convert_targets(pfsph_scene *s, double lam_t, double theta, const double *rho,
-                           pfsph_error *err)
+static int convert_targets(pfsph_scene *s, double lam_t, double theta, const double *rho, pfsph_error *err)
 {
     pfsph_pairwise_params *pp = &s->pairwise;
     const int np = s->nphases;
@@ -226,8 +210,8 @@ static int convert_targets(pfsph_scene *s, double lam_t, double theta, const dou
                                   "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
                                   "more than their cohesions give with c = 0 (at most %g N/m); "
                                   "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
-                                  pp->sigma[a][b], s->phases[a].name, s->phases[b].name,
-                                  lam_t * self, s->phases[a].name, s->phases[b].name);
+                                  pp->sigma[a][b], s->phases[a].name, s->phases[b].name, lam_t * self,
+                                  s->phases[a].name, s->phases[b].name);
             pp->c[a][b] = pp->c[b][a] = cab > 0 ? cab : 0.0;
         }
     /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. It is
@@ -255,8 +239,8 @@ static int convert_targets(pfsph_scene *s, double lam_t, double theta, const dou
                                   "(boundary particle mass)",
                                   s->phases[so].name);
             /* Eq. 21's ratio, or at temperature the measured one (pfsph_pairwise_angle_ratio) */
-            double cw = pfsph_pairwise_angle_ratio(s->dim, theta, pp->angle_deg[a][b]) *
-                        pp->c[fl][fl] * rho[fl] / rho[so];
+            double cw =
+                pfsph_pairwise_angle_ratio(s->dim, theta, pp->angle_deg[a][b]) * pp->c[fl][fl] * rho[fl] / rho[so];
             if (cw < 0) cw = 0; /* cos(180 deg) rounding */
             pp->c[a][b] = pp->c[b][a] = cw;
         }
@@ -269,8 +253,7 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
     pp->resolved = false;
     if (!pp->enabled) return PFSPH_OK;
     if (!(spacing > 0) || !(h > 0) || !(pp->k >= 1.0))
-        return pfsph_fail(err, PFSPH_EINPUT,
-                          "pairwise: need spacing > 0, h > 0 and k >= 1 (got %g, %g, %g)",
+        return pfsph_fail(err, PFSPH_EINPUT, "pairwise: need spacing > 0, h > 0 and k >= 1 (got %g, %g, %g)",
                           (double)spacing, (double)h, pp->k);
     const int np = s->nphases;
     const double R = pp->k * (double)h;
@@ -298,8 +281,8 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
                 if (sg > tp->sigma_ref) tp->sigma_ref = sg, tp->rho_ref = rho[a];
             }
         const double tn = !tp->enabled ? 0.0
-                          : tp->kT >= 0 ? (tp->sigma_ref > 0 ? tp->kT / (tp->sigma_ref * dd) : 0.0)
-                                        : tp->reduced;
+            : tp->kT >= 0              ? (tp->sigma_ref > 0 ? tp->kT / (tp->sigma_ref * dd) : 0.0)
+                                       : tp->reduced;
         const double fn = pfsph_pairwise_sigma_factor(s->dim, tn);
         const bool done = fabs(fn - f) <= 1e-12 * fn && fabs(tn - theta) <= 1e-12 * tn;
         f = fn;
@@ -322,8 +305,7 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
     /* Thermostat: kT = reduced * sigma_ref * d^(dim-1), sigma_ref the largest (Eq. 13)
      * liquid-air tension of the table (docs/thermostat.md). */
     tp->kT_resolved = 0;
-    if (tp->enabled)
-        tp->kT_resolved = tp->kT >= 0 ? tp->kT : tp->reduced * tp->sigma_ref * dd;
+    if (tp->enabled) tp->kT_resolved = tp->kT >= 0 ? tp->kT : tp->reduced * tp->sigma_ref * dd;
     /* The hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid"):
      * nu_eff = nu_struct + gain nu_morris, nu_struct = g(theta_a) sqrt(sigma_a d / rho_a) with
      * sigma_a the phase's own tension at temperature and theta_a its reduced temperature. */
@@ -341,8 +323,7 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
         const double nu0 = sqrt(sg * (double)spacing / rho[a]);
         pp->nu_struct[a] = g * nu0;
         pp->nu_floor[a] = PFSPH_VISC_FLOOR * nu0;
-        if (pp->visc_correct)
-            pp->nu_morris[a] = fmax((nu - pp->nu_struct[a]) / PFSPH_VISC_GAIN, pp->nu_floor[a]);
+        if (pp->visc_correct) pp->nu_morris[a] = fmax((nu - pp->nu_struct[a]) / PFSPH_VISC_GAIN, pp->nu_floor[a]);
     }
     pp->resolved = true;
     return PFSPH_OK;
@@ -365,42 +346,46 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
     }
     fprintf(out, "  thermostat on: kT = %.4g %s", tp->kT_resolved, unit);
     if (tp->sigma_ref > 0)
-        fprintf(out, " = %.4g sigma d^%d (sigma = %.4g N/m, Eq. 13 of the coefficients)", tp->kT_resolved /
-                (tp->sigma_ref * pow(d, s->dim - 1)), s->dim - 1, tp->sigma_ref);
+        fprintf(out, " = %.4g sigma d^%d (sigma = %.4g N/m, Eq. 13 of the coefficients)",
+                tp->kT_resolved / (tp->sigma_ref * pow(d, s->dim - 1)), s->dim - 1, tp->sigma_ref);
     fprintf(out, "\n");
     for (int a = 0; a < s->nphases; a++) {
         if (is_solid(s, a)) continue;
         double m = s->phases[a].rest_density * V, nu = s->phases[a].viscosity;
         double h = s->support_factor * d;
         double ts = tp->rho_ref > 0 && s->phases[a].rest_density > 0 ? s->phases[a].rest_density / tp->rho_ref : 1;
-        fprintf(out, "    %s: kT x %.3g, thermal speed sqrt(kT/m) = %.3g m/s per component", s->phases[a].name,
-                ts, sqrt(ts * tp->kT_resolved / m));
+        fprintf(out, "    %s: kT x %.3g, thermal speed sqrt(kT/m) = %.3g m/s per component", s->phases[a].name, ts,
+                sqrt(ts * tp->kT_resolved / m));
         /* relaxation time of a particle's velocity against its neighbours' friction, about
          * h^2 / (2 (d + 2) nu) for the cubic spline (docs/thermostat.md) */
         const pfsph_pairwise_params *pp = &s->pairwise;
         const double num = pp->nu_morris[a];
-        if (num > 0)
-            fprintf(out, ", velocity relaxation ~%.3g s\n", h * h / (2.0 * (s->dim + 2) * num));
-        else
-            fprintf(out, "; viscosity 0: no friction, so no noise either (set a viscosity)\n");
+        if (num > 0) fprintf(out, ", velocity relaxation ~%.3g s\n", h * h / (2.0 * (s->dim + 2) * num));
+        else fprintf(out, "; viscosity 0: no friction, so no noise either (set a viscosity)\n");
         /* the hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid") */
         if (!(pp->nu_struct[a] > 0)) {
             if (pp->visc_correct)
-                fprintf(out, "      viscosity_correction: no measured table for %dD at this temperature; "
-                        "the viscosity is applied as set\n", s->dim);
+                fprintf(out,
+                        "      viscosity_correction: no measured table for %dD at this temperature; "
+                        "the viscosity is applied as set\n",
+                        s->dim);
             continue;
         }
         const double reach = pp->nu_struct[a] + PFSPH_VISC_GAIN * pp->nu_floor[a];
         if (!pp->visc_correct) {
-            fprintf(out, "      viscosity %.4g m^2/s set; the hot liquid is expected to flow as ~%.3g "
+            fprintf(out,
+                    "      viscosity %.4g m^2/s set; the hot liquid is expected to flow as ~%.3g "
                     "(structural %.3g + %.3g x the set one; `viscosity_correction` makes it the set one)\n",
                     nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
             continue;
         }
-        fprintf(out, "      viscosity %.4g m^2/s set: Morris viscosity %.4g applied (structural %.3g, "
-                "gain %.3g, floor %.3g)\n", nu, num, pp->nu_struct[a], PFSPH_VISC_GAIN, pp->nu_floor[a]);
+        fprintf(out,
+                "      viscosity %.4g m^2/s set: Morris viscosity %.4g applied (structural %.3g, "
+                "gain %.3g, floor %.3g)\n",
+                nu, num, pp->nu_struct[a], PFSPH_VISC_GAIN, pp->nu_floor[a]);
         if (nu < reach)
-            fprintf(out, "      warning: %s's viscosity %.4g m^2/s is below what the hot liquid reaches "
+            fprintf(out,
+                    "      warning: %s's viscosity %.4g m^2/s is below what the hot liquid reaches "
                     "(~%.3g m^2/s at this temperature, spacing and tension); it will flow as ~%.3g\n",
                     s->phases[a].name, nu, reach, reach);
     }
@@ -415,20 +400,18 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
     }
     const int np = s->nphases;
     fprintf(out, "pairwise forces: k = %.4g", pp->k);
-    if (pp->resolved) fprintf(out, ", radius k*h = %.4g m, lambda = %.4g m^%d", pp->radius,
-                              pp->lambda, s->dim + 2);
+    if (pp->resolved) fprintf(out, ", radius k*h = %.4g m, lambda = %.4g m^%d", pp->radius, pp->lambda, s->dim + 2);
     if (pp->filter && pp->eta > 0)
-        fprintf(out, "\n  anisotropic filter on: eta = %g, eps_min = %g, centre = %s\n", pp->eta,
-                pp->eps_min, pp->center == PFSPH_PW_CENTER_MEAN ? "mean" : "particle");
-    else
-        fprintf(out, "\n  anisotropic filter off (momentum conserved exactly)\n");
+        fprintf(out, "\n  anisotropic filter on: eta = %g, eps_min = %g, centre = %s\n", pp->eta, pp->eps_min,
+                pp->center == PFSPH_PW_CENTER_MEAN ? "mean" : "particle");
+    else fprintf(out, "\n  anisotropic filter off (momentum conserved exactly)\n");
     if (pp->shift.D > 0 || pp->shift.A > 0)
-        fprintf(out, "  particle shifting on: diffusivity %g m^2/s, speed factor %g, surface %g, "
-                "max step %g d\n", pp->shift.D, pp->shift.A, pp->shift.surface,
-                pp->shift.max_frac);
+        fprintf(out,
+                "  particle shifting on: diffusivity %g m^2/s, speed factor %g, surface %g, "
+                "max step %g d\n",
+                pp->shift.D, pp->shift.A, pp->shift.surface, pp->shift.max_frac);
     thermo_report(s, out);
-    fprintf(out, "  coefficients c[a][b] (%s):\n  %-14s", s->dim == 2 ? "N m/kg^2, 2D" : "N/kg^2",
-            "");
+    fprintf(out, "  coefficients c[a][b] (%s):\n  %-14s", s->dim == 2 ? "N m/kg^2, 2D" : "N/kg^2", "");
     for (int b = 0; b < np; b++) fprintf(out, " %12.12s", s->phases[b].name);
     fprintf(out, "\n");
     for (int a = 0; a < np; a++) {
@@ -439,32 +422,35 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
     for (int a = 0; a < np; a++)
         for (int b = a; b < np; b++) {
             if (pp->sigma_set[a][b])
-                fprintf(out, "  target: sigma(%s, %s) = %g N/m -> c = %.6g\n", s->phases[a].name,
-                        s->phases[b].name, pp->sigma[a][b], pp->c[a][b]);
+                fprintf(out, "  target: sigma(%s, %s) = %g N/m -> c = %.6g\n", s->phases[a].name, s->phases[b].name,
+                        pp->sigma[a][b], pp->c[a][b]);
             if (pp->angle_set[a][b])
-                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (%s)\n",
-                        s->phases[a].name, s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b],
-                        pfsph_pairwise_angle_measured(s->dim, pp->theta) ? "table at temperature"
-                                                                          : "Eq. 21");
+                fprintf(out, "  target: contact angle(%s, %s) = %g deg -> c = %.6g (%s)\n", s->phases[a].name,
+                        s->phases[b].name, pp->angle_deg[a][b], pp->c[a][b],
+                        pfsph_pairwise_angle_measured(s->dim, pp->theta) ? "table at temperature" : "Eq. 21");
         }
     if (!pp->resolved) return;
     /* what the liquid is expected to do at its temperature: Eq. 13's tension times the
      * measured factor f(theta) (docs/thermostat.md) */
     double lam = pp->lambda * pp->sigma_factor;
     if (!s->pairwise.thermo.enabled)
-        fprintf(out, "  expected tensions: Eq. 13 (thermostat off: the liquid freezes, and a frozen "
+        fprintf(out,
+                "  expected tensions: Eq. 13 (thermostat off: the liquid freezes, and a frozen "
                 "drop's Laplace pressure reads 0.76-0.88 of it)\n");
     else
-        fprintf(out, "  expected tensions at theta = %.4g: Eq. 13 x %.3f (measured %dD factor at "
-                "temperature, docs/thermostat.md)%s\n", pp->theta, pp->sigma_factor, s->dim,
+        fprintf(out,
+                "  expected tensions at theta = %.4g: Eq. 13 x %.3f (measured %dD factor at "
+                "temperature, docs/thermostat.md)%s\n",
+                pp->theta, pp->sigma_factor, s->dim,
                 pp->theta > pfsph_pairwise_sigma_theta_max(s->dim) ? "; theta beyond the measured table: "
-                "its last value is used" : "");
+                                                                     "its last value is used"
+                                                                   : "");
     for (int a = 0; a < np; a++) {
         if (s->phases[a].kind == PFSPH_PHASE_SOLID) continue;
         double ra = s->phases[a].rest_density;
         if (pp->c[a][a] > 0)
-            fprintf(out, "  predicted: sigma(%s, air) = %.5g N/m (Eq. 16 with c_air = 0)\n",
-                    s->phases[a].name, lam * pp->c[a][a] * ra * ra);
+            fprintf(out, "  predicted: sigma(%s, air) = %.5g N/m (Eq. 16 with c_air = 0)\n", s->phases[a].name,
+                    lam * pp->c[a][a] * ra * ra);
         for (int b = a + 1; b < np; b++) {
             double rb = s->phases[b].rest_density;
             if (s->phases[b].kind == PFSPH_PHASE_SOLID) {
@@ -472,19 +458,16 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
                 const double r = pp->c[a][b] * rb / (pp->c[a][a] * ra);
                 const bool table = pfsph_pairwise_angle_measured(s->dim, pp->theta);
                 const double ang = pfsph_pairwise_angle_expected(s->dim, pp->theta, r);
-                const char *note = !table && r > 1 ? " (complete wetting)"
-                                   : table && r > pfsph_pairwise_angle_ratio_max(s->dim)
-                                       ? " (beyond the measured table: extrapolated)" : "";
-                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (%s)\n",
-                        s->phases[a].name, s->phases[b].name, ang, note,
-                        table ? "measured at temperature, docs/pairwise.md" : "Eq. 21");
+                const char *note = !table && r > 1                        ? " (complete wetting)"
+                    : table && r > pfsph_pairwise_angle_ratio_max(s->dim) ? " (beyond the measured table: extrapolated)"
+                                                                          : "";
+                fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (%s)\n", s->phases[a].name,
+                        s->phases[b].name, ang, note, table ? "measured at temperature, docs/pairwise.md" : "Eq. 21");
             } else {
-                double sg = lam * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb -
-                                   2.0 * pp->c[a][b] * ra * rb);
+                double sg = lam * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb - 2.0 * pp->c[a][b] * ra * rb);
                 if (pp->c[a][a] > 0 || pp->c[b][b] > 0 || pp->c[a][b] > 0)
-                    fprintf(out, "  predicted: sigma(%s, %s) = %.5g N/m (Eq. 13)%s\n",
-                            s->phases[a].name, s->phases[b].name, sg,
-                            sg < 0 ? " -- negative: the fluids mix" : "");
+                    fprintf(out, "  predicted: sigma(%s, %s) = %.5g N/m (Eq. 13)%s\n", s->phases[a].name,
+                            s->phases[b].name, sg, sg < 0 ? " -- negative: the fluids mix" : "");
             }
         }
     }

@@ -10,14 +10,14 @@
 
 static const double PI = 3.14159265358979323846;
 
-static int emit(pfsph_particles *ps, long *count, double x, double y, double z,
-                const double *v, int phase)
+static int emit(pfsph_particles *ps, long *count, double x, double y, double z, const double *v, int phase)
 {
     (*count)++;
     if (!ps) return 0;
     pfsph_real p[3] = {(pfsph_real)x, (pfsph_real)y, (pfsph_real)z};
     pfsph_real vv[3] = {0, 0, 0};
-    if (v) for (int a = 0; a < 3; a++) vv[a] = (pfsph_real)v[a];
+    if (v)
+        for (int a = 0; a < 3; a++) vv[a] = (pfsph_real)v[a];
     return pfsph_particles_push(ps, p, vv, (uint8_t)phase) < 0 ? -1 : 0;
 }
 
@@ -40,8 +40,7 @@ static int inside_block(const pfsph_block *b, int dim, const double p[3])
         for (int a = 0; a < 3; a++)
             if (a != b->axis) r2 += (p[a] - b->center[a]) * (p[a] - b->center[a]);
         return r2 <= b->radius * b->radius && fabs(p[b->axis] - b->center[b->axis]) <= 0.5 * b->height;
-    default:
-        return 0;
+    default: return 0;
     }
 }
 
@@ -173,7 +172,7 @@ static long sample(const pfsph_scene *s, const pfsph_block *b, uint32_t stream, 
     for (int a = 0; a < 3; a++)
         if (k1[a] <= k0[a]) return 0;
     /* the later blocks that can take a site of b, with their ranges */
-    long (*lr)[6] = nlater ? malloc((size_t)nlater * sizeof *lr) : NULL;
+    long(*lr)[6] = nlater ? malloc((size_t)nlater * sizeof *lr) : NULL;
     const pfsph_block **lb = nlater ? malloc((size_t)nlater * sizeof *lb) : NULL;
     if (nlater && (!lr || !lb)) {
         free(lr);
@@ -299,8 +298,8 @@ static void basis(const double n[3], double t1[3], double t2[3])
 }
 
 /* Points on a sphere of radius r (3D: Fibonacci lattice, 2D: circle) at spacing ~d. */
-static int sample_sphere_layer(pfsph_particles *ps, long *count, const double c[3], double r,
-                               double d, int dim, int phase)
+static int sample_sphere_layer(pfsph_particles *ps, long *count, const double c[3], double r, double d, int dim,
+                               int phase)
 {
     if (r <= 0) return 0;
     if (dim == 2) {
@@ -317,14 +316,12 @@ static int sample_sphere_layer(pfsph_particles *ps, long *count, const double c[
     const double ga = PI * (3 - sqrt(5.0));
     for (long i = 0; i < m; i++) {
         double y = 1 - 2 * ((double)i + 0.5) / (double)m, rr = sqrt(1 - y * y), t = ga * (double)i;
-        if (emit(ps, count, c[0] + r * rr * cos(t), c[1] + r * y, c[2] + r * rr * sin(t), NULL, phase))
-            return -1;
+        if (emit(ps, count, c[0] + r * rr * cos(t), c[1] + r * y, c[2] + r * rr * sin(t), NULL, phase)) return -1;
     }
     return 0;
 }
 
-long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
-                         pfsph_particles *ps)
+long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d, pfsph_particles *ps)
 {
     const int dim = s->dim, L = o->layers < 1 ? 1 : o->layers;
     long count = 0;
@@ -362,14 +359,12 @@ long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
                         long dd = idx[a] < n[a] - 1 - idx[a] ? idx[a] : n[a] - 1 - idx[a];
                         if (container) {
                             if (idx[a] < 0 || idx[a] >= n[a]) in_shell = 1;
-                        } else if (dd < depth)
-                            depth = dd;
+                        } else if (dd < depth) depth = dd;
                     }
                     if (container) {
                         if (!in_shell) continue;
                         if (o->open_top && j >= n[1]) continue;
-                    } else if (depth >= L)
-                        continue;
+                    } else if (depth >= L) continue;
                     double p[3] = {0, 0, 0};
                     for (int a = 0; a < dim; a++) {
                         double w = (o->max[a] - o->min[a]) / (double)n[a];
@@ -381,14 +376,12 @@ long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
     }
     case PFSPH_SHAPE_SPHERE:
         for (int l = 0; l < L; l++)
-            if (sample_sphere_layer(ps, &count, o->center, o->radius - (l + 0.5) * d, d, dim, o->phase))
-                return -1;
+            if (sample_sphere_layer(ps, &count, o->center, o->radius - (l + 0.5) * d, d, dim, o->phase)) return -1;
         return count;
     case PFSPH_SHAPE_CYLINDER: {
         if (dim == 2) {
             for (int l = 0; l < L; l++)
-                if (sample_sphere_layer(ps, &count, o->center, o->radius - (l + 0.5) * d, d, 2, o->phase))
-                    return -1;
+                if (sample_sphere_layer(ps, &count, o->center, o->radius - (l + 0.5) * d, d, 2, o->phase)) return -1;
             return count;
         }
         int ax = o->axis, u = (ax + 1) % 3, v = (ax + 2) % 3;
@@ -441,8 +434,7 @@ long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
         if (dim == 2) {
             t1[0] = -nrm[1], t1[1] = nrm[0], t1[2] = 0;
             t2[0] = t2[1] = t2[2] = 0;
-        } else
-            basis(nrm, t1, t2);
+        } else basis(nrm, t1, t2);
         /* extent: the domain's diagonal around the plane point, clipped to the domain */
         double diag = 0;
         for (int a = 0; a < dim; a++)
@@ -455,8 +447,7 @@ long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
                 for (long i = -m; i <= m; i++) {
                     double p[3];
                     for (int a = 0; a < 3; a++)
-                        p[a] = o->center[a] + ((double)i * t1[a] + (double)j * t2[a]) * d -
-                               (l + 0.5) * d * nrm[a];
+                        p[a] = o->center[a] + ((double)i * t1[a] + (double)j * t2[a]) * d - (l + 0.5) * d * nrm[a];
                     int in = 1;
                     for (int a = 0; a < dim; a++)
                         if (p[a] < s->domain_min[a] - L * d || p[a] > s->domain_max[a] + L * d) in = 0;
@@ -466,8 +457,7 @@ long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
                 }
         return count;
     }
-    default:
-        return 0;
+    default: return 0;
     }
 }
 
@@ -524,7 +514,6 @@ double pfsph__solid_distance(const pfsph_solid *o, int dim, double d, const doub
         for (int a = 0; a < dim; a++) s += (p[a] - o->center[a]) * o->normal[a] / ln;
         return s;
     }
-    default:
-        return INFINITY;
+    default: return INFINITY;
     }
 }

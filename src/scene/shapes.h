@@ -8,8 +8,7 @@
 /* Append the fluid particles of block b alone on the scene lattice of spacing d (sites at
  * (k + 1/2) d along every axis; shapes.c). ps may be NULL to only count. Returns the count or
  * -1 (out of memory). */
-long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d,
-                         pfsph_particles *ps);
+long pfsph__sample_block(const pfsph_scene *s, const pfsph_block *b, double d, pfsph_particles *ps);
 /* The same for s->blocks[i] as the scene makes it: less the sites that later blocks contain
  * (a later block replaces what earlier ones put where they overlap). */
 long pfsph__sample_scene_block(const pfsph_scene *s, int i, double d, pfsph_particles *ps);
@@ -18,8 +17,7 @@ long pfsph__sample_scene_block(const pfsph_scene *s, int i, double d, pfsph_part
 int pfsph__scene_block_covered(const pfsph_scene *s, int i, double d);
 /* Append the boundary particles of a solid (its `layers` layers at spacing d, the first layer
  * centred d/2 inside the solid surface). ps may be NULL to only count. */
-long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d,
-                         pfsph_particles *ps);
+long pfsph__sample_solid(const pfsph_scene *s, const pfsph_solid *o, double d, pfsph_particles *ps);
 /* Signed distance from p to the solid's surface, positive on the fluid side (d: the particle
  * spacing, which sets the thickness of container walls). */
 double pfsph__solid_distance(const pfsph_solid *o, int dim, double d, const double p[3]);

@@ -27,7 +27,7 @@ struct pfsph_vdraw {
     float view[16], proj[16];
     int ortho, walls3d;
     double f;
-    float *ov;        /* overlay vertices: x, y, r, g, b, a */
+    float *ov; /* overlay vertices: x, y, r, g, b, a */
     size_t nov, ovcap;
 };
 
@@ -79,18 +79,17 @@ static const char *SPRITE_FS =
 
 /* Meshes: the liquid shaded as render.c's shade_water, bodies as its shade_solid, both on the
  * normal in camera coordinates (x right, y up, z towards the viewer) as the renderer has it. */
-static const char *MESH_VS =
-    "#version 330 core\n"
-    "layout(location = 0) in vec3 pos;\n"
-    "layout(location = 1) in vec3 nrm;\n"
-    "layout(location = 2) in vec3 col;\n"
-    "uniform mat4 view, proj;\n"
-    "out vec3 vn;\n"
-    "out vec3 vcol;\n"
-    "void main() {\n"
-    "  vn = mat3(view) * nrm; vcol = col;\n"
-    "  gl_Position = proj * (view * vec4(pos, 1.0));\n"
-    "}\n";
+static const char *MESH_VS = "#version 330 core\n"
+                             "layout(location = 0) in vec3 pos;\n"
+                             "layout(location = 1) in vec3 nrm;\n"
+                             "layout(location = 2) in vec3 col;\n"
+                             "uniform mat4 view, proj;\n"
+                             "out vec3 vn;\n"
+                             "out vec3 vcol;\n"
+                             "void main() {\n"
+                             "  vn = mat3(view) * nrm; vcol = col;\n"
+                             "  gl_Position = proj * (view * vec4(pos, 1.0));\n"
+                             "}\n";
 
 static const char *MESH_FS =
     "#version 330 core\n"
@@ -115,55 +114,51 @@ static const char *MESH_FS =
     "  }\n"
     "}\n";
 
-static const char *COMP_VS =
-    "#version 330 core\n"
-    "void main() {\n"
-    "  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);\n"
-    "  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
-    "}\n";
+static const char *COMP_VS = "#version 330 core\n"
+                             "void main() {\n"
+                             "  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);\n"
+                             "  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
+                             "}\n";
 
-static const char *COMP_FS =
-    "#version 330 core\n"
-    "uniform sampler2D c0, z0, c1, z1;\n"
-    "uniform float afront, aback;\n"
-    "uniform int height, ss;\n"
-    "out vec4 o;\n"
-    "void main() {\n"
-    "  vec3 acc = vec3(0.0);\n"
-    /* each output pixel averages ss x ss samples, each composited as the renderer does */
-    "  for (int sy = 0; sy < ss; sy++)\n"
-    "    for (int sx = 0; sx < ss; sx++) {\n"
-    "      ivec2 p = ivec2(gl_FragCoord.xy) * ss + ivec2(sx, sy);\n"
-    "      vec4 f = texelFetch(c0, p, 0), b = texelFetch(c1, p, 0);\n"
-    "      float t = height > 1 ? float(height - 1 - p.y) / float(height - 1) : 0.0;\n"
-    "      vec3 bg = mix(vec3(0.945, 0.950, 0.965), vec3(0.840, 0.850, 0.875), t);\n"
-    "      vec3 c = f.a > 0.5 ? f.rgb : bg;\n"
-    "      if (b.a > 0.5) {\n"
-    "        float zf = texelFetch(z0, p, 0).r, zb = texelFetch(z1, p, 0).r;\n"
-    "        float a = f.a < 0.5 ? aback : (zb < zf ? afront : 0.0);\n"
-    "        c = mix(c, b.rgb, a);\n"
-    "      }\n"
-    "      acc += c;\n"
-    "    }\n"
-    "  o = vec4(acc / float(ss * ss), 1.0);\n"
-    "}\n";
+static const char *COMP_FS = "#version 330 core\n"
+                             "uniform sampler2D c0, z0, c1, z1;\n"
+                             "uniform float afront, aback;\n"
+                             "uniform int height, ss;\n"
+                             "out vec4 o;\n"
+                             "void main() {\n"
+                             "  vec3 acc = vec3(0.0);\n"
+                             /* each output pixel averages ss x ss samples, each composited as the renderer does */
+                             "  for (int sy = 0; sy < ss; sy++)\n"
+                             "    for (int sx = 0; sx < ss; sx++) {\n"
+                             "      ivec2 p = ivec2(gl_FragCoord.xy) * ss + ivec2(sx, sy);\n"
+                             "      vec4 f = texelFetch(c0, p, 0), b = texelFetch(c1, p, 0);\n"
+                             "      float t = height > 1 ? float(height - 1 - p.y) / float(height - 1) : 0.0;\n"
+                             "      vec3 bg = mix(vec3(0.945, 0.950, 0.965), vec3(0.840, 0.850, 0.875), t);\n"
+                             "      vec3 c = f.a > 0.5 ? f.rgb : bg;\n"
+                             "      if (b.a > 0.5) {\n"
+                             "        float zf = texelFetch(z0, p, 0).r, zb = texelFetch(z1, p, 0).r;\n"
+                             "        float a = f.a < 0.5 ? aback : (zb < zf ? afront : 0.0);\n"
+                             "        c = mix(c, b.rgb, a);\n"
+                             "      }\n"
+                             "      acc += c;\n"
+                             "    }\n"
+                             "  o = vec4(acc / float(ss * ss), 1.0);\n"
+                             "}\n";
 
-static const char *OVER_VS =
-    "#version 330 core\n"
-    "layout(location = 0) in vec2 p;\n"
-    "layout(location = 1) in vec4 col;\n"
-    "uniform vec2 size;\n"
-    "out vec4 vcol;\n"
-    "void main() {\n"
-    "  vcol = col;\n"
-    "  gl_Position = vec4(2.0 * p.x / size.x - 1.0, 1.0 - 2.0 * p.y / size.y, 0.0, 1.0);\n"
-    "}\n";
+static const char *OVER_VS = "#version 330 core\n"
+                             "layout(location = 0) in vec2 p;\n"
+                             "layout(location = 1) in vec4 col;\n"
+                             "uniform vec2 size;\n"
+                             "out vec4 vcol;\n"
+                             "void main() {\n"
+                             "  vcol = col;\n"
+                             "  gl_Position = vec4(2.0 * p.x / size.x - 1.0, 1.0 - 2.0 * p.y / size.y, 0.0, 1.0);\n"
+                             "}\n";
 
-static const char *OVER_FS =
-    "#version 330 core\n"
-    "in vec4 vcol;\n"
-    "out vec4 o;\n"
-    "void main() { o = vcol; }\n";
+static const char *OVER_FS = "#version 330 core\n"
+                             "in vec4 vcol;\n"
+                             "out vec4 o;\n"
+                             "void main() { o = vcol; }\n";
 
 static GLuint compile(GLenum type, const char *src, char *msg, size_t cap)
 {
@@ -327,8 +322,8 @@ int pfsph_vdraw_software(void)
     return r && (strstr(r, "llvmpipe") || strstr(r, "softpipe") || strstr(r, "swrast") || strstr(r, "Software"));
 }
 
-void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const float proj[16],
-                       int ortho, double f, int walls3d)
+void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const float proj[16], int ortho, double f,
+                       int walls3d)
 {
     if (w != d->w || h != d->h) make_targets(d, w, h);
     memcpy(d->view, view, sizeof d->view);
@@ -487,8 +482,10 @@ void pfsph_vdraw_rect(pfsph_vdraw *d, float x, float y, float w, float h, const 
 
 void pfsph_viridis(double t, float out[3])
 {
-    static const float st[5][3] = {{0.267f, 0.005f, 0.329f}, {0.229f, 0.322f, 0.546f},
-                                   {0.128f, 0.567f, 0.551f}, {0.369f, 0.789f, 0.383f},
+    static const float st[5][3] = {{0.267f, 0.005f, 0.329f},
+                                   {0.229f, 0.322f, 0.546f},
+                                   {0.128f, 0.567f, 0.551f},
+                                   {0.369f, 0.789f, 0.383f},
                                    {0.993f, 0.906f, 0.144f}};
     if (!(t > 0)) t = 0;
     if (t > 1) t = 1;
@@ -516,24 +513,20 @@ static const struct glyph {
     char c;
     const char *rows; /* 5 rows of 3, '#' lit */
 } FONT[] = {
-    {'0', "####.##.##.####"}, {'1', ".#.##..#..#.###"}, {'2', "###..#####..###"},
-    {'3', "###..#.##..####"}, {'4', "#.##.####..#..#"}, {'5', "####..###..####"},
-    {'6', "####..####.####"}, {'7', "###..#..#.#..#."}, {'8', "####.#####.####"},
-    {'9', "####.####..####"}, {'A', ".#.#.#####.##.#"},  {'B', "##.#.###.#.###."},
-    {'C', ".###..#..#...##"}, {'D', "##.#.##.##.###."}, {'E', "####..##.#..###"},
-    {'F', "####..##.#..#.."}, {'G', ".###..#.##.#.##"}, {'H', "#.##.#####.##.#"},
-    {'I', "###.#..#..#.###"}, {'J', "..#..#..##.#.#."}, {'K', "#.##.###.#.##.#"},
-    {'L', "#..#..#..#..###"}, {'M', "#.#####.##.##.#"}, {'N', "##.#.##.##.##.#"},
-    {'O', ".#.#.##.##.#.#."}, {'P', "##.#.###.#..#.."}, {'Q', ".#.#.##.###..##"},
-    {'R', "##.#.###.#.##.#"}, {'S', ".###...#...###."}, {'T', "###.#..#..#..#."},
-    {'U', "#.##.##.##.####"}, {'V', "#.##.##.##.#.#."}, {'W', "#.##.########.#"},
-    {'X', "#.##.#.#.#.##.#"}, {'Y', "#.##.#.#..#..#."}, {'Z', "###..#.#.#..###"},
-    {'.', "............#.."}, {'-', "......###......"}, {'=', "...###...###..."},
-    {'/', "..#..#.#.#..#.."}, {':', "....#.....#...."}, {'%', "#.#..#.#.#..#.#"},
-    {',', ".........#.#..."}, {'(', ".#.#..#..#...#."}, {')', ".#...#..#..#.#."},
-    {'+', "....#.###.#...."}, {'[', "##.#..#..#..##."}, {']', ".##..#..#..#.##"},
-    {'_', "............###"}, {'>', "#...#...#.#.#.."}, {'<', "..#.#.#...#...#"},
-    {'*', "....#.#.#.#...."}, {'^', ".#.#.#........."}, {'\'', ".#..#.........."},
+    {'0', "####.##.##.####"}, {'1', ".#.##..#..#.###"},  {'2', "###..#####..###"}, {'3', "###..#.##..####"},
+    {'4', "#.##.####..#..#"}, {'5', "####..###..####"},  {'6', "####..####.####"}, {'7', "###..#..#.#..#."},
+    {'8', "####.#####.####"}, {'9', "####.####..####"},  {'A', ".#.#.#####.##.#"}, {'B', "##.#.###.#.###."},
+    {'C', ".###..#..#...##"}, {'D', "##.#.##.##.###."},  {'E', "####..##.#..###"}, {'F', "####..##.#..#.."},
+    {'G', ".###..#.##.#.##"}, {'H', "#.##.#####.##.#"},  {'I', "###.#..#..#.###"}, {'J', "..#..#..##.#.#."},
+    {'K', "#.##.###.#.##.#"}, {'L', "#..#..#..#..###"},  {'M', "#.#####.##.##.#"}, {'N', "##.#.##.##.##.#"},
+    {'O', ".#.#.##.##.#.#."}, {'P', "##.#.###.#..#.."},  {'Q', ".#.#.##.###..##"}, {'R', "##.#.###.#.##.#"},
+    {'S', ".###...#...###."}, {'T', "###.#..#..#..#."},  {'U', "#.##.##.##.####"}, {'V', "#.##.##.##.#.#."},
+    {'W', "#.##.########.#"}, {'X', "#.##.#.#.#.##.#"},  {'Y', "#.##.#.#..#..#."}, {'Z', "###..#.#.#..###"},
+    {'.', "............#.."}, {'-', "......###......"},  {'=', "...###...###..."}, {'/', "..#..#.#.#..#.."},
+    {':', "....#.....#...."}, {'%', "#.#..#.#.#..#.#"},  {',', ".........#.#..."}, {'(', ".#.#..#..#...#."},
+    {')', ".#...#..#..#.#."}, {'+', "....#.###.#...."},  {'[', "##.#..#..#..##."}, {']', ".##..#..#..#.##"},
+    {'_', "............###"}, {'>', "#...#...#.#.#.."},  {'<', "..#.#.#...#...#"}, {'*', "....#.#.#.#...."},
+    {'^', ".#.#.#........."}, {'\'', ".#..#.........."},
 };
 
 float pfsph_vdraw_text(pfsph_vdraw *d, float x, float y, float sc, const char *s, const float rgba[4])

@@ -29,8 +29,8 @@ int pfsph_vdraw_software(void);
 /* Start a frame of w x h pixels with these column-major matrices; f: pixels per metre at unit
  * distance (perspective) or everywhere (ortho), for the shading level of small discs; walls3d:
  * translucent, flat-shaded walls (3D) rather than walls behind the fluid (2D). */
-void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const float proj[16],
-                       int ortho, double f, int walls3d);
+void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const float proj[16], int ortho, double f,
+                       int walls3d);
 /* Draw n sprites into layer 0 (fluid, bodies, diffuse) or 1 (walls). */
 void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size_t n);
 /* A triangle mesh held by the GPU (one vertex buffer, and an index buffer when indexed). */

@@ -78,8 +78,8 @@ static const char *const BY_UNIT[BY_COUNT] = {"", "M/S", "KG/M3", "PA"};
 #define VIEW_MAX_BODIES 64
 typedef struct vframe {
     pfsph_particles fluid, walls, bodies, diffuse;
-    int nb;                                   /* rigid bodies (live), at most VIEW_MAX_BODIES */
-    double bx[VIEW_MAX_BODIES][3];            /* their centres */
+    int nb;                        /* rigid bodies (live), at most VIEW_MAX_BODIES */
+    double bx[VIEW_MAX_BODIES][3]; /* their centres */
     bool draggable[VIEW_MAX_BODIES];
     double time;
     uint64_t steps;
@@ -145,16 +145,16 @@ typedef struct live {
     const pfsph_scene *scene0; /* as loaded: what reset goes back to */
     pfsph_sim *sim;
     int threads;
-    vframe fr[3];              /* triple buffer: the worker's, the newest ready, the drawn one */
+    vframe fr[3]; /* triple buffer: the worker's, the newest ready, the drawn one */
     int iw, ir, idr;
-    bool fresh;                /* fr[ir] is newer than fr[idr] */
+    bool fresh; /* fr[ir] is newer than fr[idr] */
     bool quit, paused, step_once, reset, end_noted;
     vcmd cmd[MAX_CMDS];
     int ncmd;
     bool failed;
-    char msg[1200];            /* the last error or refusal, for the overlay */
-    double sps;                /* steps per second, over the last half second */
-    uint64_t published;        /* snapshots published */
+    char msg[1200];     /* the last error or refusal, for the overlay */
+    double sps;         /* steps per second, over the last half second */
+    uint64_t published; /* snapshots published */
 } live;
 
 /* Snapshot of the simulation into f (worker thread, no lock needed: f is the worker's). */
@@ -319,7 +319,7 @@ typedef struct replay {
     int cur;        /* index into fluid */
     int loaded_bnd; /* frame number of the boundary file in memory, -1 none */
     bool playing;
-    double next_t;  /* wall time of the next frame while playing */
+    double next_t; /* wall time of the next frame while playing */
 } replay;
 
 static int read_set(const char *dir, const char *prefix, int num, bool ply, pfsph_particles *ps, double *t,
@@ -388,17 +388,17 @@ typedef struct app {
     bool is_live;
     live L;
     replay R;
-    vframe rf;          /* replay: the frame shown */
+    vframe rf; /* replay: the frame shown */
     const vframe *shown;
     pfsph_vcam cam, cam0;
-    double depth;       /* scene extent, for the clip planes */
-    double vref;        /* speed colour scale */
+    double depth; /* scene extent, for the clip planes */
+    double vref;  /* speed colour scale */
     int by;
     bool show_walls, show_bodies, show_diffuse, show_help;
-    bool show_surface;  /* replay: meshes where the run has them (M toggles) */
-    bool cut_walls;     /* 3D: the walls facing the camera cut away (X toggles) */
+    bool show_surface;                  /* replay: meshes where the run has them (M toggles) */
+    bool cut_walls;                     /* 3D: the walls facing the camera cut away (X toggles) */
     pfsph_vmesh *gl_liquid, *gl_bodies; /* the shown frame's meshes on the GPU */
-    float *mv;          /* vertex staging for the uploads */
+    float *mv;                          /* vertex staging for the uploads */
     size_t mv_cap;
     int pair_a, pair_b; /* selected phase pair (live) */
     bool gravity_off;
@@ -407,21 +407,22 @@ typedef struct app {
     pfsph_vdraw *draw;
     pfsph_vsprite *spr;
     size_t spr_cap;
-    bool dirty;         /* redraw needed */
-    bool save_next;     /* S pressed: write the next frame drawn */
-    int saved;          /* screenshots written with S */
-    double mx, my;      /* cursor, framebuffer pixels */
+    bool dirty;     /* redraw needed */
+    bool save_next; /* S pressed: write the next frame drawn */
+    int saved;      /* screenshots written with S */
+    double mx, my;  /* cursor, framebuffer pixels */
     bool drag_l, drag_r, slider_drag;
-    int grab;           /* body dragged with ctrl + left button, -1 none */
+    int grab; /* body dragged with ctrl + left button, -1 none */
     double grab_depth;
-    double fps;         /* frames drawn per second, over the last half second */
+    double fps; /* frames drawn per second, over the last half second */
     int fb_w, fb_h;
 } app;
 
 static double field(const pfsph_particles *ps, size_t i, int by)
 {
     switch (by) {
-    case BY_SPEED: return sqrt((double)ps->vx[i] * ps->vx[i] + (double)ps->vy[i] * ps->vy[i] + (double)ps->vz[i] * ps->vz[i]);
+    case BY_SPEED:
+        return sqrt((double)ps->vx[i] * ps->vx[i] + (double)ps->vy[i] * ps->vy[i] + (double)ps->vz[i] * ps->vz[i]);
     case BY_DENSITY: return ps->rho[i];
     default: return ps->p[i];
     }
@@ -470,7 +471,8 @@ static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
     double g = sqrt(g2), lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < fluid->n; i++) {
         double h = -(fluid->x[i] * sc->gravity[0] + fluid->y[i] * sc->gravity[1] +
-                     (sc->dim == 3 ? fluid->z[i] * sc->gravity[2] : 0.0)) / g;
+                     (sc->dim == 3 ? fluid->z[i] * sc->gravity[2] : 0.0)) /
+            g;
         if (!isfinite(h)) continue;
         lo = fmin(lo, h);
         hi = fmax(hi, h);
@@ -481,8 +483,8 @@ static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
 static const float DIFFUSE_COL[3][3] = {{0.98f, 0.98f, 0.98f}, {0.80f, 0.82f, 0.85f}, {0.55f, 0.78f, 0.98f}};
 
 /* kind: 0 fluid, 1 walls, 2 diffuse, 3 bodies (as the renderer colours them) */
-static size_t add_sprites(app *A, size_t n0, const pfsph_particles *ps, double rad, double zoff, int kind,
-                          double lo, double hi, const pfsph_cutaway *cw)
+static size_t add_sprites(app *A, size_t n0, const pfsph_particles *ps, double rad, double zoff, int kind, double lo,
+                          double hi, const pfsph_cutaway *cw)
 {
     const pfsph_scene *sc = A->scene;
     if (n0 + ps->n > A->spr_cap) {
@@ -523,8 +525,7 @@ static size_t add_sprites(app *A, size_t n0, const pfsph_particles *ps, double r
     return m;
 }
 
-static const float INK[4] = {0.08f, 0.09f, 0.12f, 1}, PANEL[4] = {1, 1, 1, 0.72f},
-                   RED[4] = {0.75f, 0.1f, 0.1f, 1};
+static const float INK[4] = {0.08f, 0.09f, 0.12f, 1}, PANEL[4] = {1, 1, 1, 0.72f}, RED[4] = {0.75f, 0.1f, 0.1f, 1};
 
 static void panel_text(app *A, float x, float y, float sc, const char *s, const float col[4])
 {
@@ -572,8 +573,11 @@ static void overlay(app *A, double lo, double hi)
         pthread_mutex_unlock(&A->L.mu);
         char fps[32] = "";
         if (A->fps > 0) snprintf(fps, sizeof fps, "  %.0f FPS", A->fps); /* none yet in the first half second */
-        snprintf(line, sizeof line, "LIVE  T=%.4f S  STEP %llu  %.1f STEPS/S%s%s", f->time, (unsigned long long)f->steps,
-                 sps, fps, failed ? "  STOPPED" : paused ? "  PAUSED" : "");
+        snprintf(line, sizeof line, "LIVE  T=%.4f S  STEP %llu  %.1f STEPS/S%s%s", f->time,
+                 (unsigned long long)f->steps, sps, fps,
+                 failed       ? "  STOPPED"
+                     : paused ? "  PAUSED"
+                              : "");
         panel_text(A, 6 * s, y, s, line, INK);
         y += lh;
         snprintf(line, sizeof line, "G %.3g %.3g %.3g M/S2", g[0], g[1], g[2]);
@@ -968,7 +972,8 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
             A->grab_depth = bd;
         } else {
             pthread_mutex_lock(&A->L.mu);
-            snprintf(A->L.msg, sizeof A->L.msg, "ctrl + drag: no body near the cursor (bodies moved by keyframes cannot be dragged)");
+            snprintf(A->L.msg, sizeof A->L.msg,
+                     "ctrl + drag: no body near the cursor (bodies moved by keyframes cannot be dragged)");
             pthread_mutex_unlock(&A->L.mu);
             A->dirty = true;
         }
@@ -1057,7 +1062,8 @@ static int parse_opts(int argc, char **argv, opts *o)
             long n = v ? strtol(v, &end, 10) : -1;
             if (!v || *end || n < 0 || n > 100000000 || (!strcmp(a, "--frames") && n < 1) ||
                 (!strcmp(a, "--threads") && n > 1024))
-                return usage(!strcmp(a, "--threads") ? "--threads: '%s' is not 0..1024" : "'%s' is not a frame count or number",
+                return usage(!strcmp(a, "--threads") ? "--threads: '%s' is not 0..1024"
+                                                     : "'%s' is not a frame count or number",
                              v ? v : "");
             if (!strcmp(a, "--frame")) o->frame = (int)n;
             else if (!strcmp(a, "--frames")) o->frames = (int)n;
@@ -1071,7 +1077,8 @@ static int parse_opts(int argc, char **argv, opts *o)
         } else if (!strcmp(a, "--bench")) {
             char *end = NULL;
             o->bench = v ? strtod(v, &end) : -1;
-            if (!v || *end || !(o->bench > 0 && o->bench <= 3600)) return usage("--bench: '%s' is not 0..3600 seconds", v ? v : "");
+            if (!v || *end || !(o->bench > 0 && o->bench <= 3600))
+                return usage("--bench: '%s' is not 0..3600 seconds", v ? v : "");
             i++;
         } else if (!strcmp(a, "--hide")) {
             if (!v) return usage("%s needs a list: walls,bodies,diffuse", a);
@@ -1275,9 +1282,10 @@ static int run_window(app *A)
             if (o->bench > 0 && now - bench_t0 >= o->bench) {
                 uint64_t st = A->shown->steps;
                 printf("bench: %zu fluid + %zu wall particles, %.1f frames/s drawn, %.2f simulation steps/s, "
-                       "%dx%d, %d sample(s) per pixel, %s\n", A->shown->fluid.n, A->shown->walls.n,
-                       drawn / (now - bench_t0), (double)(st - bench_steps0) / (now - bench_t0), A->fb_w, A->fb_h,
-                       ss * ss, (const char *)glGetString(GL_RENDERER));
+                       "%dx%d, %d sample(s) per pixel, %s\n",
+                       A->shown->fluid.n, A->shown->walls.n, drawn / (now - bench_t0),
+                       (double)(st - bench_steps0) / (now - bench_t0), A->fb_w, A->fb_h, ss * ss,
+                       (const char *)glGetString(GL_RENDERER));
                 break;
             }
             glfwPollEvents();

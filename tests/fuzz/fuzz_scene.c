@@ -15,7 +15,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     pfsph_error err;
     int rc = pfsph_scene_parse(&s, text, "fuzz.json", &err);
     if (rc != PFSPH_OK && rc != PFSPH_EINPUT) abort(); /* only these two outcomes exist */
-    if (rc != PFSPH_OK && !err.msg[0]) abort();         /* an error always says why */
+    if (rc != PFSPH_OK && !err.msg[0]) abort();        /* an error always says why */
     free(text);
     return 0;
 }

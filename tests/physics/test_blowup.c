@@ -31,8 +31,8 @@ static void test_blowup_diagnosis(void **state)
     int st = tu_run(cmd, out, sizeof out);
     printf("exit %d: %s", st, out);
     assert_int_equal(st, 3);
-    const char *must[] = {"unstable at step", "t = ", "stage ", "particle id", "phase 'water'",
-                          "position", "likely cause", "sound_speed", "last good state (frame"};
+    const char *must[] = {"unstable at step", "t = ",         "stage ",      "particle id",           "phase 'water'",
+                          "position",         "likely cause", "sound_speed", "last good state (frame"};
     for (size_t k = 0; k < sizeof must / sizeof *must; k++)
         if (!strstr(out, must[k])) fail_msg("diagnosis lacks \"%s\"", must[k]);
     /* the kept checkpoint is the named frame and restores into the same scene */
@@ -137,7 +137,6 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_blowup_diagnosis),
-                                       cmocka_unit_test(test_density_explosion),
-                                       cmocka_unit_test(test_pcisph_tiny_dt)};
+                                       cmocka_unit_test(test_density_explosion), cmocka_unit_test(test_pcisph_tiny_dt)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -119,8 +119,8 @@ static void test_rest_on_floor(void **state)
         drift = fmax(drift, sqrt(dx * dx + dy * dy));
         vmax = fmax(vmax, sqrt(st.v[0] * st.v[0] + st.v[1] * st.v[1]));
     }
-    printf("rest on floor: largest drift %.3g mm, largest speed %.3g mm/s, tilt %.3g deg\n", 1e3 * drift,
-           1e3 * vmax, 2 * asin(fabs(st.q[3])) * 180 / 3.14159265358979);
+    printf("rest on floor: largest drift %.3g mm, largest speed %.3g mm/s, tilt %.3g deg\n", 1e3 * drift, 1e3 * vmax,
+           2 * asin(fabs(st.q[3])) * 180 / 3.14159265358979);
     assert_true(drift < 0.002);
     assert_true(2 * asin(fabs(st.q[3])) < 1 * 3.14159265358979 / 180);
     pfsph_sim_destroy(sim);
@@ -146,7 +146,8 @@ static void test_sinking_disc(void **state)
     }
     double speed = sqrt(st.v[0] * st.v[0] + st.v[1] * st.v[1]);
     printf("sinking disc: peak sinking speed %.3f m/s, final height %.4f m (radius 0.03), final speed %.3g m/s, "
-           "largest rise %.3g mm\n", vpeak, st.x[1], speed, 1e3 * rise);
+           "largest rise %.3g mm\n",
+           vpeak, st.x[1], speed, 1e3 * rise);
     /* free fall with buoyancy would reach sqrt(2 (2/3) g 0.17) = 1.49 m/s: drag must slow it */
     assert_true(vpeak > 0.1 && vpeak < 1.49);
     assert_true(fabs(st.x[1] - 0.03) < 0.01);
@@ -162,10 +163,11 @@ static void test_sinking_disc(void **state)
  * (more than 20% of it) for the test to mean anything. */
 static void momentum(const char *extra)
 {
-    pfsph_sim *sim = make_x(0.0, 0.0,
-                          "{\"shape\": \"sphere\", \"center\": [0.4, 0.25], \"radius\": 0.15, \"phase\": \"water\"}",
-                          "{\"name\": \"puck\", \"shape\": \"sphere\", \"radius\": 0.04, \"position\": [0.4, 0.25],"
-                          " \"velocity\": [0.5, 0], \"density\": 1000, \"phase\": \"body\"}", extra);
+    pfsph_sim *sim =
+        make_x(0.0, 0.0, "{\"shape\": \"sphere\", \"center\": [0.4, 0.25], \"radius\": 0.15, \"phase\": \"water\"}",
+               "{\"name\": \"puck\", \"shape\": \"sphere\", \"radius\": 0.04, \"position\": [0.4, 0.25],"
+               " \"velocity\": [0.5, 0], \"density\": 1000, \"phase\": \"body\"}",
+               extra);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const double mb = pfsph_bodies_mass(pfsph_sim_bodies(sim), 0);
     const double P0 = mb * 0.5;
@@ -242,8 +244,8 @@ static void test_left_domain_feels_nothing(void **state)
     advance(sim, 0.68);
     pfsph_bodies_get_state(B, 0, &b);
     pfsph_bodies_last_force(B, 0, F, T);
-    printf("left the domain: x %.4f -> %.4f m, vx %.9f -> %.9f m/s, force %g %g N\n", a.x[0], b.x[0], a.v[0],
-           b.v[0], F[0], F[1]);
+    printf("left the domain: x %.4f -> %.4f m, vx %.9f -> %.9f m/s, force %g %g N\n", a.x[0], b.x[0], a.v[0], b.v[0],
+           F[0], F[1]);
     assert_true(a.x[0] - 0.05 > 1.0 + 0.02); /* wholly outside, beyond the grid's margin */
     assert_true(F[0] == 0 && F[1] == 0 && T[2] == 0);
     assert_true(b.v[0] == a.v[0]);

@@ -52,7 +52,8 @@ static void test_stack(void **st)
     (void)st;
     pfsph_sim *sim = make(
         "{\"name\": \"a\", \"shape\": \"box\", \"half_extents\": [0.05, 0.025, 0.05], \"position\": [0.2, 0.1, 0.2]},"
-        "{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.05, 0.025, 0.05], \"position\": [0.2, 0.17, 0.2], \"rotation\": [0, 20, 0]},"
+        "{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.05, 0.025, 0.05], \"position\": [0.2, 0.17, 0.2], "
+        "\"rotation\": [0, 20, 0]},"
         "{\"name\": \"c\", \"shape\": \"box\", \"half_extents\": [0.05, 0.025, 0.05], \"position\": [0.2, 0.24, 0.2]}");
     advance(sim, 1.2);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
@@ -75,10 +76,11 @@ static void test_stack(void **st)
 static void test_mesh_on_box(void **st)
 {
     (void)st;
-    pfsph_sim *sim = make(
-        "{\"name\": \"crate\", \"shape\": \"box\", \"half_extents\": [0.08, 0.04, 0.08], \"position\": [0.2, 0.04, 0.2], \"density\": 2000},"
-        "{\"name\": \"ball\", \"shape\": \"mesh\", \"file\": \"data/meshes/icosphere.obj\", \"scale\": 0.05,"
-        " \"position\": [0.2, 0.25, 0.2], \"density\": 500}");
+    pfsph_sim *sim =
+        make("{\"name\": \"crate\", \"shape\": \"box\", \"half_extents\": [0.08, 0.04, 0.08], \"position\": [0.2, "
+             "0.04, 0.2], \"density\": 2000},"
+             "{\"name\": \"ball\", \"shape\": \"mesh\", \"file\": \"data/meshes/icosphere.obj\", \"scale\": 0.05,"
+             " \"position\": [0.2, 0.25, 0.2], \"density\": 500}");
     advance(sim, 1.2);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     pfsph_body_state c, b;

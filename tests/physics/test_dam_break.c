@@ -63,8 +63,8 @@ static void run(const char *solver, double limit)
     }
     double mass = c->fluid->n * (double)c->mass[0];
     printf("%s: %zu particles, %llu steps, mass %.6g -> %.6g, particles past a wall %.0f, "
-           "deepest %.4f m, average density error %.3f%% (max over frames %.3f%%)\n", solver, n0,
-           (unsigned long long)pfsph_sim_steps(sim), mass0, mass, outside, maxpen, 100 * err_sum / frames,
+           "deepest %.4f m, average density error %.3f%% (max over frames %.3f%%)\n",
+           solver, n0, (unsigned long long)pfsph_sim_steps(sim), mass0, mass, outside, maxpen, 100 * err_sum / frames,
            100 * err_max);
     assert_true(mass == mass0);
     assert_true(outside == 0);
@@ -74,9 +74,21 @@ static void run(const char *solver, double limit)
     pfsph_sim_destroy(sim);
 }
 
-static void test_wcsph(void **state) { (void)state; run("wcsph", 0.01); }
-static void test_pcisph(void **state) { (void)state; run("pcisph", 0.01); }
-static void test_dfsph(void **state) { (void)state; run("dfsph", 0.01); }
+static void test_wcsph(void **state)
+{
+    (void)state;
+    run("wcsph", 0.01);
+}
+static void test_pcisph(void **state)
+{
+    (void)state;
+    run("pcisph", 0.01);
+}
+static void test_dfsph(void **state)
+{
+    (void)state;
+    run("dfsph", 0.01);
+}
 
 static void test_threads_identical(void **state)
 {
@@ -94,8 +106,7 @@ static void test_threads_identical(void **state)
         const pfsph_particles *fa = pfsph_sim_ctx(a)->fluid, *fb = pfsph_sim_ctx(b)->fluid;
         assert_int_equal(fa->n, fb->n);
         assert_int_equal(pfsph_sim_steps(a), pfsph_sim_steps(b));
-        for (int k = 0; k < PFSPH_NFIELDS; k++)
-            assert_memory_equal(fa->f[k], fb->f[k], fa->n * sizeof(pfsph_real));
+        for (int k = 0; k < PFSPH_NFIELDS; k++) assert_memory_equal(fa->f[k], fb->f[k], fa->n * sizeof(pfsph_real));
         assert_memory_equal(fa->id, fb->id, fa->n * sizeof(uint32_t));
         pfsph_sim_destroy(a);
         pfsph_sim_destroy(b);
@@ -106,7 +117,6 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_wcsph), cmocka_unit_test(test_pcisph),
-                                       cmocka_unit_test(test_dfsph),
-                                       cmocka_unit_test(test_threads_identical)};
+                                       cmocka_unit_test(test_dfsph), cmocka_unit_test(test_threads_identical)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -85,9 +85,9 @@ static void test_mass_2d(void **st)
     pfsph_emitters_get_state(E, 0, &s0);
     pfsph_emitters_get_state(E, 1, &s1);
     printf("2D: water %.5g kg/m (rate x time %.5g, %+.3f %%), oil %.5g (%.5g, %+.3f %%); sites %zu and %zu; "
-           "%zu particles, next id %u, removed %zu, refused %llu + %llu\n", mw, ew, 100 * (mw / ew - 1), mo, eo,
-           100 * (mo / eo - 1), in0.sites, in1.sites, c->fluid->n, c->fluid->next_id, pfsph_sim_removed(sim),
-           (unsigned long long)s0.refused, (unsigned long long)s1.refused);
+           "%zu particles, next id %u, removed %zu, refused %llu + %llu\n",
+           mw, ew, 100 * (mw / ew - 1), mo, eo, 100 * (mo / eo - 1), in0.sites, in1.sites, c->fluid->n,
+           c->fluid->next_id, pfsph_sim_removed(sim), (unsigned long long)s0.refused, (unsigned long long)s1.refused);
     assert_true(fabs(mw / ew - 1) < 0.01);
     assert_true(fabs(mo / eo - 1) < 0.01);
     assert_true(uniq);
@@ -128,8 +128,8 @@ static void test_mass_3d(void **st)
     int uniq;
     double mall = phase_mass(c, 0, &uniq);
     printf("3D: disc %zu sites, %.5g kg (rate x time %.5g, %+.3f %%); rectangle %zu sites at %.4g m^3/s, %.5g kg "
-           "(%.5g, %+.3f %%); %zu particles in all (%.5g kg)\n", in0.sites, m0, e0, 100 * (m0 / e0 - 1), in1.sites,
-           in1.rate, m1, e1, 100 * (m1 / e1 - 1), c->fluid->n, mall);
+           "(%.5g, %+.3f %%); %zu particles in all (%.5g kg)\n",
+           in0.sites, m0, e0, 100 * (m0 / e0 - 1), in1.sites, in1.rate, m1, e1, 100 * (m1 / e1 - 1), c->fluid->n, mall);
     assert_true(fabs(m0 / e0 - 1) < 0.01);
     assert_true(fabs(m1 / e1 - 1) < 0.01);
     assert_int_equal(pfsph_sim_removed(sim), 0);
@@ -183,8 +183,7 @@ static void test_entry_spacing(void **st)
     pfsph_emitter_state es;
     pfsph_emitters_get_state(pfsph_sim_emitters(sim), 0, &es);
     double top = -INFINITY;
-    for (size_t i = 0; i < f->n; i++)
-        top = fmax(top, (double)f->y[i]);
+    for (size_t i = 0; i < f->n; i++) top = fmax(top, (double)f->y[i]);
     printf("pool: %zu particles entered in %llu steps, closest to another at entry %.4f d; %llu sites refused, %llu "
            "particles pushed by the inlet; %zu fluid particles, the highest at %.3f m (nozzle 0.11 m)\n",
            entered, (unsigned long long)pfsph_sim_steps(sim), closest, (unsigned long long)es.refused,
@@ -234,9 +233,9 @@ static void test_blow_gas(void **st)
         }
     const double owed = in.layer_rate * 0.2 * (double)in.sites;
     printf("blow: %zu sites, %llu gas particles emitted of %.0f owed, %llu refused, %llu pushes by the inlet; "
-           "%zu gas in the tank, their mean height %.4f m; %zu removed\n", in.sites, (unsigned long long)es.emitted,
-           owed, (unsigned long long)es.refused, (unsigned long long)es.pushed, gas, gas ? gy / gas : 0,
-           pfsph_sim_removed(sim));
+           "%zu gas in the tank, their mean height %.4f m; %zu removed\n",
+           in.sites, (unsigned long long)es.emitted, owed, (unsigned long long)es.refused,
+           (unsigned long long)es.pushed, gas, gas ? gy / gas : 0, pfsph_sim_removed(sim));
     assert_int_equal(gas, es.emitted);
     assert_true((double)es.emitted >= 0.75 * owed);
     assert_true(es.pushed > 0);
@@ -336,7 +335,8 @@ static void test_resume(void **st)
     }
     free(csv);
     printf("resume: fluid %ld at the checkpoint (frame 5), %ld at frame 10, %ld diffuse particles; frames 6, 8, 10 "
-           "(fluid and diffuse) and stats.csv identical\n", n5, n10, dif10);
+           "(fluid and diffuse) and stats.csv identical\n",
+           n5, n10, dif10);
     assert_true(n5 > 0 && n10 > n5);
     assert_true(dif10 > 0);
 }
@@ -345,10 +345,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_mass_2d),          cmocka_unit_test(test_mass_3d),
-        cmocka_unit_test(test_entry_spacing),    cmocka_unit_test(test_blow_gas),
-        cmocka_unit_test(test_threads_identical),
-        cmocka_unit_test(test_resume),
+        cmocka_unit_test(test_mass_2d),  cmocka_unit_test(test_mass_3d),           cmocka_unit_test(test_entry_spacing),
+        cmocka_unit_test(test_blow_gas), cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_resume),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

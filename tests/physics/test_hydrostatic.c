@@ -40,7 +40,8 @@ static void run_tank(const char *solver)
         assert_int_equal(pfsph_sim_advance(sim, 2.0 + 0.05 * (k + 1), &err), PFSPH_OK);
         const pfsph_particles *f = c->fluid;
         top = -1e9;
-        for (size_t i = 0; i < f->n; i++) if (f->y[i] > top) top = f->y[i];
+        for (size_t i = 0; i < f->n; i++)
+            if (f->y[i] > top) top = f->y[i];
         /* free surface ~ top particle centre + half a spacing */
         double surface = top + 0.5 * c->spacing;
         double num = 0, den = 0;
@@ -60,8 +61,8 @@ static void run_tank(const char *solver)
     }
     double ratio = ratio_sum / samples, derr = err_sum / samples;
     printf("%s: fluid %zu (start %zu), interior samples %zu, p / (rho g depth) = %.4f, "
-           "density error %.4f%%, vmax %.4f m/s\n", solver, c->fluid->n, n0, cnt_total / samples, ratio,
-           100 * derr, pfsph_sim_stats(sim)->vmax);
+           "density error %.4f%%, vmax %.4f m/s\n",
+           solver, c->fluid->n, n0, cnt_total / samples, ratio, 100 * derr, pfsph_sim_stats(sim)->vmax);
     assert_int_equal(c->fluid->n, n0);
     assert_true(derr < 0.01);
     /* DFSPH stops each density solve at its tolerance (0.1 % by default): the mean over the
@@ -74,9 +75,21 @@ static void run_tank(const char *solver)
     pfsph_sim_destroy(sim);
 }
 
-static void test_wcsph(void **state) { (void)state; run_tank("wcsph"); }
-static void test_pcisph(void **state) { (void)state; run_tank("pcisph"); }
-static void test_dfsph(void **state) { (void)state; run_tank("dfsph"); }
+static void test_wcsph(void **state)
+{
+    (void)state;
+    run_tank("wcsph");
+}
+static void test_pcisph(void **state)
+{
+    (void)state;
+    run_tank("pcisph");
+}
+static void test_dfsph(void **state)
+{
+    (void)state;
+    run_tank("dfsph");
+}
 
 int main(int argc, char **argv)
 {

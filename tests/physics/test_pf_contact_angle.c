@@ -103,23 +103,20 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
 {
     const double HALF = getenv("PF_HALF") ? atof(getenv("PF_HALF")) : 0.08;
     char json[8192];
-    int len = snprintf(
-        json, sizeof json,
-        "{\"dimension\": 2, \"seed\": %d, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
-        " \"domain\": {\"min\": [-0.05, -0.1], \"max\": [%g, 0.4]},"
-        " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"dt_max\": 0.002},"
-        " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}",
-        getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 11, nd * PITCH + 0.05,
-        getenv("PF_NU") ? getenv("PF_NU") : "0.001");
+    int len = snprintf(json, sizeof json,
+                       "{\"dimension\": 2, \"seed\": %d, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
+                       " \"domain\": {\"min\": [-0.05, -0.1], \"max\": [%g, 0.4]},"
+                       " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"dt_max\": 0.002},"
+                       " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}",
+                       getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 11, nd * PITCH + 0.05,
+                       getenv("PF_NU") ? getenv("PF_NU") : "0.001");
     for (int q = 0; q < nd; q++)
-        len += snprintf(json + len, sizeof json - (size_t)len,
-                        ", {\"name\": \"p%d\", \"kind\": \"solid\"}", q);
+        len += snprintf(json + len, sizeof json - (size_t)len, ", {\"name\": \"p%d\", \"kind\": \"solid\"}", q);
     len += snprintf(json + len, sizeof json - (size_t)len, "], \"fluid\": [");
     for (int q = 0; q < nd; q++)
         len += snprintf(json + len, sizeof json - (size_t)len,
-                        "%s{\"shape\": \"box\", \"min\": [%g, 0], \"max\": [%g, %g]}",
-                        q ? ", " : "", q * PITCH + 0.5 * PITCH - HALF,
-                        q * PITCH + 0.5 * PITCH + HALF, 2 * HALF);
+                        "%s{\"shape\": \"box\", \"min\": [%g, 0], \"max\": [%g, %g]}", q ? ", " : "",
+                        q * PITCH + 0.5 * PITCH - HALF, q * PITCH + 0.5 * PITCH + HALF, 2 * HALF);
     len += snprintf(json + len, sizeof json - (size_t)len, "], \"solids\": [");
     for (int q = 0; q < nd; q++)
         len += snprintf(json + len, sizeof json - (size_t)len,
@@ -133,8 +130,8 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     const double caa = 4.0 / (pfsph_pairwise_lambda(2, (getenv("PF_K") ? atof(getenv("PF_K")) : 1.7) * 0.02) * 1e6);
     for (int q = 0; q < nd; q++)
         if (ratio)
-            len += snprintf(json + len, sizeof json - (size_t)len,
-                            ", {\"phases\": [\"water\", \"p%d\"], \"c\": %.9g}", q, ratio[q] * caa);
+            len += snprintf(json + len, sizeof json - (size_t)len, ", {\"phases\": [\"water\", \"p%d\"], \"c\": %.9g}",
+                            q, ratio[q] * caa);
         else
             len += snprintf(json + len, sizeof json - (size_t)len,
                             ", {\"phases\": [\"water\", \"p%d\"], \"contact_angle\": %g}", q, target[q]);
@@ -172,8 +169,8 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     for (int q = 0; q < nd; q++) {
         assert_true(cnt[q] > 0);
         const double mean = sum[q] / cnt[q], sd = sqrt(fmax(0, sum2[q] / cnt[q] - mean * mean));
-        print_message("target %5.1f deg: measured %6.1f deg (sd %.1f over %d samples, %.1f-%.1f s)\n",
-                      target[q], mean, sd, cnt[q], 0.5 * t_end, t_end);
+        print_message("target %5.1f deg: measured %6.1f deg (sd %.1f over %d samples, %.1f-%.1f s)\n", target[q], mean,
+                      sd, cnt[q], 0.5 * t_end, t_end);
         th[q] = mean;
     }
     /* the drops sit on their plates: the lowest particle centre within a spacing of the face

@@ -84,14 +84,12 @@ static void run_ratio(double rho_gas, double t_end)
         if (k % 2 == 0 || k == ns)
             printf("ratio %g t=%.3f: centroid (%.4f, %.4f), components %d, rmax %.2f R, water "
                    "inside %d, ekin %.3g J\n",
-                   1000.0 / rho_gas, t, b.cx, b.cy, b.components, b.rmax / R, b.liquid_in,
-                   pfsph_sim_stats(sim)->ekin);
+                   1000.0 / rho_gas, t, b.cx, b.cy, b.components, b.rmax / R, b.liquid_in, pfsph_sim_stats(sim)->ekin);
     }
     double U = (y_end - y_mid) / (0.025 * (ns - ns / 2));
     printf("ratio %g: rise velocity %.4f m/s over the second half, 2D Davies-Taylor %.4f m/s, "
            "ratio %.3f; steps %llu, last dt %.3g s\n",
-           1000.0 / rho_gas, U, U_dt, U / U_dt, (unsigned long long)pfsph_sim_steps(sim),
-           pfsph_sim_stats(sim)->dt);
+           1000.0 / rho_gas, U, U_dt, U / U_dt, (unsigned long long)pfsph_sim_steps(sim), pfsph_sim_stats(sim)->dt);
     fflush(stdout);
     pfsph_sim_destroy(sim);
     assert_int_equal(worst_comp, 1);
@@ -123,8 +121,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_ratio_100)};
     (void)test_ratio_1000;
 #else
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_ratio_100),
-                                       cmocka_unit_test(test_ratio_1000)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_ratio_100), cmocka_unit_test(test_ratio_1000)};
 #endif
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

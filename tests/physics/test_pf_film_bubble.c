@@ -466,7 +466,8 @@ static void test_blow_bubble(void **state)
     const double blown = (double)st.emitted * V0, end_err = (end_gas - m0.gas - blown) / blown;
     print_message("blowing: %llu gas particles emitted (%.0f %% of the start's gas), all in the bubble: %s; film "
                   "liquid largest change %.3f %% (bound 2 %%); gas growth against the blown volume, largest relative "
-                  "difference once 20 %% is blown %.2f %% (bound 20 %%), at the end %+.2f %% (bound 10 %%, last 5 samples); a %.4f "
+                  "difference once 20 %% is blown %.2f %% (bound 20 %%), at the end %+.2f %% (bound 10 %%, last 5 "
+                  "samples); a %.4f "
                   "-> %.4f; gas outside the film, summed over samples: %d\n",
                   (unsigned long long)st.emitted, 100 * blown / m0.gas, count_bad ? "no" : "yes", 100 * max_dl,
                   100 * max_grow, 100 * end_err, m0.a, m.a, outside);

@@ -125,9 +125,21 @@ static void run_bubble(const char *solver)
     assert_true(fabs(U / U_dt - 1) < 0.3);
 }
 
-static void test_pcisph(void **state) { (void)state; run_bubble("pcisph"); }
-static void test_wcsph(void **state) { (void)state; run_bubble("wcsph"); }
-static void test_dfsph(void **state) { (void)state; run_bubble("dfsph"); }
+static void test_pcisph(void **state)
+{
+    (void)state;
+    run_bubble("pcisph");
+}
+static void test_wcsph(void **state)
+{
+    (void)state;
+    run_bubble("wcsph");
+}
+static void test_dfsph(void **state)
+{
+    (void)state;
+    run_bubble("dfsph");
+}
 
 int main(int argc, char **argv)
 {

@@ -129,8 +129,8 @@ static void relax(int dim, int N, const char *k, double t_end, double ratio_min)
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     shape st = measure(c);
     const double spread0 = st.spread;
-    print_message("%dD, %zu particles, k %s: t = 0 spread %.2f d, moment ratio %.3f\n", dim,
-                  c->fluid->n, k, st.spread, st.ratio);
+    print_message("%dD, %zu particles, k %s: t = 0 spread %.2f d, moment ratio %.3f\n", dim, c->fluid->n, k, st.spread,
+                  st.ratio);
     assert_true(spread0 > 2.0); /* a square or cube: corners reach (sqrt(dim) - 1) a/2 further */
     double dmin = st.dmin, tmin = 0;
     double avg_spread = 0, avg_ratio = 0, avg_close = 0;
@@ -204,7 +204,6 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     omp_set_num_threads(1); /* 400-1000 particles: threads only add synchronisation */
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_square_to_disc),
-                                       cmocka_unit_test(test_cube_to_sphere)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_square_to_disc), cmocka_unit_test(test_cube_to_sphere)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

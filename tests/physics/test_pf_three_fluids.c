@@ -83,8 +83,8 @@ static void run_case(const char *name, const double cf[6], const int want[3])
     assert_int_equal(n0, 600);
     int n[3][3];
     contacts(c, n);
-    printf("%s: start n12 %d n21 %d n23 %d n32 %d n13 %d n31 %d\n", name, n[0][1], n[1][0],
-           n[1][2], n[2][1], n[0][2], n[2][0]);
+    printf("%s: start n12 %d n21 %d n23 %d n32 %d n13 %d n31 %d\n", name, n[0][1], n[1][0], n[1][2], n[2][1], n[0][2],
+           n[2][0]);
     const int pa[3] = {0, 1, 0}, pb[3] = {1, 2, 2};
     const char *pname[3] = {"1-2", "2-3", "1-3"};
     int ok = 1;
@@ -99,8 +99,8 @@ static void run_case(const char *name, const double cf[6], const int want[3])
         for (int q = 0; q < 3; q++) {
             int ab = n[pa[q]][pb[q]], ba = n[pb[q]][pa[q]];
             int pass = want[q] == TOUCH ? (ab >= 5 && ba >= 5) : (ab == 0 && ba == 0);
-            printf("  %s %s: %d/%d (%.3f/%.3f)%s", pname[q], want[q] == TOUCH ? "touch" : "apart",
-                   ab, ba, ab / 200.0, ba / 200.0, pass ? "" : " FAIL");
+            printf("  %s %s: %d/%d (%.3f/%.3f)%s", pname[q], want[q] == TOUCH ? "touch" : "apart", ab, ba, ab / 200.0,
+                   ba / 200.0, pass ? "" : " FAIL");
             ok &= pass;
         }
         printf("  vmax %.3f m/s\n", pfsph_sim_stats(sim)->vmax);

@@ -94,7 +94,8 @@ static void test_resume_film(void **st)
     static pfsph_scene s;
     const char *json =
         "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
-        " \"domain\": {\"min\": [-0.2, -0.2], \"max\": [0.2, 0.2]}, \"time\": {\"end\": 0.4, \"fps\": 25, \"dt_max\": 0.002},"
+        " \"domain\": {\"min\": [-0.2, -0.2], \"max\": [0.2, 0.2]}, \"time\": {\"end\": 0.4, \"fps\": 25, \"dt_max\": "
+        "0.002},"
         " \"phases\": [{\"name\": \"soap\", \"kind\": \"fluid\", \"viscosity\": 0.005},"
         " {\"name\": \"air\", \"kind\": \"gas\", \"rest_density\": 1000, \"viscosity\": 0.005}],"
         " \"fluid\": [{\"shape\": \"sphere\", \"center\": [-0.055, 0], \"radius\": 0.05, \"phase\": \"air\","

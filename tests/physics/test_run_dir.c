@@ -305,8 +305,7 @@ static void on_progress(const pfsph_progress *p, void *user)
         if (l->partial > 0 && p->wall_s - l->last_wall < l->min_gap) l->min_gap = p->wall_s - l->last_wall;
         l->last_wall = p->wall_s;
         l->partial++;
-    } else
-        l->frames++;
+    } else l->frames++;
 }
 
 static void test_progress(void **state)

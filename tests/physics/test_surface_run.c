@@ -176,7 +176,8 @@ static void test_houdini_roundtrip(void **state)
     pfsph_particles ps, back;
     assert_int_equal(pfsph_particles_init(&ps, 8), 0);
     for (int i = 0; i < 5; i++) {
-        pfsph_real x[3] = {(pfsph_real)(0.1 * i), (pfsph_real)(-1.0 / 3 * i), (pfsph_real)1e-7}, v[3] = {1, -2, (pfsph_real)0.3};
+        pfsph_real x[3] = {(pfsph_real)(0.1 * i), (pfsph_real)(-1.0 / 3 * i), (pfsph_real)1e-7},
+                   v[3] = {1, -2, (pfsph_real)0.3};
         long k = pfsph_particles_push(&ps, x, v, (uint8_t)(i * 50));
         ps.rho[k] = (pfsph_real)(1000 + i / 7.0);
         ps.p[k] = (pfsph_real)(i * 123.456);
@@ -274,7 +275,8 @@ static void test_contour_run(void **state)
         assert_non_null(first[k]);
         const char *t = (const char *)first[k];
         size_t np = 0, nl = 0;
-        assert_int_equal(sscanf(strstr(t, "<Piece"), "<Piece NumberOfPoints=\"%zu\" NumberOfLines=\"%zu\"", &np, &nl), 2);
+        assert_int_equal(sscanf(strstr(t, "<Piece"), "<Piece NumberOfPoints=\"%zu\" NumberOfLines=\"%zu\"", &np, &nl),
+                         2);
         printf("frame %d: %zu points, %zu lines\n", k, np, nl);
         assert_true(np > 50);
         assert_int_equal(np, nl);
@@ -322,10 +324,13 @@ static void test_refusals(void **state)
     char out[8192], path[1400];
     /* PLY for a 2D scene's outline, a bad format: exit 2 with the JSON path */
     snprintf(path, sizeof path, "%s/s2.json", tu_tmpdir());
-    assert_int_equal(tu_write_file(path,
-        "{\"dimension\": 2, \"particle_radius\": 0.01, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},\n"
-        " \"phases\": [{\"name\": \"water\"}], \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.1, 0.1]}],\n"
-        " \"output\": {\"surface\": {\"formats\": [\"ply\"]}}}\n"), 0);
+    assert_int_equal(
+        tu_write_file(path,
+                      "{\"dimension\": 2, \"particle_radius\": 0.01, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},\n"
+                      " \"phases\": [{\"name\": \"water\"}], \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], "
+                      "\"max\": [0.1, 0.1]}],\n"
+                      " \"output\": {\"surface\": {\"formats\": [\"ply\"]}}}\n"),
+        0);
     assert_int_equal(pf(out, sizeof out, "check '%s'", path), 2);
     assert_non_null(strstr(out, "$.output.surface.formats"));
     assert_non_null(strstr(out, "VTP"));
@@ -374,12 +379,9 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_run_and_mesh),
-        cmocka_unit_test(test_render_meshes),
-        cmocka_unit_test(test_contour_run),
-        cmocka_unit_test(test_refusals),
-        cmocka_unit_test(test_diffuse_type),
-        cmocka_unit_test(test_houdini_roundtrip),
+        cmocka_unit_test(test_run_and_mesh), cmocka_unit_test(test_render_meshes),
+        cmocka_unit_test(test_contour_run),  cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_diffuse_type), cmocka_unit_test(test_houdini_roundtrip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

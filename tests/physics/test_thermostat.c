@@ -87,8 +87,10 @@ static void test_noise(void **st)
     const char *json =
         "{\"dimension\": 2, \"seed\": 5, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
         " \"domain\": {\"min\": [-0.5, -0.5], \"max\": [0.5, 0.5]}, \"solver\": {\"type\": \"wcsph\"},"
-        " \"phases\": [{\"name\": \"a\", \"viscosity\": 0.002}, {\"name\": \"b\", \"viscosity\": 0.0005, \"rest_density\": 700}],"
-        " \"fluid\": [{\"shape\": \"box\", \"min\": [-0.1, -0.1], \"max\": [0, 0.1], \"jitter\": 0.3, \"phase\": \"a\"},"
+        " \"phases\": [{\"name\": \"a\", \"viscosity\": 0.002}, {\"name\": \"b\", \"viscosity\": 0.0005, "
+        "\"rest_density\": 700}],"
+        " \"fluid\": [{\"shape\": \"box\", \"min\": [-0.1, -0.1], \"max\": [0, 0.1], \"jitter\": 0.3, \"phase\": "
+        "\"a\"},"
         "           {\"shape\": \"box\", \"min\": [0, -0.1], \"max\": [0.1, 0.1], \"jitter\": 0.3, \"phase\": \"b\"}],"
         " \"pairwise\": {\"k\": 1.7, \"coefficients\": [{\"phases\": [\"a\", \"a\"], \"sigma\": 4},"
         "   {\"phases\": [\"b\", \"b\"], \"sigma\": 2}, {\"phases\": [\"a\", \"b\"], \"sigma\": 1}]}}";
@@ -187,8 +189,8 @@ static double broken_bonds(const char *thermo)
     free(bond);
     pfsph_sim_destroy(sim);
     double r = (double)broken / (double)nb;
-    print_message("thermostat %s: %zu of %zu bonds broken in 2 s (%.1f %%)\n", thermo[0] ? thermo : "default",
-                  broken, nb, 100 * r);
+    print_message("thermostat %s: %zu of %zu bonds broken in 2 s (%.1f %%)\n", thermo[0] ? thermo : "default", broken,
+                  nb, 100 * r);
     return r;
 }
 
@@ -204,13 +206,17 @@ static const char *WALL_SCENE =
     "{\"dimension\": 2, \"seed\": 9, \"particle_radius\": 0.005, \"gravity\": [0, -9.81],"
     " \"domain\": {\"min\": [-0.3, -0.1], \"max\": [0.3, 0.4]}, \"solver\": {\"type\": \"pcisph\"},"
     " \"time\": {\"end\": 0.1, \"fps\": 50, \"dt_max\": 0.002},"
-    " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.002}, {\"name\": \"wall\", \"kind\": \"solid\", \"rest_density\": 1000},"
+    " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.002}, {\"name\": \"wall\", \"kind\": \"solid\", "
+    "\"rest_density\": 1000},"
     "   {\"name\": \"wood\", \"kind\": \"solid\", \"rest_density\": 600}],"
     " \"fluid\": [{\"shape\": \"box\", \"min\": [-0.1, 0], \"max\": [0.1, 0.06]}],"
-    " \"solids\": [{\"shape\": \"container\", \"min\": [-0.2, 0], \"max\": [0.2, 0.3], \"open_top\": true, \"layers\": 2, \"phase\": \"wall\"}],"
-    " \"bodies\": [{\"name\": \"disc\", \"shape\": \"sphere\", \"radius\": 0.02, \"position\": [0.05, 0.09], \"phase\": \"wood\"}],"
+    " \"solids\": [{\"shape\": \"container\", \"min\": [-0.2, 0], \"max\": [0.2, 0.3], \"open_top\": true, \"layers\": "
+    "2, \"phase\": \"wall\"}],"
+    " \"bodies\": [{\"name\": \"disc\", \"shape\": \"sphere\", \"radius\": 0.02, \"position\": [0.05, 0.09], "
+    "\"phase\": \"wood\"}],"
     " \"pairwise\": {\"k\": 1.7, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 2},"
-    "   {\"phases\": [\"water\", \"wall\"], \"contact_angle\": 60}, {\"phases\": [\"water\", \"wood\"], \"contact_angle\": 90}]},"
+    "   {\"phases\": [\"water\", \"wall\"], \"contact_angle\": 60}, {\"phases\": [\"water\", \"wood\"], "
+    "\"contact_angle\": 90}]},"
     " \"output\": {\"formats\": [\"vtp\"], \"fields\": [\"id\"], \"checkpoint_interval\": %d}}";
 
 static void test_threads(void **st)
@@ -274,9 +280,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_noise),     cmocka_unit_test(test_temperature),
-        cmocka_unit_test(test_liquidity), cmocka_unit_test(test_threads),
-        cmocka_unit_test(test_resume),
+        cmocka_unit_test(test_noise),   cmocka_unit_test(test_temperature), cmocka_unit_test(test_liquidity),
+        cmocka_unit_test(test_threads), cmocka_unit_test(test_resume),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

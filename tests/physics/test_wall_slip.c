@@ -63,8 +63,8 @@ static void test_free_and_no_slip(void **state)
     double no_slip_named = momentum_loss(nu, ", \"slip\": \"no-slip\"");
     double no_slip2 = momentum_loss(2 * nu, "");
     const double r1 = no_slip / (4 * sqrt(nu * T / pi) / H), r2 = no_slip2 / (4 * sqrt(2 * nu * T / pi) / H);
-    printf("free slip %.4f %%, no slip %.4f %%: %.3f of Stokes' (%.3f at 2 nu)\n", 100 * free_slip, 100 * no_slip,
-           r1, r2);
+    printf("free slip %.4f %%, no slip %.4f %%: %.3f of Stokes' (%.3f at 2 nu)\n", 100 * free_slip, 100 * no_slip, r1,
+           r2);
     assert_true(fabs(free_slip) < 0.01);
     assert_true(no_slip > 0.1);
     assert_true(no_slip_named == no_slip); /* the default, spelled out */

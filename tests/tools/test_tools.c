@@ -81,7 +81,8 @@ static void test_paraview(void **state)
     const char *j = json_after(out, "pfsph_pvd_info: ");
     assert_non_null(j);
     assert_non_null(strstr(j, "\"steps\": 3"));
-    assert_non_null(strstr(j, "\"point_arrays\": [\"density\", \"phase\", \"pressure\", \"surface_layer\", \"velocity\"]"));
+    assert_non_null(
+        strstr(j, "\"point_arrays\": [\"density\", \"phase\", \"pressure\", \"surface_layer\", \"velocity\"]"));
     assert_non_null(strstr(j, "\"times\": [0.0, 0.05, 0.1]"));
     assert_non_null(strstr(j, "\"points\": 1500"));
     snprintf(cmd, sizeof cmd, "pvpython '%s/tools/paraview/pfsph_pvd_info.py' '%s/liquid.pvd'", tu_source_dir(), g_run);
@@ -104,14 +105,17 @@ static void test_paraview_2d(void **state)
     char scene[1400], run[1400], cmd[4096], out[16384];
     snprintf(scene, sizeof scene, "%s/outline.json", tu_tmpdir());
     snprintf(run, sizeof run, "%s/outline", tu_tmpdir());
-    assert_int_equal(tu_write_file(scene,
-        "{\"dimension\": 2, \"particle_radius\": 0.01, \"gravity\": [0, -9.81],\n"
-        " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.7, 0.6]}, \"time\": {\"end\": 0.1, \"fps\": 20},\n"
-        " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}],\n"
-        " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.2, 0.3], \"phase\": \"water\"}],\n"
-        " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.6, 0.5], \"open_top\": true,\n"
-        "             \"phase\": \"wall\"}],\n"
-        " \"output\": {\"formats\": [\"vtp\"], \"surface\": true}}\n"), 0);
+    assert_int_equal(
+        tu_write_file(
+            scene,
+            "{\"dimension\": 2, \"particle_radius\": 0.01, \"gravity\": [0, -9.81],\n"
+            " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.7, 0.6]}, \"time\": {\"end\": 0.1, \"fps\": 20},\n"
+            " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}],\n"
+            " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.2, 0.3], \"phase\": \"water\"}],\n"
+            " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.6, 0.5], \"open_top\": true,\n"
+            "             \"phase\": \"wall\"}],\n"
+            " \"output\": {\"formats\": [\"vtp\"], \"surface\": true}}\n"),
+        0);
     snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet", tu_pfsph_bin(), scene, run);
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     snprintf(cmd, sizeof cmd, "pvpython '%s/tools/paraview/pfsph_pvd_info.py' '%s/liquid.pvd'", tu_source_dir(), run);
@@ -183,8 +187,9 @@ static void test_blender_load(void **state)
     assert_non_null(b);
     double zf = 0, zl = 0;
     int faces = 0, keys = 0;
-    assert_int_equal(sscanf(b, "\"body ball\": {\"faces\": %d, \"keys\": %d, \"z_first\": %lf, \"z_last\": %lf",
-                            &faces, &keys, &zf, &zl), 4);
+    assert_int_equal(sscanf(b, "\"body ball\": {\"faces\": %d, \"keys\": %d, \"z_first\": %lf, \"z_last\": %lf", &faces,
+                            &keys, &zf, &zl),
+                     4);
     assert_int_equal(keys, 3);
     assert_true(faces > 100);
     assert_true(fabs(zf - 0.1) < 1e-6);
@@ -198,7 +203,8 @@ static void test_blender_render(void **state)
     char cmd[4096], out[16384], png[1400];
     snprintf(cmd, sizeof cmd,
              "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_render.py' -- '%s' '%s/png' "
-             "--size 160x90 --samples 4 --frames 2:2", tu_source_dir(), g_run, g_run);
+             "--size 160x90 --samples 4 --frames 2:2",
+             tu_source_dir(), g_run, g_run);
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     assert_non_null(strstr(out, "pfsph_render: 1 PNG frames"));
     snprintf(png, sizeof png, "%s/png/frame_0002.png", g_run);

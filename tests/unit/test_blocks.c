@@ -82,10 +82,11 @@ static void test_disc_in_tank(void **state)
 static void test_one_lattice(void **state)
 {
     (void)state;
-    parse_ok("{\"particle_radius\":0.01,\"domain\":{\"min\":[-1,-1,-1],\"max\":[1,1,1]},\"fluid\":["
-             "{\"shape\":\"box\",\"min\":[-0.513,0.0037,0.2],\"max\":[-0.3,0.2,0.41]},"
-             "{\"shape\":\"sphere\",\"center\":[0.1234,0.0567,-0.0891],\"radius\":0.101},"
-             "{\"shape\":\"cylinder\",\"center\":[0.5011,-0.3,0.3333],\"radius\":0.07,\"height\":0.13,\"axis\":\"x\"}]}");
+    parse_ok(
+        "{\"particle_radius\":0.01,\"domain\":{\"min\":[-1,-1,-1],\"max\":[1,1,1]},\"fluid\":["
+        "{\"shape\":\"box\",\"min\":[-0.513,0.0037,0.2],\"max\":[-0.3,0.2,0.41]},"
+        "{\"shape\":\"sphere\",\"center\":[0.1234,0.0567,-0.0891],\"radius\":0.101},"
+        "{\"shape\":\"cylinder\",\"center\":[0.5011,-0.3,0.3333],\"radius\":0.07,\"height\":0.13,\"axis\":\"x\"}]}");
     const double d = 0.02;
     pfsph_particles ps;
     assert_int_equal(pfsph_particles_init(&ps, 1024), PFSPH_OK);
@@ -169,7 +170,8 @@ static void test_carving_counts(void **state)
             }
             free(mark);
             pfsph_particles_free(&one);
-            if (total != uni) fail_msg("dim %d case %d: blocks hold %ld particles, their union %ld sites", dim, t, total, uni);
+            if (total != uni)
+                fail_msg("dim %d case %d: blocks hold %ld particles, their union %ld sites", dim, t, total, uni);
             cases++;
         }
     printf("%d random block sets: counts equal walks, totals equal the union's sites\n", cases);
@@ -193,8 +195,8 @@ static void test_hundred_blocks(void **state)
     for (int i = 1; i < 100; i++)
         len += (size_t)snprintf(json + len, cap - len,
                                 ",{\"shape\":\"%s\",\"center\":[%.4f,%.4f],\"radius\":0.05,\"phase\":\"%s\"}",
-                                i % 2 ? "sphere" : "cylinder", 0.08 + 0.08 * ((i - 1) % 11), 0.06 + 0.08 * ((i - 1) / 11),
-                                i % 3 ? "b" : "a");
+                                i % 2 ? "sphere" : "cylinder", 0.08 + 0.08 * ((i - 1) % 11),
+                                0.06 + 0.08 * ((i - 1) / 11), i % 3 ? "b" : "a");
     snprintf(json + len, cap - len, "]}");
     parse_ok(json);
     free(json);
@@ -216,7 +218,7 @@ static void test_hundred_blocks(void **state)
             for (int b = 1; b < 100 && !in; b++) {
                 const pfsph_block *q = &g_scene.blocks[b];
                 in = (x - q->center[0]) * (x - q->center[0]) + (y - q->center[1]) * (y - q->center[1]) <=
-                     q->radius * q->radius;
+                    q->radius * q->radius;
             }
             uni += in;
         }
@@ -263,10 +265,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_disc_in_tank),
-        cmocka_unit_test(test_one_lattice),
-        cmocka_unit_test(test_carving_counts),
-        cmocka_unit_test(test_hundred_blocks),
+        cmocka_unit_test(test_disc_in_tank),      cmocka_unit_test(test_one_lattice),
+        cmocka_unit_test(test_carving_counts),    cmocka_unit_test(test_hundred_blocks),
         cmocka_unit_test(test_large_counts_fast),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

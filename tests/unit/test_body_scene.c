@@ -47,11 +47,12 @@ static void test_parse_ok(void **st)
     (void)st;
     static pfsph_scene s;
     pfsph_error err;
-    int rc = parse(3, "{\"name\": \"lid\", \"shape\": \"box\", \"half_extents\": [0.1, 0.05, 0.1],"
-                      " \"position\": [0.5, 0.5, 0.5], \"rotation\": [0, 45, 0], \"phase\": \"wood\"},"
-                      "{\"shape\": \"cylinder\", \"radius\": 0.05, \"height\": 0.2, \"axis\": \"x\","
-                      " \"position\": [0.3, 0.3, 0.3], \"mass\": 2, \"kinematic\": true,"
-                      " \"keyframes\": [{\"t\": 0}, {\"t\": 1, \"position\": [0.4, 0.3, 0.3]}]}",
+    int rc = parse(3,
+                   "{\"name\": \"lid\", \"shape\": \"box\", \"half_extents\": [0.1, 0.05, 0.1],"
+                   " \"position\": [0.5, 0.5, 0.5], \"rotation\": [0, 45, 0], \"phase\": \"wood\"},"
+                   "{\"shape\": \"cylinder\", \"radius\": 0.05, \"height\": 0.2, \"axis\": \"x\","
+                   " \"position\": [0.3, 0.3, 0.3], \"mass\": 2, \"kinematic\": true,"
+                   " \"keyframes\": [{\"t\": 0}, {\"t\": 1, \"position\": [0.4, 0.3, 0.3]}]}",
                    &s, &err);
     if (rc) fprintf(stderr, "%s\n", err.msg);
     assert_int_equal(rc, PFSPH_OK);
@@ -72,7 +73,8 @@ static void test_parse_errors(void **st)
     expect_error(2, "{\"position\": [0.5, 0.5]}", "$.bodies[0].shape", "missing");
     expect_error(2, "{\"shape\": \"cone\", \"position\": [0.5, 0.5]}", "$.bodies[0].shape", "one of");
     expect_error(2, "{\"shape\": \"sphere\", \"position\": [0.5, 0.5]}", "$.bodies[0].radius", "missing");
-    expect_error(2, "{\"shape\": \"sphere\", \"radius\": -1, \"position\": [0.5, 0.5]}", "$.bodies[0].radius", "out of range");
+    expect_error(2, "{\"shape\": \"sphere\", \"radius\": -1, \"position\": [0.5, 0.5]}", "$.bodies[0].radius",
+                 "out of range");
     expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"phase\": \"water\"}",
                  "$.bodies[0].phase", "not a solid phase");
     expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"phase\": \"steel\"}",
@@ -84,31 +86,34 @@ static void test_parse_errors(void **st)
     expect_error(2, "{\"shape\": \"mesh\", \"file\": \"a.obj\", \"position\": [0.5, 0.5]}", "$.bodies[0].shape", "3D");
     expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"keyframes\": [{\"t\": 0}]}",
                  "$.bodies[0].keyframes", "kinematic");
-    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"kinematic\": true,"
-                    " \"keyframes\": [{\"t\": 1}, {\"t\": 0.5}]}",
+    expect_error(2,
+                 "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"kinematic\": true,"
+                 " \"keyframes\": [{\"t\": 1}, {\"t\": 0.5}]}",
                  "$.bodies[0].keyframes[1].t", "increase");
-    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"kinematic\": true,"
-                    " \"keyframes\": [{\"t\": 0}, {\"t\": 1, \"position\": [3, 0.5]}]}",
+    expect_error(2,
+                 "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"kinematic\": true,"
+                 " \"keyframes\": [{\"t\": 0}, {\"t\": 1, \"position\": [3, 0.5]}]}",
                  "$.bodies[0].keyframes[1].position", "outside the domain");
     expect_error(2, "{\"name\": \"a,b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5]}",
                  "$.bodies[0].name", "letters");
-    expect_error(2, "{\"name\": \"a\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5]},"
-                    "{\"name\": \"a\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.2, 0.5]}",
+    expect_error(2,
+                 "{\"name\": \"a\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5]},"
+                 "{\"name\": \"a\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.2, 0.5]}",
                  "$.bodies[1].name", "used by");
     expect_error(3, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5, 0.5], \"inertia\": [1, 1, 3]}",
                  "$.bodies[0].inertia", "sum of");
     expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"inertia\": 0}",
                  "$.bodies[0].inertia", "> 0");
-    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"colour\": 1}",
-                 "$.bodies[0]", "colour");
+    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"colour\": 1}", "$.bodies[0]",
+                 "colour");
 }
 
 /* Each bad OBJ file makes `pfsph check` fail with status 2 and a message naming the file. */
 static void test_bad_obj_cli(void **st)
 {
     (void)st;
-    static const char *const bad[] = {"missing_file.obj", "bad_malformed.obj", "bad_open.obj",
-                                      "bad_degenerate.obj", "bad_index.obj", "bad_empty.obj",
+    static const char *const bad[] = {"missing_file.obj",    "bad_malformed.obj", "bad_open.obj",
+                                      "bad_degenerate.obj",  "bad_index.obj",     "bad_empty.obj",
                                       "bad_nonmanifold.obj", "bad_nan.obj"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         char body[2048], json[8192], scene[1100], cmd[2400], out[4096];
@@ -148,16 +153,25 @@ static void test_bad_obj_cli(void **st)
 static void test_overlap(void **st)
 {
     (void)st;
-    static const char *A = "{\"name\": \"a\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.5],"
-                           " \"density\": 600, \"phase\": \"wood\"}";
+    static const char *A =
+        "{\"name\": \"a\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.5],"
+        " \"density\": 600, \"phase\": \"wood\"}";
     const struct {
         const char *b;
         int overlap;
     } cases[] = {
-        {"{\"name\": \"b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.65, 0.5], \"density\": 600, \"phase\": \"wood\"}", 1},
-        {"{\"name\": \"b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.7, 0.5], \"density\": 600, \"phase\": \"wood\"}", 0},
-        {"{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.7], \"density\": 600, \"phase\": \"wood\"}", 0},
-        {"{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.65], \"density\": 600, \"phase\": \"wood\"}", 1},
+        {"{\"name\": \"b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.65, 0.5], \"density\": 600, "
+         "\"phase\": \"wood\"}",
+         1},
+        {"{\"name\": \"b\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.7, 0.5], \"density\": 600, "
+         "\"phase\": \"wood\"}",
+         0},
+        {"{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.7], \"density\": "
+         "600, \"phase\": \"wood\"}",
+         0},
+        {"{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.1, 0.1], \"position\": [0.5, 0.65], \"density\": "
+         "600, \"phase\": \"wood\"}",
+         1},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
         char bodies[1024];
@@ -187,10 +201,11 @@ static void test_keyframes(void **st)
     (void)st;
     static pfsph_scene s;
     pfsph_error err;
-    int rc = parse(3, "{\"name\": \"paddle\", \"shape\": \"box\", \"half_extents\": [0.05, 0.1, 0.02],"
-                      " \"position\": [0.5, 0.5, 0.5], \"kinematic\": true, \"keyframes\": ["
-                      "  {\"t\": 0, \"position\": [0.5, 0.5, 0.5], \"rotation\": [0, 0, 0]},"
-                      "  {\"t\": 0.2, \"position\": [0.7, 0.5, 0.5], \"rotation\": [0, 0, 90]}]}",
+    int rc = parse(3,
+                   "{\"name\": \"paddle\", \"shape\": \"box\", \"half_extents\": [0.05, 0.1, 0.02],"
+                   " \"position\": [0.5, 0.5, 0.5], \"kinematic\": true, \"keyframes\": ["
+                   "  {\"t\": 0, \"position\": [0.5, 0.5, 0.5], \"rotation\": [0, 0, 0]},"
+                   "  {\"t\": 0.2, \"position\": [0.7, 0.5, 0.5], \"rotation\": [0, 0, 90]}]}",
                    &s, &err);
     if (rc) fprintf(stderr, "%s\n", err.msg);
     assert_int_equal(rc, PFSPH_OK);
@@ -202,12 +217,12 @@ static void test_keyframes(void **st)
     pfsph_body_state bs;
     assert_int_equal(pfsph_sim_advance(sim, 0.1, &err), PFSPH_OK);
     pfsph_bodies_get_state(B, 0, &bs);
-    printf("t = 0.1: x = %.9f, q = %.6f %.6f %.6f %.6f, v = %.6f, w = %.6f\n", bs.x[0], bs.q[0], bs.q[1],
-           bs.q[2], bs.q[3], bs.v[0], bs.w[2]);
+    printf("t = 0.1: x = %.9f, q = %.6f %.6f %.6f %.6f, v = %.6f, w = %.6f\n", bs.x[0], bs.q[0], bs.q[1], bs.q[2],
+           bs.q[3], bs.v[0], bs.w[2]);
     assert_true(fabs(bs.x[0] - 0.6) < 1e-9);
     /* halfway between 0 and 90 degrees about z: 45 degrees */
     assert_true(fabs(bs.q[0] - cos(M_PI / 8)) < 1e-9 && fabs(bs.q[3] - sin(M_PI / 8)) < 1e-9);
-    assert_true(fabs(bs.v[0] - 1.0) < 1e-6);             /* 0.2 m in 0.2 s */
+    assert_true(fabs(bs.v[0] - 1.0) < 1e-6);            /* 0.2 m in 0.2 s */
     assert_true(fabs(bs.w[2] - M_PI / 2 / 0.2) < 1e-3); /* 90 degrees in 0.2 s */
     assert_int_equal(pfsph_sim_advance(sim, 0.3, &err), PFSPH_OK);
     pfsph_bodies_get_state(B, 0, &bs);
@@ -230,11 +245,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_parse_ok),
-        cmocka_unit_test(test_parse_errors),
-        cmocka_unit_test(test_bad_obj_cli),
-        cmocka_unit_test(test_keyframes),
-        cmocka_unit_test(test_overlap),
+        cmocka_unit_test(test_parse_ok),  cmocka_unit_test(test_parse_errors), cmocka_unit_test(test_bad_obj_cli),
+        cmocka_unit_test(test_keyframes), cmocka_unit_test(test_overlap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -48,8 +48,7 @@ static void assert_same_set(const pfsph_particles *a, const pfsph_particles *b)
 {
     assert_int_equal(a->n, b->n);
     assert_int_equal(a->next_id, b->next_id);
-    for (int k = 0; k < PFSPH_NFIELDS; k++)
-        assert_memory_equal(a->f[k], b->f[k], a->n * sizeof(pfsph_real));
+    for (int k = 0; k < PFSPH_NFIELDS; k++) assert_memory_equal(a->f[k], b->f[k], a->n * sizeof(pfsph_real));
     assert_memory_equal(a->phase, b->phase, a->n);
     assert_memory_equal(a->id, b->id, a->n * sizeof(uint32_t));
 }
@@ -471,10 +470,10 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_roundtrip_pcisph), cmocka_unit_test(test_roundtrip_wcsph),
-        cmocka_unit_test(test_roundtrip_dfsph),
-        cmocka_unit_test(test_corrupt_and_truncated), cmocka_unit_test(test_other_scene),
-        cmocka_unit_test(test_keep_and_fallback), cmocka_unit_test(test_scene_key),
-        cmocka_unit_test(test_crafted_ids), cmocka_unit_test(test_crafted_clock),
+        cmocka_unit_test(test_roundtrip_dfsph),  cmocka_unit_test(test_corrupt_and_truncated),
+        cmocka_unit_test(test_other_scene),      cmocka_unit_test(test_keep_and_fallback),
+        cmocka_unit_test(test_scene_key),        cmocka_unit_test(test_crafted_ids),
+        cmocka_unit_test(test_crafted_clock),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -161,8 +161,7 @@ static void test_foam_follows_flow(void **state)
             assert_int_equal(p->n, 1);
             assert_int_equal(p->phase[0], PFSPH_DIFFUSE_FOAM);
             double fac = pow(1 - kcp[c], s);
-            double ve[3] = {U[0] + fac * (v0[0] - U[0]), U[1] + fac * (v0[1] - U[1]),
-                            U[2] + fac * (v0[2] - U[2])};
+            double ve[3] = {U[0] + fac * (v0[0] - U[0]), U[1] + fac * (v0[1] - U[1]), U[2] + fac * (v0[2] - U[2])};
             assert_true(fabs(p->vx[0] - ve[0]) < 1e-6);
             assert_true(fabs(p->vy[0] - ve[1]) < 1e-6);
             assert_true(fabs(p->vz[0] - ve[2]) < 1e-6);
@@ -231,8 +230,7 @@ static void test_classification(void **state)
     assert_int_equal(lo, 3);
     assert_int_equal(hi, 8);
     const int counts[] = {5, 6, 20, 21};
-    const int expect[] = {PFSPH_DIFFUSE_SPRAY, PFSPH_DIFFUSE_FOAM, PFSPH_DIFFUSE_FOAM,
-                          PFSPH_DIFFUSE_BUBBLE};
+    const int expect[] = {PFSPH_DIFFUSE_SPRAY, PFSPH_DIFFUSE_FOAM, PFSPH_DIFFUSE_FOAM, PFSPH_DIFFUSE_BUBBLE};
     for (int c = 0; c < 4; c++) {
         fixture f;
         fx_init(&f, 3, 0.1, 1e-4);
@@ -422,8 +420,8 @@ static void test_shear_layer_rate(void **state)
     }
     pfsph_diffuse_totals(d, &created, NULL);
     double expect = steps * mean, sd = sqrt(steps * var);
-    print_message("shear layer: %d emitters, created %llu, Eq. 16 predicts %.1f +- %.1f\n",
-                  emitters, (unsigned long long)created, expect, sd);
+    print_message("shear layer: %d emitters, created %llu, Eq. 16 predicts %.1f +- %.1f\n", emitters,
+                  (unsigned long long)created, expect, sd);
     assert_true(expect > 1000);
     assert_true(fabs((double)created - expect) < 4 * sd + 1);
     pfsph_diffuse_destroy(d);
@@ -630,8 +628,7 @@ static void test_determinism(void **state)
     assert_true(a.n > 100);
     size_t n3[3] = {0, 0, 0};
     for (size_t i = 0; i < a.n; i++) n3[a.phase[i]]++;
-    print_message("determinism: %zu particles (spray %zu, foam %zu, bubble %zu)\n", a.n, n3[0],
-                  n3[1], n3[2]);
+    print_message("determinism: %zu particles (spray %zu, foam %zu, bubble %zu)\n", a.n, n3[0], n3[1], n3[2]);
     assert_true(same(&a, &b));
     assert_false(same(&a, &c));
     pfsph_particles_free(&a);
@@ -675,8 +672,8 @@ static void test_removed_in_solid(void **state)
             if (fabs(p->x[i] - 0.5) < 1e-3) ymin_seen = fmin(ymin_seen, p->y[i]);
     }
     const pfsph_particles *p = pfsph_diffuse_particles(d);
-    assert_int_equal(p->n, 1);                     /* the one over the floor is gone */
-    assert_true(fabs(p->x[0] - 1.5) < 1e-6);       /* the other falls on */
+    assert_int_equal(p->n, 1);               /* the one over the floor is gone */
+    assert_true(fabs(p->x[0] - 1.5) < 1e-6); /* the other falls on */
     assert_true(p->y[0] < -0.1);
     assert_true(ymin_seen >= 0.025 - 0.01 - 1e-6); /* removed within one step (1 cm) of d/2 */
     pfsph_diffuse_destroy(d);
@@ -689,12 +686,12 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_spray_parabola),     cmocka_unit_test(test_foam_follows_flow),
-        cmocka_unit_test(test_bubble_rises),       cmocka_unit_test(test_classification),
-        cmocka_unit_test(test_lifetime_and_cap),   cmocka_unit_test(test_rest_makes_nothing),
-        cmocka_unit_test(test_shear_layer_rate),   cmocka_unit_test(test_emission_cylinder),
-        cmocka_unit_test(test_determinism),        cmocka_unit_test(test_fluid_untouched),
-        cmocka_unit_test(test_gas_not_counted),    cmocka_unit_test(test_removed_in_solid),
+        cmocka_unit_test(test_spray_parabola),   cmocka_unit_test(test_foam_follows_flow),
+        cmocka_unit_test(test_bubble_rises),     cmocka_unit_test(test_classification),
+        cmocka_unit_test(test_lifetime_and_cap), cmocka_unit_test(test_rest_makes_nothing),
+        cmocka_unit_test(test_shear_layer_rate), cmocka_unit_test(test_emission_cylinder),
+        cmocka_unit_test(test_determinism),      cmocka_unit_test(test_fluid_untouched),
+        cmocka_unit_test(test_gas_not_counted),  cmocka_unit_test(test_removed_in_solid),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -109,7 +109,10 @@ static void test_sym3_random(void **state)
     for (int t = 0; t < 200; t++) {
         /* rotation from a random unit quaternion */
         double q[4], n = 0;
-        for (int i = 0; i < 4; i++) { q[i] = urand() - 0.5; n += q[i] * q[i]; }
+        for (int i = 0; i < 4; i++) {
+            q[i] = urand() - 0.5;
+            n += q[i] * q[i];
+        }
         n = sqrt(n);
         for (int i = 0; i < 4; i++) q[i] /= n;
         double R[3][3] = {
@@ -208,7 +211,10 @@ static void test_sym3_fast(void **state)
     }
     for (int t = 0; t < 2000; t++) { /* nearly double eigenvalues, in either position */
         double q[4], n = 0;
-        for (int i = 0; i < 4; i++) { q[i] = urand() - 0.5; n += q[i] * q[i]; }
+        for (int i = 0; i < 4; i++) {
+            q[i] = urand() - 0.5;
+            n += q[i] * q[i];
+        }
         n = sqrt(n);
         for (int i = 0; i < 4; i++) q[i] /= n;
         double R[3][3] = {

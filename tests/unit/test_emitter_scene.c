@@ -12,18 +12,21 @@
 #include "pfsph/sim.h"
 #include "testutil.h"
 
-#define HEAD2 "{\"dimension\": 2, \"particle_radius\": 0.0025, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]}," \
-              " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}], "
-#define HEAD3 "{\"particle_radius\": 0.005, \"domain\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}," \
-              " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}], "
+#define HEAD2                                                                                         \
+    "{\"dimension\": 2, \"particle_radius\": 0.0025, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]}," \
+    " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}], "
+#define HEAD3                                                                            \
+    "{\"particle_radius\": 0.005, \"domain\": {\"min\": [0, 0, 0], \"max\": [1, 1, 1]}," \
+    " \"phases\": [{\"name\": \"water\"}, {\"name\": \"wall\", \"kind\": \"solid\"}], "
 
 /* a water box and a bubble of air with a soap film: the emitter key "bubble" */
-#define HEADB "{\"dimension\": 2, \"particle_radius\": 0.0025, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]}," \
-              " \"phases\": [{\"name\": \"water\"}, {\"name\": \"air\", \"kind\": \"gas\"}], \"fluid\": [" \
-              "{\"shape\": \"box\", \"min\": [0, 0], \"max\": [1, 0.1]}, {\"shape\": \"sphere\", \"center\": " \
-              "[0.5, 0.5], \"radius\": 0.1, \"phase\": \"air\", \"bubble\": {\"film\": \"water\", \"thickness\": " \
-              "0.001}}], \"emitters\": [{\"center\": [0.5, 0.5], \"width\": 0.02, \"direction\": [0, 1], " \
-              "\"speed\": 0.1, "
+#define HEADB                                                                                            \
+    "{\"dimension\": 2, \"particle_radius\": 0.0025, \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},"    \
+    " \"phases\": [{\"name\": \"water\"}, {\"name\": \"air\", \"kind\": \"gas\"}], \"fluid\": ["         \
+    "{\"shape\": \"box\", \"min\": [0, 0], \"max\": [1, 0.1]}, {\"shape\": \"sphere\", \"center\": "     \
+    "[0.5, 0.5], \"radius\": 0.1, \"phase\": \"air\", \"bubble\": {\"film\": \"water\", \"thickness\": " \
+    "0.001}}], \"emitters\": [{\"center\": [0.5, 0.5], \"width\": 0.02, \"direction\": [0, 1], "         \
+    "\"speed\": 0.1, "
 
 typedef struct bad_case {
     const char *json;
@@ -70,7 +73,8 @@ static const bad_case cases[] = {
     {HEAD2 "\"emitters\": [{\"phase\": \"oil\", \"center\": [0.5, 0.9], \"width\": 0.1, \"direction\": [0, -1], "
            "\"speed\": 1}]}",
      "$.emitters[0].phase: unknown phase \"oil\""},
-    {HEAD2 "\"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.1, 0.1]}], \"emitters\": {\"center\": [0.5, 0.9]}}",
+    {HEAD2
+     "\"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.1, 0.1]}], \"emitters\": {\"center\": [0.5, 0.9]}}",
      "$.emitters: expected an array of emitters"},
     {HEAD2 "\"emitters\": []}", "$.fluid: a scene needs at least one fluid block"},
     /* the lattice: a segment narrower than a spacing between two sites holds none */
@@ -99,11 +103,13 @@ static void test_bad_keys_exit_2(void **st)
         snprintf(want, sizeof want, "%s: %s", path, cases[i].expect);
         snprintf(cmd, sizeof cmd, "'%s' check '%s'", tu_pfsph_bin(), path);
         int rc = tu_run(cmd, out, sizeof out);
-        if (rc != 2 || !strstr(out, want)) fail_msg("case %zu: check exit %d, expected 2 and \"%s\":\n%s", i, rc, want, out);
-        snprintf(cmd, sizeof cmd, "cd '%s' && '%s' run '%s' -o '%s/run_%zu' --quiet", tu_tmpdir(), tu_pfsph_bin(),
-                 path, tu_tmpdir(), i);
+        if (rc != 2 || !strstr(out, want))
+            fail_msg("case %zu: check exit %d, expected 2 and \"%s\":\n%s", i, rc, want, out);
+        snprintf(cmd, sizeof cmd, "cd '%s' && '%s' run '%s' -o '%s/run_%zu' --quiet", tu_tmpdir(), tu_pfsph_bin(), path,
+                 tu_tmpdir(), i);
         rc = tu_run(cmd, out, sizeof out);
-        if (rc != 2 || !strstr(out, want)) fail_msg("case %zu: run exit %d, expected 2 and \"%s\":\n%s", i, rc, want, out);
+        if (rc != 2 || !strstr(out, want))
+            fail_msg("case %zu: run exit %d, expected 2 and \"%s\":\n%s", i, rc, want, out);
     }
 }
 
@@ -131,9 +137,10 @@ static void test_bubble_key(void **st)
 static void test_check_counts(void **st)
 {
     (void)st;
-    const char *json = HEAD2 "\"gravity\": [0, 0], \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.1, 0.1]}],"
-                             " \"emitters\": [{\"center\": [0.5, 0.9], \"width\": 0.1, \"direction\": [0, -1],"
-                             " \"speed\": 1, \"start\": 0.2, \"stop\": 0.7}]}";
+    const char *json =
+        HEAD2 "\"gravity\": [0, 0], \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [0.1, 0.1]}],"
+              " \"emitters\": [{\"center\": [0.5, 0.9], \"width\": 0.1, \"direction\": [0, -1],"
+              " \"speed\": 1, \"start\": 0.2, \"stop\": 0.7}]}";
     char path[512], cmd[2048], out[8192];
     snprintf(path, sizeof path, "%s/good.json", tu_tmpdir());
     assert_int_equal(tu_write_file(path, json), 0);
@@ -142,8 +149,9 @@ static void test_check_counts(void **st)
     printf("%s", out);
     if (rc) fail_msg("exit %d: %s", rc, out);
     assert_non_null(strstr(out, "particles: 400 fluid at the start, up to 2420 with the emitters' by t = 1 s"));
-    assert_non_null(strstr(out, "[0] segment of 20 sites, phase \"water\", 1 m/s, 0.1 m^2/s (100 kg/s per metre, "
-                                "200 layers/s), from 0.2 s to 0.7 s"));
+    assert_non_null(strstr(out,
+                           "[0] segment of 20 sites, phase \"water\", 1 m/s, 0.1 m^2/s (100 kg/s per metre, "
+                           "200 layers/s), from 0.2 s to 0.7 s"));
     assert_non_null(strstr(out, "1 emitter"));
 
     /* the estimate counts the most fluid: a nozzle open longer needs more memory */
@@ -224,7 +232,8 @@ static void test_state_checks(void **st)
     assert_int_equal(la, lb);
     /* the stored stage seconds differ; all after them (the fluid set, the diffuse flag, the body
      * count, the emitters) does not */
-    const size_t tail = 8 + 4 + pfsph_sim_ctx(sim)->fluid->n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 5) + 1 + 4 + 4 + 32;
+    const size_t tail =
+        8 + 4 + pfsph_sim_ctx(sim)->fluid->n * (PFSPH_NFIELDS * sizeof(pfsph_real) + 5) + 1 + 4 + 4 + 32;
     assert_memory_equal((char *)a + la - tail, (char *)b + lb - tail, tail);
     free(a);
     free(b);

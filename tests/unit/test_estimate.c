@@ -62,8 +62,8 @@ static void test_counts_match_walk(void **state)
             long walked = pfsph__sample_block(&s, &b, d, &ps);
             long counted = pfsph__sample_block(&s, &b, d, NULL);
             if (walked != counted)
-                fail_msg("dim %d shape %d axis %d d %g r %g h %g: walk %ld, closed form %ld", dim, b.shape,
-                         b.axis, d, b.radius, b.height, walked, counted);
+                fail_msg("dim %d shape %d axis %d d %g r %g h %g: walk %ld, closed form %ld", dim, b.shape, b.axis, d,
+                         b.radius, b.height, walked, counted);
             assert_int_equal((long)ps.n, walked);
             cases++;
         }

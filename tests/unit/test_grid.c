@@ -33,8 +33,7 @@ static int inside(int dim, const pfsph_real p[3])
 /* n random particles over the domain widened by 10% on each side (so some fall outside), plus
  * particles exactly on the faces and corners, on cell boundaries, and with NaN / inf positions.
  * in_flag[id] says whether the particle should survive the sort. */
-static void make_set(pfsph_particles *ps, int dim, size_t n, uint64_t seed, unsigned char *in_flag,
-                     size_t *n_out)
+static void make_set(pfsph_particles *ps, int dim, size_t n, uint64_t seed, unsigned char *in_flag, size_t *n_out)
 {
     lcg_state = seed;
     assert_int_equal(pfsph_particles_init(ps, 16), PFSPH_OK);
@@ -103,8 +102,8 @@ static void check_dim(int dim, size_t n, int fine)
     }
     size_t removed = 0;
     assert_int_equal(pfsph_grid_sort(&g, &ps, &removed), PFSPH_OK);
-    printf("%dD: %zu particles, %zu outside/non-finite, removed %zu, kept %zu, grid %dx%dx%d\n",
-           dim, n, n_outside, removed, ps.n, g.nc[0], g.nc[1], g.nc[2]);
+    printf("%dD: %zu particles, %zu outside/non-finite, removed %zu, kept %zu, grid %dx%dx%d\n", dim, n, n_outside,
+           removed, ps.n, g.nc[0], g.nc[1], g.nc[2]);
     assert_int_equal(removed, n_outside);
     assert_int_equal(ps.n, n - n_outside);
 
@@ -154,9 +153,8 @@ static void check_dim(int dim, size_t n, int fine)
             qsort(got, cnt, sizeof(uint32_t), cmp_u32);
             for (size_t q = 1; q < cnt; q++) assert_true(got[q] != got[q - 1]); /* disjoint */
             if (cnt != nb || memcmp(got, brute, nb * sizeof(uint32_t)) != 0)
-                fail_msg("%dD radius %.4f particle %zu at (%.9g, %.9g, %.9g): grid %zu, brute %zu",
-                         dim, (double)radii[ri], i, (double)ps.x[i], (double)ps.y[i],
-                         (double)ps.z[i], cnt, nb);
+                fail_msg("%dD radius %.4f particle %zu at (%.9g, %.9g, %.9g): grid %zu, brute %zu", dim,
+                         (double)radii[ri], i, (double)ps.x[i], (double)ps.y[i], (double)ps.z[i], cnt, nb);
             /* the band of cells the ball touches (pfsph_grid_ranges_radius): the same set */
             pfsph_grid_ranges_radius(&g, ps.x[i], ps.y[i], ps.z[i], radii[ri], &rg);
             cnt = 0;
@@ -169,16 +167,16 @@ static void check_dim(int dim, size_t n, int fine)
                 }
             qsort(got, cnt, sizeof(uint32_t), cmp_u32);
             if (cnt != nb || memcmp(got, brute, nb * sizeof(uint32_t)) != 0)
-                fail_msg("%dD radius %.4f particle %zu, trimmed walk: grid %zu, brute %zu", dim,
-                         (double)radii[ri], i, cnt, nb);
+                fail_msg("%dD radius %.4f particle %zu, trimmed walk: grid %zu, brute %zu", dim, (double)radii[ri], i,
+                         cnt, nb);
             trimmed += rg.n;
             total += nb;
             if (nb > max_nb) max_nb = nb;
             if (span > max_range) max_range = span;
         }
         printf("%dD radius %.4f: mean %.2f neighbours (max %zu), largest candidate set %zu, trimmed walk "
-               "%.2f rows\n", dim, (double)radii[ri], (double)total / (double)ps.n, max_nb, max_range,
-               (double)trimmed / (double)ps.n);
+               "%.2f rows\n",
+               dim, (double)radii[ri], (double)total / (double)ps.n, max_nb, max_range, (double)trimmed / (double)ps.n);
     }
     free(brute);
     free(got);
@@ -188,8 +186,20 @@ static void check_dim(int dim, size_t n, int fine)
     pfsph_particles_free(&ps);
 }
 
-static void test_neighbours_2d(void **state) { (void)state; check_dim(2, 3000, 0); check_dim(2, 3000, 1); check_dim(2, 3000, 2); }
-static void test_neighbours_3d(void **state) { (void)state; check_dim(3, 8000, 0); check_dim(3, 8000, 1); check_dim(3, 8000, 2); }
+static void test_neighbours_2d(void **state)
+{
+    (void)state;
+    check_dim(2, 3000, 0);
+    check_dim(2, 3000, 1);
+    check_dim(2, 3000, 2);
+}
+static void test_neighbours_3d(void **state)
+{
+    (void)state;
+    check_dim(3, 8000, 0);
+    check_dim(3, 8000, 1);
+    check_dim(3, 8000, 2);
+}
 
 /* Sorting the same input with 1 and 2 threads, and twice in a row, gives the same order; a
  * second sort of an already sorted set is the identity (stable). */
@@ -282,8 +292,8 @@ static void test_near(void **state)
                 const int nr = pfsph_grid_near(&g, q[0], q[1], q[2]);
                 /* inside the grid's cells the flags are exact; outside them they answer 1 */
                 const int in_cells = inside(dim, q) && q[0] < LO[0] + (pfsph_real)g.nc[0] * g.cell &&
-                                     q[1] < LO[1] + (pfsph_real)g.nc[1] * g.cell &&
-                                     (dim == 2 || q[2] < LO[2] + (pfsph_real)g.nc[2] * g.cell);
+                    q[1] < LO[1] + (pfsph_real)g.nc[1] * g.cell &&
+                    (dim == 2 || q[2] < LO[2] + (pfsph_real)g.nc[2] * g.cell);
                 if (!nr) assert_int_equal(r.n, 0);
                 if (in_cells) assert_int_equal(nr, r.n > 0);
                 zero += !nr;
@@ -373,11 +383,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_neighbours_2d),
-        cmocka_unit_test(test_neighbours_3d),
-        cmocka_unit_test(test_determinism),
-        cmocka_unit_test(test_edge_cases),
-        cmocka_unit_test(test_near),
+        cmocka_unit_test(test_neighbours_2d), cmocka_unit_test(test_neighbours_3d), cmocka_unit_test(test_determinism),
+        cmocka_unit_test(test_edge_cases),    cmocka_unit_test(test_near),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

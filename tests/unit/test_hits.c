@@ -80,7 +80,8 @@ static void test_variants(void **state)
         }
     }
     print_message("hits: scalar against the definition (%d hits), %d SIMD variant(s) checked (chosen here: %s), "
-                  "%d hits\n", brute_hits, tested, pfsph_hits_level_name(), hits);
+                  "%d hits\n",
+                  brute_hits, tested, pfsph_hits_level_name(), hits);
     if (tested) assert_true(hits > 100); /* none in a double-precision build: the filter is scalar there */
 }
 
@@ -99,9 +100,9 @@ static void test_terms(void **state)
         dy[e] = (pfsph_real)(0.06 * (uni() - 0.5));
         dz[e] = (pfsph_real)(0.06 * (uni() - 0.5));
         r2[e] = dx[e] * dx[e] + dy[e] * dy[e] + dz[e] * dz[e];
-        if (e % 17 == 0) r2[e] = 0; /* coincident */
+        if (e % 17 == 0) r2[e] = 0;                     /* coincident */
         if (e % 19 == 0) r2[e] = h2 * (pfsph_real)0.25; /* q = 1/2, the branch point */
-        if (e % 23 == 0) r2[e] = h2; /* q = 1 */
+        if (e % 23 == 0) r2[e] = h2;                    /* q = 1 */
         vx[e] = (pfsph_real)uni(), vy[e] = (pfsph_real)uni(), vz[e] = (pfsph_real)uni();
         nd[e] = (pfsph_real)(7000 + 1000 * uni());
         p[e] = (pfsph_real)(1000 * uni());

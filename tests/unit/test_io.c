@@ -14,8 +14,7 @@
 #include "pfsph/surface_io.h"
 #include "testutil.h"
 
-typedef int (*writer_fn)(const char *, const pfsph_particles *, const pfsph_io_opts *,
-                         pfsph_error *);
+typedef int (*writer_fn)(const char *, const pfsph_particles *, const pfsph_io_opts *, pfsph_error *);
 typedef int (*reader_fn)(const char *, pfsph_particles *, double *, pfsph_error *);
 
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
@@ -26,10 +25,7 @@ static uint32_t rnd32(void)
     rng ^= rng << 17;
     return (uint32_t)(rng >> 16);
 }
-static pfsph_real rndr(double scale)
-{
-    return (pfsph_real)(scale * ((double)rnd32() / 4294967296.0 * 2.0 - 1.0));
-}
+static pfsph_real rndr(double scale) { return (pfsph_real)(scale * ((double)rnd32() / 4294967296.0 * 2.0 - 1.0)); }
 
 static void make_set(pfsph_particles *ps, size_t n, int dim)
 {
@@ -48,8 +44,7 @@ static void make_set(pfsph_particles *ps, size_t n, int dim)
 
 static int same_bits(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
 
-static void compare_sets(const pfsph_particles *a, const pfsph_particles *b, int with_id,
-                         int with_aux)
+static void compare_sets(const pfsph_particles *a, const pfsph_particles *b, int with_id, int with_aux)
 {
     assert_int_equal(a->n, b->n);
     const size_t rb = a->n * sizeof(pfsph_real);
@@ -70,8 +65,11 @@ static void roundtrip(writer_fn w, reader_fn r, const char *ext)
         for (int opt = 0; opt < 2; opt++) {
             pfsph_particles ps, back;
             make_set(&ps, 257 + (size_t)opt * 1000, dim);
-            pfsph_io_opts o = {.dim = dim, .write_id = opt, .write_speed = opt,
-                               .aux_name = opt ? "volume" : NULL, .time = 0.1 * dim + 1e-17};
+            pfsph_io_opts o = {.dim = dim,
+                               .write_id = opt,
+                               .write_speed = opt,
+                               .aux_name = opt ? "volume" : NULL,
+                               .time = 0.1 * dim + 1e-17};
             char path[512];
             snprintf(path, sizeof path, "%s/rt_%d_%d.%s", dir, dim, opt, ext);
             pfsph_error err = {0};
@@ -113,8 +111,7 @@ static void test_ply_header(void **state)
     make_set(&ps, 3, 3);
     char path[512];
     snprintf(path, sizeof path, "%s/h.ply", tu_tmpdir());
-    pfsph_io_opts o = {.dim = 3, .write_id = true, .write_speed = true, .aux_name = "lifetime",
-                       .time = 0.5};
+    pfsph_io_opts o = {.dim = 3, .write_id = true, .write_speed = true, .aux_name = "lifetime", .time = 0.5};
     pfsph_error err;
     assert_int_equal(pfsph_write_ply(path, &ps, &o, &err), PFSPH_OK);
     FILE *f = fopen(path, "rb");
@@ -290,8 +287,7 @@ static void dump(const char *path, const void *d, size_t n)
 }
 
 /* Replace the first occurrence of `from` by `to` (same length or not) and write to out. */
-static void patched(const unsigned char *b, size_t n, const char *from, const char *to,
-                    const char *out)
+static void patched(const unsigned char *b, size_t n, const char *from, const char *to, const char *out)
 {
     size_t fl = strlen(from), tl = strlen(to);
     for (size_t i = 0; i + fl <= n; i++)
@@ -337,9 +333,7 @@ static void corrupt_common(writer_fn w, reader_fn r, const char *ext)
     }
     /* Random byte flips in the header may be accepted or refused, but never crash. */
     size_t hdr = 0;
-    while (hdr + 13 < n && memcmp(b + hdr, "<AppendedData", 13) != 0 &&
-           memcmp(b + hdr, "end_header", 10) != 0)
-        hdr++;
+    while (hdr + 13 < n && memcmp(b + hdr, "<AppendedData", 13) != 0 && memcmp(b + hdr, "end_header", 10) != 0) hdr++;
     for (int k = 0; k < 300; k++) {
         unsigned char *c = malloc(n);
         memcpy(c, b, n);
@@ -549,21 +543,21 @@ static void test_vtp_opens_in_vtk(void **state)
     char path[512], script[512];
     snprintf(path, sizeof path, "%s/vtk.vtp", tu_tmpdir());
     snprintf(script, sizeof script, "%s/check_vtk.py", tu_tmpdir());
-    pfsph_io_opts o = {.dim = 3, .write_id = true, .write_speed = true, .aux_name = "volume",
-                       .time = 0.75};
+    pfsph_io_opts o = {.dim = 3, .write_id = true, .write_speed = true, .aux_name = "volume", .time = 0.75};
     pfsph_error err;
     assert_int_equal(pfsph_write_vtp(path, &ps, &o, &err), PFSPH_OK);
     assert_int_equal(tu_write_file(script,
-        "import sys, vtk\n"
-        "r = vtk.vtkXMLPolyDataReader(); r.SetFileName(sys.argv[1]); r.Update()\n"
-        "d = r.GetOutput(); pd = d.GetPointData()\n"
-        "names = sorted(pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays()))\n"
-        "print('n', d.GetNumberOfPoints(), d.GetNumberOfVerts(), r.GetErrorCode())\n"
-        "print('arrays', ','.join(names))\n"
-        "print('time', d.GetFieldData().GetArray('TimeValue').GetValue(0))\n"
-        "print('p7 %.9g %.9g %.9g' % d.GetPoint(7))\n"
-        "print('id7', int(pd.GetArray('id').GetValue(7)))\n"
-        "print('rho7 %.9g' % pd.GetArray('density').GetValue(7))\n"), 0);
+                                   "import sys, vtk\n"
+                                   "r = vtk.vtkXMLPolyDataReader(); r.SetFileName(sys.argv[1]); r.Update()\n"
+                                   "d = r.GetOutput(); pd = d.GetPointData()\n"
+                                   "names = sorted(pd.GetArrayName(i) for i in range(pd.GetNumberOfArrays()))\n"
+                                   "print('n', d.GetNumberOfPoints(), d.GetNumberOfVerts(), r.GetErrorCode())\n"
+                                   "print('arrays', ','.join(names))\n"
+                                   "print('time', d.GetFieldData().GetArray('TimeValue').GetValue(0))\n"
+                                   "print('p7 %.9g %.9g %.9g' % d.GetPoint(7))\n"
+                                   "print('id7', int(pd.GetArray('id').GetValue(7)))\n"
+                                   "print('rho7 %.9g' % pd.GetArray('density').GetValue(7))\n"),
+                     0);
     char cmd[1200];
     snprintf(cmd, sizeof cmd, "%s %s %s", py, script, path);
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
@@ -580,11 +574,11 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_vtp_roundtrip),      cmocka_unit_test(test_ply_roundtrip),
-        cmocka_unit_test(test_ply_header),         cmocka_unit_test(test_speed_field),
-        cmocka_unit_test(test_write_errors),       cmocka_unit_test(test_atomic_keeps_old_file),
-        cmocka_unit_test(test_vtp_corrupt),        cmocka_unit_test(test_ply_corrupt),
-        cmocka_unit_test(test_vtp_opens_in_vtk),   cmocka_unit_test(test_surface_ply_roundtrip),
+        cmocka_unit_test(test_vtp_roundtrip),    cmocka_unit_test(test_ply_roundtrip),
+        cmocka_unit_test(test_ply_header),       cmocka_unit_test(test_speed_field),
+        cmocka_unit_test(test_write_errors),     cmocka_unit_test(test_atomic_keeps_old_file),
+        cmocka_unit_test(test_vtp_corrupt),      cmocka_unit_test(test_ply_corrupt),
+        cmocka_unit_test(test_vtp_opens_in_vtk), cmocka_unit_test(test_surface_ply_roundtrip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -59,8 +59,8 @@ static void test_normalisation(void **state)
         pfsph_kernel_init(&k, dim, H);
         double rad = radial_integral(&k, 2000);
         double lat = lattice_integral(&k, dim == 2 ? 400 : 80);
-        printf("%dD: radial integral of W = %.8f (err %.2e), lattice sum = %.8f (err %.2e)\n",
-               dim, rad, fabs(rad - 1), lat, fabs(lat - 1));
+        printf("%dD: radial integral of W = %.8f (err %.2e), lattice sum = %.8f (err %.2e)\n", dim, rad, fabs(rad - 1),
+               lat, fabs(lat - 1));
         assert_true(fabs(rad - 1) < 1e-3);
         assert_true(fabs(lat - 1) < 1e-3);
     }
@@ -89,8 +89,8 @@ static void test_shape(void **state)
             if (w - prev > worst_rise) worst_rise = w - prev;
             prev = w;
         }
-        printf("%dD: largest rise of W between neighbouring samples %.3e (W(0) = %.4e)\n", dim,
-               worst_rise, (double)k.sigma);
+        printf("%dD: largest rise of W between neighbouring samples %.3e (W(0) = %.4e)\n", dim, worst_rise,
+               (double)k.sigma);
         assert_true(worst_rise <= 4e-7 * (double)k.sigma);
         /* continuity of W at q = 1/2 (the two polynomial pieces meet) */
         double wl = (double)pfsph_kernel_w(&k, H * (pfsph_real)0.4999),
@@ -110,8 +110,9 @@ static void test_derivative(void **state)
         for (int i = 1; i < 1000; i++) {
             double r = (double)H * i / 1000.0;
             if (r - e <= 0 || r + e >= (double)H) continue;
-            double fd = ((double)pfsph_kernel_w(&k, (pfsph_real)(r + e)) -
-                         (double)pfsph_kernel_w(&k, (pfsph_real)(r - e))) / (2 * e);
+            double fd =
+                ((double)pfsph_kernel_w(&k, (pfsph_real)(r + e)) - (double)pfsph_kernel_w(&k, (pfsph_real)(r - e))) /
+                (2 * e);
             double an = (double)pfsph_kernel_dw_r(&k, (pfsph_real)r) * r;
             if (fabs(fd - an) > worst) worst = fabs(fd - an);
             assert_true(an <= 0); /* W non-increasing */
@@ -146,13 +147,11 @@ static void test_gradient_antisymmetry(void **state)
             pfsph_real rji = pfsph_sqrt(dji[0] * dji[0] + dji[1] * dji[1] + dji[2] * dji[2]);
             pfsph_real gij = pfsph_kernel_dw_r(&k, rij), gji = pfsph_kernel_dw_r(&k, rji);
             if (gij != 0) nonzero++;
-            for (int a = 0; a < 3; a++)
-                assert_true(gij * dij[a] == -(gji * dji[a]));
+            for (int a = 0; a < 3; a++) assert_true(gij * dij[a] == -(gji * dji[a]));
             /* W decreases with r, so grad_i W(x_ij) points from i towards j */
             assert_true(gij <= 0);
         }
-        printf("%dD: %d of 2000 random pairs inside the support, antisymmetry exact\n", dim,
-               nonzero);
+        printf("%dD: %d of 2000 random pairs inside the support, antisymmetry exact\n", dim, nonzero);
         assert_true(nonzero > 200);
     }
 }
@@ -182,8 +181,8 @@ static void test_lattice_sum(void **state)
                     double dx = ix * d - off[0], dy = iy * d - off[1], dz = iz * d - off[2];
                     sum_off += (double)pfsph_kernel_w(&k, (pfsph_real)sqrt(dx * dx + dy * dy + dz * dz));
                 }
-        printf("%dD: lattice sum at d = h/2: %.6f * 1/d^%d (rel err %.2e); off-lattice point %.4f\n",
-               dim, sum / expect, dim, rel, sum_off / expect);
+        printf("%dD: lattice sum at d = h/2: %.6f * 1/d^%d (rel err %.2e); off-lattice point %.4f\n", dim, sum / expect,
+               dim, rel, sum_off / expect);
         assert_true(fabs(rel) < 0.01);
     }
 }
@@ -192,10 +191,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_normalisation),
-        cmocka_unit_test(test_shape),
-        cmocka_unit_test(test_derivative),
-        cmocka_unit_test(test_gradient_antisymmetry),
+        cmocka_unit_test(test_normalisation), cmocka_unit_test(test_shape),
+        cmocka_unit_test(test_derivative),    cmocka_unit_test(test_gradient_antisymmetry),
         cmocka_unit_test(test_lattice_sum),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

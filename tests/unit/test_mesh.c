@@ -33,8 +33,7 @@ static void load(pfsph_mesh *m, const char *name, int expect_rc, const char *exp
     pfsph_error err = {0};
     int rc = pfsph_mesh_load_obj(m, path, &err);
     if (rc != expect_rc) fail_msg("%s: rc %d, expected %d (%s)", name, rc, expect_rc, err.msg);
-    if (expect_msg && !strstr(err.msg, expect_msg))
-        fail_msg("%s: message '%s' lacks '%s'", name, err.msg, expect_msg);
+    if (expect_msg && !strstr(err.msg, expect_msg)) fail_msg("%s: message '%s' lacks '%s'", name, err.msg, expect_msg);
     if (rc) {
         assert_null(m->v);
         assert_null(m->tri);
@@ -58,10 +57,8 @@ static void validate(pfsph_mesh *m, const char *name, int expect_rc, const char 
 {
     pfsph_error err = {0};
     int rc = pfsph_mesh_validate_closed(m, name, &err);
-    if (rc != expect_rc) fail_msg("%s: validate rc %d, expected %d (%s)", name, rc, expect_rc,
-                                  err.msg);
-    if (expect_msg && !strstr(err.msg, expect_msg))
-        fail_msg("%s: message '%s' lacks '%s'", name, err.msg, expect_msg);
+    if (rc != expect_rc) fail_msg("%s: validate rc %d, expected %d (%s)", name, rc, expect_rc, err.msg);
+    if (expect_msg && !strstr(err.msg, expect_msg)) fail_msg("%s: message '%s' lacks '%s'", name, err.msg, expect_msg);
 }
 
 static double volume_of(const pfsph_mesh *m)
@@ -85,8 +82,7 @@ static void test_obj_files(void **state)
         {"lprism.obj", 12, 20, 1.5, 1e-14}, /* CRLF, negatives, no final newline */
         /* a 32 x 16 torus polyhedron: 2 pi^2 R r^2 times the two polygon-area factors */
         {"torus.obj", 512, 1024,
-         2 * PI * PI * 1.0 * 0.35 * 0.35 * (sin(2 * PI / 32) / (2 * PI / 32)) *
-             (sin(2 * PI / 16) / (2 * PI / 16)),
+         2 * PI * PI * 1.0 * 0.35 * 0.35 * (sin(2 * PI / 32) / (2 * PI / 32)) * (sin(2 * PI / 16) / (2 * PI / 16)),
          0.01},
         {"icosphere.obj", 42, 80, 4.0 / 3.0 * PI, 0.2},
         {"tetra_inside_out.obj", 4, 4, 1.0 / 6.0, 1e-14},
@@ -98,8 +94,8 @@ static void test_obj_files(void **state)
         assert_int_equal(m.ntris, good[k].nt);
         validate(&m, good[k].name, PFSPH_OK, NULL);
         double v = volume_of(&m);
-        printf("%-22s %5zu vertices %5zu triangles volume %.6f (expected %.6f)\n", good[k].name,
-               m.nverts, m.ntris, v, good[k].vol);
+        printf("%-22s %5zu vertices %5zu triangles volume %.6f (expected %.6f)\n", good[k].name, m.nverts, m.ntris, v,
+               good[k].vol);
         assert_true(fabs(v - good[k].vol) <= good[k].vol_tol * good[k].vol);
         pfsph_mesh_free(&m);
     }
@@ -121,8 +117,7 @@ static void test_obj_files(void **state)
     validate(&m, "bad_degenerate.obj", PFSPH_EINPUT, "triangle 13 (vertices 1 9 2) is degenerate");
     pfsph_mesh_free(&m);
     load(&m, "bad_nonmanifold.obj", PFSPH_OK, NULL);
-    validate(&m, "bad_nonmanifold.obj", PFSPH_EINPUT,
-             "edge 1-2 is non-manifold (shared by 4 triangles)");
+    validate(&m, "bad_nonmanifold.obj", PFSPH_EINPUT, "edge 1-2 is non-manifold (shared by 4 triangles)");
     pfsph_mesh_free(&m);
     pfsph_mesh_free(&m); /* twice is fine */
 }
@@ -135,8 +130,7 @@ static void test_obj_syntax(void **state)
     char buf[4096];
 
     /* fan triangulation of a pentagon, negative indices */
-    parse_str(&m, "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nf -5 -4 -3 -2 -1\n", PFSPH_OK,
-              NULL);
+    parse_str(&m, "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nf -5 -4 -3 -2 -1\n", PFSPH_OK, NULL);
     const uint32_t fan[9] = {0, 1, 2, 0, 2, 3, 0, 3, 4};
     assert_int_equal(m.ntris, 3);
     assert_memory_equal(m.tri, fan, sizeof fan);
@@ -288,8 +282,8 @@ static void test_mass_cube_tetra(void **state)
     snprintf(txt, sizeof txt,
              "v %.17g %.17g %.17g\nv %.17g %.17g %.17g\nv %.17g %.17g %.17g\nv %.17g %.17g %.17g\n"
              "f 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n",
-             P[0][0], P[0][1], P[0][2], P[1][0], P[1][1], P[1][2], P[2][0], P[2][1], P[2][2],
-             P[3][0], P[3][1], P[3][2]);
+             P[0][0], P[0][1], P[0][2], P[1][0], P[1][1], P[1][2], P[2][0], P[2][1], P[2][2], P[3][0], P[3][1],
+             P[3][2]);
     /* the faces above are in no particular order: validate must reject them (orientation) */
     parse_str(&m, txt, PFSPH_OK, NULL);
     validate(&m, "tet", PFSPH_EINPUT, "inconsistent orientation");
@@ -308,7 +302,8 @@ static void test_mass_cube_tetra(void **state)
         for (int k = 0; k < 4; k++) s[a] += P[k][a];
     }
     double V = fabs(e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) - e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
-                    e1[2] * (e2[0] * e3[1] - e2[1] * e3[0])) / 6.0;
+                    e1[2] * (e2[0] * e3[1] - e2[1] * e3[0])) /
+        6.0;
     for (int a = 0; a < 3; a++)
         for (int b = 0; b < 3; b++) {
             double sum = s[a] * s[b];
@@ -318,8 +313,7 @@ static void test_mass_cube_tetra(void **state)
     double tr = C[0] + C[4] + C[8];
     check_close("tet V", v, V, 1e-14 * V);
     for (int a = 0; a < 3; a++) check_close("tet com", c[a], s[a] / 4, 1e-14);
-    for (int i = 0; i < 9; i++)
-        check_close("tet I", I[i], (i % 4 == 0 ? tr : 0.0) - C[i], 1e-13 * tr);
+    for (int i = 0; i < 9; i++) check_close("tet I", I[i], (i % 4 == 0 ? tr : 0.0) - C[i], 1e-13 * tr);
     printf("tetrahedron: V %.15g (Tonon %.15g), Ixx %.15g (Tonon %.15g)\n", v, V, I[0], tr - C[0]);
     pfsph_mesh_free(&m);
 }
@@ -329,9 +323,8 @@ static void rotation(const double axis[3], double ang, double R[9])
 {
     double l = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
     double x = axis[0] / l, y = axis[1] / l, z = axis[2] / l, c = cos(ang), s = sin(ang), t = 1 - c;
-    double r[9] = {t * x * x + c,     t * x * y - s * z, t * x * z + s * y,
-                   t * x * y + s * z, t * y * y + c,     t * y * z - s * x,
-                   t * x * z - s * y, t * y * z + s * x, t * z * z + c};
+    double r[9] = {t * x * x + c,     t * x * y - s * z, t * x * z + s * y, t * x * y + s * z, t * y * y + c,
+                   t * y * z - s * x, t * x * z - s * y, t * y * z + s * x, t * z * z + c};
     memcpy(R, r, sizeof r);
 }
 
@@ -363,8 +356,7 @@ static void test_mass_box_transformed(void **state)
             maxerr = fmax(maxerr, fabs(I[3 * a + b] - want));
             check_close("box I", I[3 * a + b], want, 1e-11 * 32 * I0[0]);
         }
-    printf("rotated box at distance 100: V error %.2g, I max error %.2g (of %.3g)\n", v - 8 * V0,
-           maxerr, 32 * I0[2]);
+    printf("rotated box at distance 100: V error %.2g, I max error %.2g (of %.3g)\n", v - 8 * V0, maxerr, 32 * I0[2]);
     /* the original is untouched by transforming the copy */
     pfsph_mesh_mass_properties(&m, &v, c, I);
     check_close("orig V", v, V0, 1e-14);
@@ -398,8 +390,8 @@ static void test_mass_sphere(void **state)
         for (int a = 0; a < 3; a++) eI = fmax(eI, fabs(I[4 * a] - Ia) / Ia);
         /* tolerance: the inscribed polyhedron's deficit is below 2 (2 pi / segments)^2 / 3 */
         double tol = 2.0 / 3.0 * (2 * PI / seg) * (2 * PI / seg);
-        printf("sphere segments %3d: %6zu triangles, V rel error %.2e, I rel error %.2e (tol %.2e)\n",
-               seg, m.ntris, ev, eI, tol);
+        printf("sphere segments %3d: %6zu triangles, V rel error %.2e, I rel error %.2e (tol %.2e)\n", seg, m.ntris, ev,
+               eI, tol);
         assert_true(ev > 0 && ev < tol);
         assert_true(eI < tol * 5.0 / 3.0); /* I ~ r^5: 5/3 of the volume's relative deficit */
         for (int a = 0; a < 3; a++) check_close("sphere com", c[a], 0, 1e-12);
@@ -443,7 +435,8 @@ static void test_mass_cylinder(void **state)
                    et = fabs(I[4 * ((axis + 1) % 3)] - Itrc) / Itrc;
             if (axis == 0)
                 printf("cylinder n=%2d: rel errors vs round: V %.2e, I_axis %.2e, I_trans %.2e "
-                       "(tol %.2e)\n", n, ev, ea, et, tol);
+                       "(tol %.2e)\n",
+                       n, ev, ea, et, tol);
             assert_true(ev < tol && ea < 2 * tol && et < 2 * tol);
             pfsph_mesh_free(&m);
         }
@@ -536,8 +529,8 @@ static void tgrid_build(tgrid *g, const double *p, size_t n, double cell)
     assert_non_null(cid);
     for (size_t i = 0; i < n; i++) {
         const double *q = p + 3 * i;
-        cid[i] = ((size_t)tcell(g, q, 2) * (size_t)g->nc[1] + (size_t)tcell(g, q, 1)) *
-                     (size_t)g->nc[0] + (size_t)tcell(g, q, 0);
+        cid[i] = ((size_t)tcell(g, q, 2) * (size_t)g->nc[1] + (size_t)tcell(g, q, 1)) * (size_t)g->nc[0] +
+            (size_t)tcell(g, q, 0);
         g->start[cid[i] + 1]++;
     }
     for (size_t c = 0; c < total; c++) g->start[c + 1] += g->start[c];
@@ -556,15 +549,14 @@ static double tgrid_nearest(const tgrid *g, const double *q, size_t self)
     for (int z = c[2] - 1; z <= c[2] + 1; z++)
         for (int y = c[1] - 1; y <= c[1] + 1; y++)
             for (int x = c[0] - 1; x <= c[0] + 1; x++) {
-                if (x < 0 || y < 0 || z < 0 || x >= g->nc[0] || y >= g->nc[1] || z >= g->nc[2])
-                    continue;
+                if (x < 0 || y < 0 || z < 0 || x >= g->nc[0] || y >= g->nc[1] || z >= g->nc[2]) continue;
                 size_t cc = ((size_t)z * (size_t)g->nc[1] + (size_t)y) * (size_t)g->nc[0] + (size_t)x;
                 for (size_t k = g->start[cc]; k < g->start[cc + 1]; k++) {
                     size_t j = g->idx[k];
                     if (j == self) continue;
                     const double *o = g->p + 3 * j;
-                    double d2 = (o[0] - q[0]) * (o[0] - q[0]) + (o[1] - q[1]) * (o[1] - q[1]) +
-                                (o[2] - q[2]) * (o[2] - q[2]);
+                    double d2 =
+                        (o[0] - q[0]) * (o[0] - q[0]) + (o[1] - q[1]) * (o[1] - q[1]) + (o[2] - q[2]) * (o[2] - q[2]);
                     if (d2 < best) best = d2;
                 }
             }
@@ -580,8 +572,7 @@ static double uni(void)
 
 static double tri_area(const pfsph_mesh *m, size_t t)
 {
-    const double *a = m->v + 3 * m->tri[3 * t], *b = m->v + 3 * m->tri[3 * t + 1],
-                 *c = m->v + 3 * m->tri[3 * t + 2];
+    const double *a = m->v + 3 * m->tri[3 * t], *b = m->v + 3 * m->tri[3 * t + 1], *c = m->v + 3 * m->tri[3 * t + 2];
     double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
     double x = u[1] * w[2] - u[2] * w[1], y = u[2] * w[0] - u[0] * w[2], z = u[0] * w[1] - u[1] * w[0];
     return 0.5 * sqrt(x * x + y * y + z * z);
@@ -637,8 +628,7 @@ static sample_stats check_sampling(const pfsph_mesh *m, double s, const char *na
             b2 = uni();
             if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
         } else { /* corners, edge midpoints, centroid of every triangle */
-            static const double bb[7][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5},
-                                            {1.0 / 3, 1.0 / 3}};
+            static const double bb[7][2] = {{0, 0}, {1, 0}, {0, 1}, {0.5, 0}, {0.5, 0.5}, {0, 0.5}, {1.0 / 3, 1.0 / 3}};
             t = (size_t)(k - nrand) / 7;
             b1 = bb[(k - nrand) % 7][0];
             b2 = bb[(k - nrand) % 7][1];
@@ -652,8 +642,7 @@ static sample_stats check_sampling(const pfsph_mesh *m, double s, const char *na
     st.ratio = (double)n / (area / (s * s * sqrt(3.0) / 2));
     printf("%-12s s=%.3g: %6zu samples (%.2f x hex count A/(s^2 sqrt3/2) = %.0f), max gap %.3f s, "
            "min distance %.3f s, %.3f s\n",
-           name, s, n, st.ratio, area / (s * s * sqrt(3.0) / 2), st.max_gap / s, st.min_dist / s,
-           secs);
+           name, s, n, st.ratio, area / (s * s * sqrt(3.0) / 2), st.max_gap / s, st.min_dist / s, secs);
     if (!(st.max_gap <= 0.75 * s)) fail_msg("%s: hole of %.3f s", name, st.max_gap / s);
     if (!(st.min_dist >= 0.5 * s)) fail_msg("%s: samples %.3f s apart", name, st.min_dist / s);
     if (check_count && !(st.ratio > 0.7 && st.ratio < 1.3))
@@ -673,17 +662,15 @@ static void test_sample_files(void **state)
         double s;
         int count;
     } cases[] = {
-        {"cube.obj", 0.05, 1},      {"cube.obj", 0.3, 0},      {"icosphere.obj", 0.05, 1},
-        {"icosphere.obj", 0.4, 0},  {"lprism.obj", 0.04, 1},   {"lprism.obj", 0.2, 0},
-        {"torus.obj", 0.04, 1},     {"torus.obj", 0.15, 0},
+        {"cube.obj", 0.05, 1},   {"cube.obj", 0.3, 0},   {"icosphere.obj", 0.05, 1}, {"icosphere.obj", 0.4, 0},
+        {"lprism.obj", 0.04, 1}, {"lprism.obj", 0.2, 0}, {"torus.obj", 0.04, 1},     {"torus.obj", 0.15, 0},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         pfsph_mesh m;
         load(&m, cases[k].name, PFSPH_OK, NULL);
         validate(&m, cases[k].name, PFSPH_OK, NULL);
         /* the coarse cases (count not checked) keep their spacing */
-        check_sampling(&m, cases[k].s * (cases[k].count ? vg_scale() : 1.0), cases[k].name,
-                       cases[k].count);
+        check_sampling(&m, cases[k].s * (cases[k].count ? vg_scale() : 1.0), cases[k].name, cases[k].count);
         pfsph_mesh_free(&m);
     }
 }

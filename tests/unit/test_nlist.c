@@ -31,7 +31,8 @@ static void make_set(pfsph_particles *ps, pfsph_grid *g, int dim, int m)
     for (int k = 0; k < (dim == 3 ? m : 1); k++)
         for (int j = 0; j < m; j++)
             for (int i = 0; i < m; i++) {
-                pfsph_real p[3] = {(pfsph_real)(d * (i + 0.3 * lcg_uniform())), (pfsph_real)(d * (j + 0.3 * lcg_uniform())),
+                pfsph_real p[3] = {(pfsph_real)(d * (i + 0.3 * lcg_uniform())),
+                                   (pfsph_real)(d * (j + 0.3 * lcg_uniform())),
                                    dim == 3 ? (pfsph_real)(d * (k + 0.3 * lcg_uniform())) : 0};
                 assert_true(pfsph_particles_push(ps, p, NULL, 0) >= 0);
             }

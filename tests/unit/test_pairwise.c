@@ -28,8 +28,7 @@ typedef struct world {
     double d, h;
 } world;
 
-static void world_init(world *w, int dim, double d, int nphases, const double *rho,
-                       const int *kinds)
+static void world_init(world *w, int dim, double d, int nphases, const double *rho, const int *kinds)
 {
     memset(w, 0, sizeof(*w));
     w->scene = calloc(1, sizeof(pfsph_scene));
@@ -143,7 +142,10 @@ static size_t find(const pfsph_particles *ps, double x, double y, double z)
     for (size_t i = 0; i < ps->n; i++) {
         double dx = ps->x[i] - x, dy = ps->y[i] - y, dz = ps->z[i] - z;
         double r2 = dx * dx + dy * dy + dz * dz;
-        if (r2 < bd) { bd = r2; best = i; }
+        if (r2 < bd) {
+            bd = r2;
+            best = i;
+        }
     }
     return best;
 }
@@ -179,7 +181,11 @@ static void test_two_particles(void **state)
             double r = frac[t] * R;
             /* along a skew direction so that every component is exercised */
             double e[3] = {0.6, 0.8, 0.0};
-            if (dim == 3) { e[0] = 0.48; e[1] = 0.6; e[2] = 0.64; }
+            if (dim == 3) {
+                e[0] = 0.48;
+                e[1] = 0.6;
+                e[2] = 0.64;
+            }
             add(&w.fluid, 0, 0, 0, 0);
             add(&w.fluid, r * e[0], r * e[1], r * e[2], 1);
             world_finish(&w);
@@ -238,9 +244,8 @@ static void test_filter_matrix(void **state)
         for (int b = 0; b < 3; b++) assert_true(T[a][b] == (a == b));
     /* 2D, rotated by 30 degrees: C = R diag(1, 0.2) R^T; normal (small variance) axis kept */
     double c = cos(PI / 6), s = sin(PI / 6);
-    const double r2[3][3] = {{c * c + 0.2 * s * s, (1 - 0.2) * c * s, 0},
-                             {(1 - 0.2) * c * s, s * s + 0.2 * c * c, 0},
-                             {0, 0, 0}};
+    const double r2[3][3] = {
+        {c * c + 0.2 * s * s, (1 - 0.2) * c * s, 0}, {(1 - 0.2) * c * s, s * s + 0.2 * c * c, 0}, {0, 0, 0}};
     pfsph_pairwise_filter_matrix(2, r2, 0.2, 0.5, T);
     double n[2] = {-s, c}, t[2] = {c, s};
     double Tn = n[0] * (T[0][0] * n[0] + T[0][1] * n[1]) + n[1] * (T[1][0] * n[0] + T[1][1] * n[1]);
@@ -308,8 +313,7 @@ static void test_lattice_isotropic(void **state)
                 for (int k = (dim == 3 ? -N : 0); k <= (dim == 3 ? N : 0); k++) {
                     if (kind == 1) /* hexagonal: rows sqrt(3)/2 d apart, odd rows shifted */
                         add(&w.fluid, (i + 0.5 * (abs(j) % 2)) * d, j * d * sqrt(3) / 2, 0, 0);
-                    else
-                        add(&w.fluid, i * d, j * d, k * d, 0);
+                    else add(&w.fluid, i * d, j * d, k * d, 0);
                 }
         world_finish(&w);
         size_t c = find(&w.fluid, 0, 0, 0);
@@ -356,7 +360,11 @@ static void test_half_space(void **state)
                     double dx = i * d, dy = (j + depth) * d, r = hypot(dx, dy);
                     if (r == 0 || r >= R) continue;
                     double wt = pfsph_kernel_w(&kk, (pfsph_real)r);
-                    sw += wt; sx += wt * dx; sy += wt * dy; sxx += wt * dx * dx; syy += wt * dy * dy;
+                    sw += wt;
+                    sx += wt * dx;
+                    sy += wt * dy;
+                    sxx += wt * dx * dx;
+                    syy += wt * dy * dy;
                 }
             double cxx = sxx / sw, cyy = syy / sw;
             if (center == PFSPH_PW_CENTER_MEAN) {
@@ -414,8 +422,7 @@ static void random_cloud(world *w, int dim, int n, int nb)
     double L = dim == 2 ? sqrt((double)n) * d : cbrt((double)n) * d;
     for (int i = 0; i < n; i++)
         add(&w->fluid, urand() * L, urand() * L, dim == 3 ? urand() * L : 0, urand() < 0.6 ? 0 : 1);
-    for (int i = 0; i < nb; i++)
-        add(&w->boundary, urand() * L, -urand() * 3 * d, dim == 3 ? urand() * L : 0, 2);
+    for (int i = 0; i < nb; i++) add(&w->boundary, urand() * L, -urand() * 3 * d, dim == 3 ? urand() * L : 0, 2);
     world_finish(w);
 }
 
@@ -441,7 +448,9 @@ static void test_momentum(void **state)
             }
             double rel = (fabs(sum[0]) + fabs(sum[1]) + fabs(sum[2])) / mag;
             print_message("dim %d, %s: |sum F| / sum |F| = %.3g\n", dim,
-                          mode == 0 ? "filter on, eta 0" : mode == 1 ? "filter off" : "filter on, eta 0.2",
+                          mode == 0       ? "filter on, eta 0"
+                              : mode == 1 ? "filter off"
+                                          : "filter on, eta 0.2",
                           rel);
             /* float storage of each acceleration rounds at ~6e-8 */
             double tol = sizeof(pfsph_real) == 4 ? 2e-6 : 1e-13;
@@ -484,8 +493,7 @@ static void test_brute_force(void **state)
             for (int k = 0; k < 2; k++)
                 for (size_t j = 0; j < sets[k]->n; j++) {
                     if (k == 0 && j == i) continue;
-                    double dx[3] = {(double)w.fluid.x[i] - sets[k]->x[j],
-                                    (double)w.fluid.y[i] - sets[k]->y[j],
+                    double dx[3] = {(double)w.fluid.x[i] - sets[k]->x[j], (double)w.fluid.y[i] - sets[k]->y[j],
                                     (double)w.fluid.z[i] - sets[k]->z[j]};
                     double r = sqrt(dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
                     if (r >= R || r == 0) continue;
@@ -502,8 +510,7 @@ static void test_brute_force(void **state)
             double C[3][3], T[3][3];
             for (int a = 0; a < 3; a++)
                 for (int b = 0; b < 3; b++)
-                    C[a][b] = sxx[a][b] / sw -
-                              (pp->center == PFSPH_PW_CENTER_MEAN ? sx[a] * sx[b] / (sw * sw) : 0);
+                    C[a][b] = sxx[a][b] / sw - (pp->center == PFSPH_PW_CENTER_MEAN ? sx[a] * sx[b] / (sw * sw) : 0);
             pfsph_pairwise_filter_matrix(dim, C, pp->eta, pp->eps_min, T);
             const double got[3] = {w.ctx.ax[i], w.ctx.ay[i], w.ctx.az[i]};
             for (int a = 0; a < 3; a++) {
@@ -555,7 +562,7 @@ static void test_film_eq24(void **state)
         for (int p = 0; p < 3; p++)
             for (int q = 0; q < 3; q++)
                 for (int other = 0; other < 3; other++) { /* j: film particle, liquid, solid */
-                    if (other && q) continue;          /* b is the film particle's only */
+                    if (other && q) continue;             /* b is the film particle's only */
                     world w;
                     world_init(&w, dim, d, 3, rho, kinds);
                     pfsph_pairwise_params *pp = &w.scene->pairwise;
@@ -583,7 +590,8 @@ static void test_film_eq24(void **state)
                     double expect_c;
                     int pj;
                     if (other == 0) {
-                        expect_c = a * b * caa + (a * (1 - b) + (1 - a) * b) * cab + (1 - a) * (1 - b) * cbb; /* Eq. 24 */
+                        expect_c =
+                            a * b * caa + (a * (1 - b) + (1 - a) * b) * cab + (1 - a) * (1 - b) * cbb; /* Eq. 24 */
                         pj = 1;
                     } else if (other == 1) {
                         expect_c = a * caa + (1 - a) * cab;
@@ -595,10 +603,10 @@ static void test_film_eq24(void **state)
                     const pfsph_particles *sj = other == 2 ? &w.boundary : &w.fluid;
                     const size_t jj = other == 2 ? 0 : j;
                     /* the formula in the header, both orders */
-                    const double c_ij = pfsph_film_pair_c((const double (*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film, 1, a,
-                                                          pj, other == 0 ? b : 0, false);
-                    const double c_ji = pfsph_film_pair_c((const double (*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film, pj,
-                                                          other == 0 ? b : 0, 1, a, false);
+                    const double c_ij = pfsph_film_pair_c((const double(*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film,
+                                                          1, a, pj, other == 0 ? b : 0, false);
+                    const double c_ji = pfsph_film_pair_c((const double(*)[PFSPH_MAX_PHASES])pp->c, w.scene->film.film,
+                                                          pj, other == 0 ? b : 0, 1, a, false);
                     assert_true(fabs(c_ij - expect_c) <= 1e-12 * expect_c);
                     assert_true(c_ij == c_ji);
                     const double rr = sqrt(pow(sj->x[jj] - w.fluid.x[i], 2) + pow(sj->y[jj] - w.fluid.y[i], 2) +
@@ -613,14 +621,18 @@ static void test_film_eq24(void **state)
                         maxrel = fmax(maxrel, rel);
                         assert_true(rel <= 1e-5);
                         if (other != 2) { /* action and reaction */
-                            const double Fj = w.ctx.mass[pj] * (k == 0 ? w.ctx.ax[j] : k == 1 ? w.ctx.ay[j] : w.ctx.az[j]);
+                            const double Fj = w.ctx.mass[pj] *
+                                (k == 0       ? w.ctx.ax[j]
+                                     : k == 1 ? w.ctx.ay[j]
+                                              : w.ctx.az[j]);
                             assert_true(fabs(Fi[k] + Fj) <= 1e-6 * fabs(F));
                         }
                     }
                     world_free(&w);
                 }
     print_message("Eq. 24: largest relative force error %.2g over a, b in {0, 0.3, 1}, film-film, film-liquid, "
-                  "film-solid, 2D and 3D\n", maxrel);
+                  "film-solid, 2D and 3D\n",
+                  maxrel);
 }
 
 /* Momentum (filter off or eta 0) and 1 vs 2 threads with two-phase particles: the cloud's
@@ -734,9 +746,10 @@ static void test_density_fused(void **state)
                     }
                 relb = fmax(relb, fabs((double)nd1[i] - s) / s);
             }
-            print_message("dim %d, pair forces %s: nd in the pair walk vs the density pass %.2g, vs O(N^2) in double %.2g "
-                          "(relative, largest); accelerations the same bits, 1 and 2 threads the same bits\n",
-                          dim, on ? "on" : "off", rel, relb);
+            print_message(
+                "dim %d, pair forces %s: nd in the pair walk vs the density pass %.2g, vs O(N^2) in double %.2g "
+                "(relative, largest); accelerations the same bits, 1 and 2 threads the same bits\n",
+                dim, on ? "on" : "off", rel, relb);
             assert_true(rel <= 1e-6);
             assert_true(relb <= 1e-5);
             pfsph_pairwise_destroy(pw);
@@ -752,16 +765,11 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_shape),
-        cmocka_unit_test(test_two_particles),
-        cmocka_unit_test(test_filter_matrix),
-        cmocka_unit_test(test_lattice_isotropic),
-        cmocka_unit_test(test_half_space),
-        cmocka_unit_test(test_momentum),
-        cmocka_unit_test(test_brute_force),
-        cmocka_unit_test(test_create_checks_grid),
-        cmocka_unit_test(test_film_eq24),
-        cmocka_unit_test(test_film_momentum_threads),
+        cmocka_unit_test(test_shape),         cmocka_unit_test(test_two_particles),
+        cmocka_unit_test(test_filter_matrix), cmocka_unit_test(test_lattice_isotropic),
+        cmocka_unit_test(test_half_space),    cmocka_unit_test(test_momentum),
+        cmocka_unit_test(test_brute_force),   cmocka_unit_test(test_create_checks_grid),
+        cmocka_unit_test(test_film_eq24),     cmocka_unit_test(test_film_momentum_threads),
         cmocka_unit_test(test_density_fused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

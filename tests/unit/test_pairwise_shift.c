@@ -87,7 +87,10 @@ static size_t find(const pfsph_particles *ps, double x, double y, double z)
     for (size_t i = 0; i < ps->n; i++) {
         double dx = ps->x[i] - x, dy = ps->y[i] - y, dz = ps->z[i] - z;
         double r2 = dx * dx + dy * dy + dz * dz;
-        if (r2 < bd) { bd = r2; best = i; }
+        if (r2 < bd) {
+            bd = r2;
+            best = i;
+        }
     }
     return best;
 }
@@ -165,8 +168,7 @@ static void test_free_surface(void **state)
     world w;
     world_init(&w, 2, d);
     for (int i = -12; i <= 12; i++)
-        for (int j = -10; j <= 0; j++)
-            add(&w.fluid, i * d + (j == 0 && i == 0 ? 0.2 * d : 0), j * d, 0);
+        for (int j = -10; j <= 0; j++) add(&w.fluid, i * d + (j == 0 && i == 0 ? 0.2 * d : 0), j * d, 0);
     world_finish(&w);
     size_t c = find(&w.fluid, 0.2 * d, 0, 0);
     double g[3];
@@ -179,8 +181,7 @@ static void test_free_surface(void **state)
     p.max_frac = 0.25;
     pfsph_real *s[3];
     shift(&w, &p, 1e-3, s);
-    print_message("shift of the displaced surface particle: (%.3g, %.3g) d\n", s[0][c] / d,
-                  s[1][c] / d);
+    print_message("shift of the displaced surface particle: (%.3g, %.3g) d\n", s[0][c] / d, s[1][c] / d);
     /* the tangential part pulls it back to its site; the normal part is (nearly) removed */
     assert_true(s[0][c] < -1e-4 * d);
     assert_true(s[1][c] <= 0 && fabs(s[1][c]) < 0.2 * fabs(s[0][c])); /* never outwards */
@@ -212,7 +213,8 @@ static void test_cap_wall_velocity(void **state)
     world_init(&w, 2, d);
     /* fluid over a 3-layer wall; one fluid particle pushed to 0.5 d above the wall's top layer */
     for (int i = -10; i <= 10; i++)
-        for (int j = 1; j <= 8; j++) add(&w.fluid, i * d + (i == 0 && j == 1 ? 0.0 : 0), j * d - (i == 0 && j == 1 ? 0.5 * d : 0), 0);
+        for (int j = 1; j <= 8; j++)
+            add(&w.fluid, i * d + (i == 0 && j == 1 ? 0.0 : 0), j * d - (i == 0 && j == 1 ? 0.5 * d : 0), 0);
     for (int i = -14; i <= 14; i++)
         for (int j = -2; j <= 0; j++) add(&w.boundary, i * d, j * d, 0);
     for (size_t i = 0; i < w.fluid.n; i++) w.fluid.vx[i] = (pfsph_real)(0.1 * (double)i);
@@ -227,8 +229,8 @@ static void test_cap_wall_velocity(void **state)
     double y0 = w.fluid.y[c];
     pfsph_real *s[3];
     double smax = shift(&w, &p, 1e-3, s);
-    print_message("largest shift %.4g d (cap %.3g d); particle near the wall moved by %.3g d\n",
-                  smax / d, p.max_frac, (w.fluid.y[c] - y0) / d);
+    print_message("largest shift %.4g d (cap %.3g d); particle near the wall moved by %.3g d\n", smax / d, p.max_frac,
+                  (w.fluid.y[c] - y0) / d);
     assert_true(smax <= p.max_frac * d * (1 + 1e-5));
     assert_true(smax >= 0.99 * p.max_frac * d);
     assert_true(w.fluid.y[c] > y0); /* away from the wall, not into it */
@@ -265,8 +267,8 @@ static void test_oracle_threads(void **state)
     for (size_t i = 0; i < f->n; i += 37) {
         double C = 0, G[3] = {0, 0, 0};
         for (size_t j = 0; j < f->n; j++) {
-            double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j],
-                   dz = (double)f->z[i] - f->z[j], r = sqrt(dx * dx + dy * dy + dz * dz);
+            double dx = (double)f->x[i] - f->x[j], dy = (double)f->y[i] - f->y[j], dz = (double)f->z[i] - f->z[j],
+                   r = sqrt(dx * dx + dy * dy + dz * dz);
             double wv = pfsph_kernel_w(&w.ctx.kern, (pfsph_real)r);
             C += w.ctx.V0 * wv;
             if (j == i || r == 0) continue;
@@ -306,11 +308,10 @@ static void test_oracle_threads(void **state)
 static void test_scene_keys(void **state)
 {
     (void)state;
-    const char *base =
-        "{\"dimension\": 2, \"particle_radius\": 0.005, \"phases\": [{\"name\": \"w\"}],"
-        " \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},"
-        " \"fluid\": [{\"shape\": \"box\", \"min\": [0.1, 0.1], \"max\": [0.2, 0.2]}],"
-        " \"pairwise\": {%s \"coefficients\": [{\"phases\": [\"w\", \"w\"], \"sigma\": 1}]}}";
+    const char *base = "{\"dimension\": 2, \"particle_radius\": 0.005, \"phases\": [{\"name\": \"w\"}],"
+                       " \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},"
+                       " \"fluid\": [{\"shape\": \"box\", \"min\": [0.1, 0.1], \"max\": [0.2, 0.2]}],"
+                       " \"pairwise\": {%s \"coefficients\": [{\"phases\": [\"w\", \"w\"], \"sigma\": 1}]}}";
     struct {
         const char *block;
         int rc;
@@ -318,8 +319,7 @@ static void test_scene_keys(void **state)
     } cases[] = {
         {"", PFSPH_OK, 0, 0.9, 0.05},
         {"\"shifting\": {\"diffusivity\": 0.002},", PFSPH_OK, 0.002, 0.9, 0.05},
-        {"\"shifting\": {\"diffusivity\": 0.002, \"surface\": 0.8, \"max_step\": 0.1},", PFSPH_OK,
-         0.002, 0.8, 0.1},
+        {"\"shifting\": {\"diffusivity\": 0.002, \"surface\": 0.8, \"max_step\": 0.1},", PFSPH_OK, 0.002, 0.8, 0.1},
         {"\"shifting\": {\"diffusivity\": -1},", PFSPH_EINPUT, 0, 0, 0},
         {"\"shifting\": {\"max_step\": 0.5},", PFSPH_EINPUT, 0, 0, 0},
         {"\"shifting\": {\"D\": 0.1},", PFSPH_EINPUT, 0, 0, 0},
@@ -349,10 +349,8 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     omp_set_num_threads(1);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_lattice),
-        cmocka_unit_test(test_free_surface),
-        cmocka_unit_test(test_cap_wall_velocity),
-        cmocka_unit_test(test_oracle_threads),
+        cmocka_unit_test(test_lattice),           cmocka_unit_test(test_free_surface),
+        cmocka_unit_test(test_cap_wall_velocity), cmocka_unit_test(test_oracle_threads),
         cmocka_unit_test(test_scene_keys),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -39,8 +39,7 @@ static double kb_numeric(int dim, double R)
                 double t = (j + 0.5) * (PI / 2) / 400;
                 double rz = r * cos(t);
                 double rx2 = 0.5 * r * r * sin(t) * sin(t);
-                sum += rz * (rz * rz - rx2) * F / r * 2 * PI * r * r * sin(t) * (R / N) *
-                       (PI / 2 / 400);
+                sum += rz * (rz * rz - rx2) * F / r * 2 * PI * r * r * sin(t) * (R / N) * (PI / 2 / 400);
             }
         }
     }
@@ -53,8 +52,8 @@ static void test_lambda(void **state)
     const double R = 0.037;
     for (int dim = 2; dim <= 3; dim++) {
         double lam = pfsph_pairwise_lambda(dim, R), num = kb_numeric(dim, R);
-        print_message("dim %d: lambda = %.6g R^%d (numeric %.6g R^%d)\n", dim,
-                      lam / pow(R, dim + 2), dim + 2, num / pow(R, dim + 2), dim + 2);
+        print_message("dim %d: lambda = %.6g R^%d (numeric %.6g R^%d)\n", dim, lam / pow(R, dim + 2), dim + 2,
+                      num / pow(R, dim + 2), dim + 2);
         assert_true(fabs(lam - num) < 1e-4 * fabs(lam));
         assert_true(lam > 0);
     }
@@ -170,8 +169,7 @@ static void test_temperature_tables(void **state)
             if (!pfsph_pairwise_angle_measured(dim, 0.01))
                 assert_true(fabs(pfsph_pairwise_angle_ratio(dim, 0.01, a) - eq21) < 1e-15);
         }
-        if (pfsph_pairwise_angle_measured(dim, 0.01))
-            assert_true(pfsph_pairwise_angle_ratio(dim, 0.01, 180.0) == 0.0);
+        if (pfsph_pairwise_angle_measured(dim, 0.01)) assert_true(pfsph_pairwise_angle_ratio(dim, 0.01, 180.0) == 0.0);
         double prev = -1;
         for (double a = 179; a >= 20; a -= 1) {
             const double r = pfsph_pairwise_angle_ratio(dim, 0.01, a);
@@ -266,7 +264,9 @@ static void test_parse(void **state)
     assert_int_equal(parse("{\"enabled\": false}", s, &err), PFSPH_OK);
     assert_false(s->pairwise.enabled);
 
-    struct { const char *json, *msg; } bad[] = {
+    struct {
+        const char *json, *msg;
+    } bad[] = {
         {"{\"eta\": 1.5}", "$.pairwise.eta"},
         {"{\"etta\": 0.1}", "did you mean \"eta\""},
         {"{\"center\": \"middle\"}", "$.pairwise.center"},
@@ -277,7 +277,8 @@ static void test_parse(void **state)
         {"{\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"c\": 1, \"sigma\": 2}]}", "exactly one of"},
         {"{\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"c\": -1}]}", "$.pairwise.coefficients[0].c"},
         {"{\"coefficients\": [{\"phases\": [\"water\", \"oil\"], \"c\": 1},"
-         " {\"phases\": [\"oil\", \"water\"], \"c\": 2}]}", "already given"},
+         " {\"phases\": [\"oil\", \"water\"], \"c\": 2}]}",
+         "already given"},
         {"{\"coefficients\": [{\"phases\": [\"wall\", \"water\"], \"sigma\": 0.07}]}", "contact_angle"},
         {"{\"coefficients\": [{\"phases\": [\"oil\", \"water\"], \"contact_angle\": 30}]}", "one fluid and one solid"},
         {"{\"coefficients\": [{\"phases\": [\"wall\", \"water\"], \"contact_angle\": 190}]}", "out of range"},
@@ -303,8 +304,9 @@ static void test_viscosity_correction(void **state)
     pfsph_scene *s = calloc(1, sizeof(*s));
     pfsph_error err = {0};
     for (int on = 0; on <= 1; on++) {
-        const char *pw = on ? "{\"viscosity_correction\": true, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}"
-                            : "{\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}";
+        const char *pw = on
+            ? "{\"viscosity_correction\": true, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}"
+            : "{\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}";
         for (int k = 0; k < 2; k++) {
             assert_int_equal(parse(pw, s, &err), PFSPH_OK);
             s->phases[0].viscosity = k ? 1e-2 : 1e-3; /* above and below what the liquid reaches */
@@ -328,7 +330,7 @@ static void test_scenes(void **state)
     (void)state;
     char path[2048];
     const char *names[] = {"pf_cube_to_sphere.json", "pf_drop_on_plane.json", "pf_three_fluids.json",
-                           "pf_wetting.json", "pf_rising_bubble.json", "pf_square_to_circle_2d.json"};
+                           "pf_wetting.json",        "pf_rising_bubble.json", "pf_square_to_circle_2d.json"};
     pfsph_scene *s = calloc(1, sizeof(*s));
     for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
         snprintf(path, sizeof path, "%s/scenes/%s", tu_source_dir(), names[i]);

@@ -58,14 +58,13 @@ static void write_or_fail(const char *path, const pfsph_particles *ps, const pfs
     if (pfsph_write_vtp(path, ps, o, &err) != PFSPH_OK) fail_msg("%s", err.msg);
 }
 
-static void block(pfsph_particles *ps, double x0, double y0, double z0, int nx, int ny, int nz,
-                  double dx, uint8_t phase, double vx)
+static void block(pfsph_particles *ps, double x0, double y0, double z0, int nx, int ny, int nz, double dx,
+                  uint8_t phase, double vx)
 {
     for (int k = 0; k < nz; k++)
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx; i++) {
-                pfsph_real x[3] = {(pfsph_real)(x0 + i * dx), (pfsph_real)(y0 + j * dx),
-                                   (pfsph_real)(z0 + k * dx)};
+                pfsph_real x[3] = {(pfsph_real)(x0 + i * dx), (pfsph_real)(y0 + j * dx), (pfsph_real)(z0 + k * dx)};
                 pfsph_real v[3] = {(pfsph_real)(vx * i), 0, 0};
                 long id = pfsph_particles_push(ps, x, v, phase);
                 assert_true(id >= 0);
@@ -129,9 +128,9 @@ static void test_render_2d(void **state)
         pfsph_particles_free(&fl);
     }
     assert_int_equal(pfsph_particles_init(&bd, 64), PFSPH_OK);
-    block(&bd, 0.02, 0.02, 0, 49, 1, 1, 0.02, 1, 0);  /* floor */
-    block(&bd, 0.02, 0.04, 0, 1, 48, 1, 0.02, 1, 0);  /* left wall */
-    block(&bd, 0.98, 0.04, 0, 1, 48, 1, 0.02, 1, 0);  /* right wall */
+    block(&bd, 0.02, 0.02, 0, 49, 1, 1, 0.02, 1, 0); /* floor */
+    block(&bd, 0.02, 0.04, 0, 1, 48, 1, 0.02, 1, 0); /* left wall */
+    block(&bd, 0.98, 0.04, 0, 1, 48, 1, 0.02, 1, 0); /* right wall */
     o.aux_name = "volume";
     snprintf(p, sizeof p, "%s/frames/boundary_00000.vtp", run);
     write_or_fail(p, &bd, &o);
@@ -143,8 +142,7 @@ static void test_render_2d(void **state)
     write_or_fail(p, &df, &o);
     pfsph_particles_free(&df);
 
-    pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1,
-                            .quiet = true};
+    pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1, .quiet = true};
     pfsph_error err = {0};
     int count = -1;
     int rc = pfsph_render_run(run, &ro, &count, &err);
@@ -263,8 +261,7 @@ static void test_render_wall_color(void **state)
     write_or_fail(p, &fl, &o);
     pfsph_particles_free(&fl);
     pfsph_particles_free(&bd);
-    pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1,
-                            .quiet = true};
+    pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1, .quiet = true};
     pfsph_error err = {0};
     int count = -1;
     if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
@@ -286,8 +283,9 @@ static void test_render_3d_default_camera(void **state)
 static void test_render_3d_scene_camera(void **state)
 {
     (void)state;
-    run_3d("run3d_cam", ", \"camera\": {\"eye\": [0.5, 1.5, 2.5], \"target\": [0.5, 0.5, 0.5], "
-                        "\"up\": [0, 1, 0], \"fov\": 35, \"width\": 64, \"height\": 64}",
+    run_3d("run3d_cam",
+           ", \"camera\": {\"eye\": [0.5, 1.5, 2.5], \"target\": [0.5, 0.5, 0.5], "
+           "\"up\": [0, 1, 0], \"fov\": 35, \"width\": 64, \"height\": 64}",
            1);
 }
 

@@ -103,8 +103,7 @@ static void test_independence(void **state)
         double cov = sxy / N - sx / N * sy / N;
         double r = cov / sqrt((sxx / N - sx * sx / N / N) * (syy / N - sy * sy / N / N));
         assert_true(fabs(r) < 5 / sqrt((double)N));
-        for (int k = 0; k < 32; k++)
-            assert_true(fabs(agree[k] - N / 2.0) < 5 * sqrt(N / 4.0));
+        for (int k = 0; k < 32; k++) assert_true(fabs(agree[k] - N / 2.0) < 5 * sqrt(N / 4.0));
         /* within one block, the four words are uncorrelated too */
     }
 }

@@ -37,29 +37,28 @@ static void expect_ok(const char *json)
 static void test_full_scene(void **state)
 {
     (void)state;
-    const char *json =
-        "{\"name\":\"t\",\"dimension\":3,\"particle_radius\":0.02,\"support_factor\":2.5,"
-        "\"gravity\":[0,-10,1],\"domain\":{\"min\":[-1,-1,-1],\"max\":[2,3,4]},"
-        "\"solver\":{\"type\":\"wcsph\",\"tolerance\":0.01,\"min_iterations\":2,"
-        "\"max_iterations\":20,\"sound_speed\":30,\"gamma\":3},"
-        "\"time\":{\"end\":2.5,\"fps\":30,\"cfl\":0.3,\"dt_min\":1e-5,\"dt_max\":0.002},"
-        "\"seed\":42,\"threads\":2,"
-        "\"phases\":[{\"name\":\"water\",\"kind\":\"fluid\",\"rest_density\":1000,"
-        "\"viscosity\":1e-4,\"color\":[0.1,0.2,0.3]},"
-        "{\"name\":\"air\",\"kind\":\"gas\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
-        "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.5,0.5,0.5],\"phase\":\"water\","
-        "\"velocity\":[1,0,0]},"
-        "{\"shape\":\"sphere\",\"center\":[1.5,1.5,1.5],\"radius\":0.2,\"phase\":\"air\"},"
-        "{\"shape\":\"cylinder\",\"center\":[1.5,0.5,3],\"radius\":0.1,\"height\":0.4,"
-        "\"axis\":\"z\"}],"
-        "\"solids\":[{\"shape\":\"container\",\"min\":[-0.5,-0.5,-0.5],\"max\":[1.9,2.9,3.9],"
-        "\"open_top\":true,\"layers\":3,\"phase\":\"wall\"},"
-        "{\"shape\":\"plane\",\"point\":[0,-0.9,0],\"normal\":[0,2,0]},"
-        "{\"shape\":\"cylinder\",\"center\":[1,2,1],\"radius\":0.1,\"height\":0.5,\"axis\":\"x\"}],"
-        "\"output\":{\"directory\":\"out/x\",\"formats\":[\"ply\"],\"fields\":[\"id\",\"speed\"],"
-        "\"boundary\":false,\"frame_interval\":2},"
-        "\"camera\":{\"eye\":[0,1,5],\"target\":[0,1,0],\"up\":[0,1,0],\"fov\":50,"
-        "\"width\":640,\"height\":480,\"color_by\":\"speed\"}}";
+    const char *json = "{\"name\":\"t\",\"dimension\":3,\"particle_radius\":0.02,\"support_factor\":2.5,"
+                       "\"gravity\":[0,-10,1],\"domain\":{\"min\":[-1,-1,-1],\"max\":[2,3,4]},"
+                       "\"solver\":{\"type\":\"wcsph\",\"tolerance\":0.01,\"min_iterations\":2,"
+                       "\"max_iterations\":20,\"sound_speed\":30,\"gamma\":3},"
+                       "\"time\":{\"end\":2.5,\"fps\":30,\"cfl\":0.3,\"dt_min\":1e-5,\"dt_max\":0.002},"
+                       "\"seed\":42,\"threads\":2,"
+                       "\"phases\":[{\"name\":\"water\",\"kind\":\"fluid\",\"rest_density\":1000,"
+                       "\"viscosity\":1e-4,\"color\":[0.1,0.2,0.3]},"
+                       "{\"name\":\"air\",\"kind\":\"gas\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
+                       "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.5,0.5,0.5],\"phase\":\"water\","
+                       "\"velocity\":[1,0,0]},"
+                       "{\"shape\":\"sphere\",\"center\":[1.5,1.5,1.5],\"radius\":0.2,\"phase\":\"air\"},"
+                       "{\"shape\":\"cylinder\",\"center\":[1.5,0.5,3],\"radius\":0.1,\"height\":0.4,"
+                       "\"axis\":\"z\"}],"
+                       "\"solids\":[{\"shape\":\"container\",\"min\":[-0.5,-0.5,-0.5],\"max\":[1.9,2.9,3.9],"
+                       "\"open_top\":true,\"layers\":3,\"phase\":\"wall\"},"
+                       "{\"shape\":\"plane\",\"point\":[0,-0.9,0],\"normal\":[0,2,0]},"
+                       "{\"shape\":\"cylinder\",\"center\":[1,2,1],\"radius\":0.1,\"height\":0.5,\"axis\":\"x\"}],"
+                       "\"output\":{\"directory\":\"out/x\",\"formats\":[\"ply\"],\"fields\":[\"id\",\"speed\"],"
+                       "\"boundary\":false,\"frame_interval\":2},"
+                       "\"camera\":{\"eye\":[0,1,5],\"target\":[0,1,0],\"up\":[0,1,0],\"fov\":50,"
+                       "\"width\":640,\"height\":480,\"color_by\":\"speed\"}}";
     expect_ok(json);
     const pfsph_scene *s = &g_scene;
     assert_string_equal(s->name, "t");
@@ -201,15 +200,17 @@ static void test_block_jitter(void **state)
     (void)state;
     pfsph_error err;
     assert_int_equal(parse("{\"particle_radius\":0.01," DOM3 ",\"fluid\":[{\"shape\":\"box\","
-                           "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"jitter\":0.6}]}", &err),
+                           "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"jitter\":0.6}]}",
+                           &err),
                      PFSPH_EINPUT);
     assert_non_null(strstr(err.msg, "$.fluid[0].jitter"));
     static pfsph_scene a;
     pfsph_particles p0, p1, p2;
     const double d = 0.02;
     for (int k = 0; k < 3; k++) {
-        expect_ok(k == 0 ? SCENE3("") : "{\"particle_radius\":0.01," DOM3 ",\"fluid\":[{\"shape\":\"box\","
-                          "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"jitter\":0.25}]}");
+        expect_ok(k == 0 ? SCENE3("")
+                         : "{\"particle_radius\":0.01," DOM3 ",\"fluid\":[{\"shape\":\"box\","
+                           "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"jitter\":0.25}]}");
         a = g_scene;
         pfsph_particles *p = k == 0 ? &p0 : k == 1 ? &p1 : &p2;
         assert_int_equal(pfsph_particles_init(p, 16), PFSPH_OK);
@@ -308,8 +309,7 @@ static void test_default_scene(void **state)
         assert_int_equal(s->blocks[i].shape, PFSPH_SHAPE_BOX);
         double c = 1;
         for (int k = 0; k < 3; k++)
-            c *= floor((s->blocks[i].max[k] - s->blocks[i].min[k]) / (2 * s->particle_radius) +
-                       1e-6);
+            c *= floor((s->blocks[i].max[k] - s->blocks[i].min[k]) / (2 * s->particle_radius) + 1e-6);
         n += c;
     }
     assert_true(n >= 8000 && n <= 15000);
@@ -397,30 +397,25 @@ typedef struct bad_case {
 } bad_case;
 
 static const bad_case bad_cases[] = {
-    {"invalid_json", "{\"dimension\": 3,\n  \"particle_radius\": 0.01,,\n}", "$",
-     "invalid JSON at line 2, column 28"},
+    {"invalid_json", "{\"dimension\": 3,\n  \"particle_radius\": 0.01,,\n}", "$", "invalid JSON at line 2, column 28"},
     {"truncated_json", "{\"dimension\": 3, \"domain\": {\"min\": [0,0,0]", "$", "unexpected end"},
     {"empty_text", "  \n", "$", "empty"},
     {"root_not_object", "[1, 2]", "$", "must be a JSON object"},
     {"unknown_key_top", SCENE3(",\"partcle_radius\":0.01"), "$.partcle_radius",
      "unknown key \"partcle_radius\" (did you mean \"particle_radius\"?)"},
     {"unknown_key_nested", SCENE3(",\"time\":{\"ends\":1}"), "$.time.ends", "did you mean \"end\""},
-    {"unknown_key_far", SCENE3(",\"output\":{\"zzzzzzz\":1}"), "$.output.zzzzzzz",
-     "valid keys: directory"},
-    {"unknown_key_block",
-     "{" DOM3 ",\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"raduis\":0.1}]}",
+    {"unknown_key_far", SCENE3(",\"output\":{\"zzzzzzz\":1}"), "$.output.zzzzzzz", "valid keys: directory"},
+    {"unknown_key_block", "{" DOM3 ",\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"raduis\":0.1}]}",
      "$.fluid[0].raduis", "did you mean \"radius\""},
     {"key_wrong_shape",
      "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],"
      "\"radius\":0.1}]}",
      "$.fluid[0].radius", "unknown key"},
     {"duplicate_key", SCENE3(",\"seed\":1,\"seed\":2"), "$.seed", "duplicate key"},
-    {"wrong_type_number", SCENE3(",\"support_factor\":\"2\""), "$.support_factor",
-     "expected a number, got a string"},
-    {"wrong_type_vector_elem", SCENE3(",\"gravity\":[0,\"down\",0]"), "$.gravity[1]",
-     "expected a number"},
-    {"wrong_vector_length", "{\"domain\":{\"min\":[0,0],\"max\":[1,1,1]}," FLUID3 "}",
-     "$.domain.min", "expected 3 numbers, got 2"},
+    {"wrong_type_number", SCENE3(",\"support_factor\":\"2\""), "$.support_factor", "expected a number, got a string"},
+    {"wrong_type_vector_elem", SCENE3(",\"gravity\":[0,\"down\",0]"), "$.gravity[1]", "expected a number"},
+    {"wrong_vector_length", "{\"domain\":{\"min\":[0,0],\"max\":[1,1,1]}," FLUID3 "}", "$.domain.min",
+     "expected 3 numbers, got 2"},
     {"wrong_vector_length_2d",
      "{\"dimension\":2,\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2]}]}",
@@ -430,14 +425,13 @@ static const bad_case bad_cases[] = {
             "\"open_top\":\"yes\"}]"),
      "$.solids[0].open_top", "expected true or false"},
     {"wrong_type_int", SCENE3(",\"threads\":1.5"), "$.threads", "expected an integer"},
-    {"wrong_type_array", SCENE3(",\"phases\":{\"name\":\"water\"}"), "$.phases",
-     "expected an array"},
+    {"wrong_type_array", SCENE3(",\"phases\":{\"name\":\"water\"}"), "$.phases", "expected an array"},
     {"out_of_range_radius", "{\"particle_radius\":-0.01," DOM3 "," FLUID3 "}", "$.particle_radius",
      "value -0.01 is out of range [1e-05, 10]"},
-    {"out_of_range_density", SCENE3(",\"phases\":[{\"name\":\"w\",\"rest_density\":1e9}]"),
-     "$.phases[0].rest_density", "value 1e+09 is out of range [0.01, 100000]"},
-    {"out_of_range_color", SCENE3(",\"phases\":[{\"name\":\"w\",\"color\":[0,0,2]}]"),
-     "$.phases[0].color[2]", "out of range [0, 1]"},
+    {"out_of_range_density", SCENE3(",\"phases\":[{\"name\":\"w\",\"rest_density\":1e9}]"), "$.phases[0].rest_density",
+     "value 1e+09 is out of range [0.01, 100000]"},
+    {"out_of_range_color", SCENE3(",\"phases\":[{\"name\":\"w\",\"color\":[0,0,2]}]"), "$.phases[0].color[2]",
+     "out of range [0, 1]"},
     {"out_of_range_layers",
      SCENE3(",\"solids\":[{\"shape\":\"container\",\"min\":[0,0,0],\"max\":[1,1,1],"
             "\"layers\":0}]"),
@@ -450,11 +444,9 @@ static const bad_case bad_cases[] = {
      SCENE3(",\"solids\":[{\"shape\":\"container\",\"min\":[0,0,0],\"max\":[1,1,1],"
             "\"phase\":\"steel\"}]"),
      "$.solids[0].phase", "unknown phase \"steel\""},
-    {"duplicate_phase",
-     SCENE3(",\"phases\":[{\"name\":\"water\"},{\"name\":\"oil\"},{\"name\":\"water\"}]"),
+    {"duplicate_phase", SCENE3(",\"phases\":[{\"name\":\"water\"},{\"name\":\"oil\"},{\"name\":\"water\"}]"),
      "$.phases[2].name", "duplicate phase name \"water\""},
-    {"empty_phase_name", SCENE3(",\"phases\":[{\"name\":\"\"}]"), "$.phases[0].name",
-     "must not be empty"},
+    {"empty_phase_name", SCENE3(",\"phases\":[{\"name\":\"\"}]"), "$.phases[0].name", "must not be empty"},
     {"fluid_with_solid_phase",
      "{" DOM3 ",\"phases\":[{\"name\":\"water\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
      "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2],\"phase\":\"wall\"}]}",
@@ -463,8 +455,8 @@ static const bad_case bad_cases[] = {
      SCENE3(",\"solids\":[{\"shape\":\"container\",\"min\":[0,0,0],\"max\":[1,1,1],"
             "\"phase\":\"water\"}]"),
      "$.solids[0].phase", "solids need a phase of kind \"solid\""},
-    {"unknown_kind", SCENE3(",\"phases\":[{\"name\":\"w\",\"kind\":\"liquid\"}]"),
-     "$.phases[0].kind", "unknown value \"liquid\""},
+    {"unknown_kind", SCENE3(",\"phases\":[{\"name\":\"w\",\"kind\":\"liquid\"}]"), "$.phases[0].kind",
+     "unknown value \"liquid\""},
     {"too_many_phases",
      SCENE3(",\"phases\":[{\"name\":\"a\"},{\"name\":\"b\"},{\"name\":\"c\"},{\"name\":\"d\"},"
             "{\"name\":\"e\"},{\"name\":\"f\"},{\"name\":\"g\"},{\"name\":\"h\"},{\"name\":\"i\"},"
@@ -478,25 +470,19 @@ static const bad_case bad_cases[] = {
             "{\"name\":\"o\"},{\"name\":\"p\"}],"
             "\"solids\":[{\"shape\":\"container\",\"min\":[0,0,0],\"max\":[1,1,1]}]"),
      "$.phases", "too many phases"},
-    {"too_many_blocks", NULL /* built at run time */, "$.fluid",
-     "too many entries (1025, at most 1024)"},
-    {"too_many_solids", NULL /* built at run time */, "$.solids",
-     "too many entries (65, at most 64)"},
+    {"too_many_blocks", NULL /* built at run time */, "$.fluid", "too many entries (1025, at most 1024)"},
+    {"too_many_solids", NULL /* built at run time */, "$.solids", "too many entries (65, at most 64)"},
     {"domain_min_ge_max", "{\"domain\":{\"min\":[0,1,0],\"max\":[1,1,1]}," FLUID3 "}", "$.domain",
      "min[1] = 1 must be less than max[1] = 1"},
     {"missing_domain", "{" FLUID3 "}", "$.domain", "missing required key \"domain\""},
     {"missing_fluid", "{" DOM3 "}", "$.fluid", "at least one fluid block"},
-    {"block_outside_domain",
-     "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.5,0.5,0.5],\"max\":[1.5,0.7,0.7]}]}",
+    {"block_outside_domain", "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.5,0.5,0.5],\"max\":[1.5,0.7,0.7]}]}",
      "$.fluid[0].max", "extends outside the domain"},
-    {"block_below_domain",
-     "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.5,-0.5,0.5],\"max\":[0.7,0.7,0.7]}]}",
+    {"block_below_domain", "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.5,-0.5,0.5],\"max\":[0.7,0.7,0.7]}]}",
      "$.fluid[0].min", "extends outside the domain [0, 0, 0] .. [1, 1, 1] along y"},
-    {"sphere_outside_domain",
-     "{" DOM3 ",\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.95,0.5,0.5],\"radius\":0.1}]}",
+    {"sphere_outside_domain", "{" DOM3 ",\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.95,0.5,0.5],\"radius\":0.1}]}",
      "$.fluid[0].center", "extends outside the domain"},
-    {"box_min_ge_max",
-     "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.5,0.5,0.5],\"max\":[0.4,0.7,0.7]}]}",
+    {"box_min_ge_max", "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0.5,0.5,0.5],\"max\":[0.4,0.7,0.7]}]}",
      "$.fluid[0].max", "max[0] = 0.4 must be greater than min[0] = 0.5"},
     /* issue 11: overlapping blocks carve (a later one replaces an earlier one); only an
      * earlier block that later ones cover wholly is refused */
@@ -512,37 +498,30 @@ static const bad_case bad_cases[] = {
      "{" DOM3 ",\"fluid\":[" BOX3 ",{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.1,0.2,0.2]},"
      "{\"shape\":\"box\",\"min\":[0.1,0,0],\"max\":[0.2,0.2,0.2]}]}",
      "$.fluid[0]", "lies inside later blocks"},
-    {"overlap_solid_obstacle",
-     SCENE3(",\"solids\":[{\"shape\":\"sphere\",\"center\":[0.2,0.2,0.2],\"radius\":0.1}]"),
+    {"overlap_solid_obstacle", SCENE3(",\"solids\":[{\"shape\":\"sphere\",\"center\":[0.2,0.2,0.2],\"radius\":0.1}]"),
      "$.fluid[0]", "overlaps the solid $.solids[0]"},
-    {"block_crosses_container",
-     SCENE3(",\"solids\":[{\"shape\":\"container\",\"min\":[0.1,0,0],\"max\":[1,1,1]}]"),
+    {"block_crosses_container", SCENE3(",\"solids\":[{\"shape\":\"container\",\"min\":[0.1,0,0],\"max\":[1,1,1]}]"),
      "$.fluid[0]", "crosses the walls of the container $.solids[0]"},
-    {"empty_box",
-     "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.015,0.2]}]}",
+    {"empty_box", "{" DOM3 ",\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.015,0.2]}]}",
      "$.fluid[0].max", "less than one particle spacing"},
-    {"empty_sphere",
-     "{" DOM3 ",\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"radius\":0.015}]}",
+    {"empty_sphere", "{" DOM3 ",\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"radius\":0.015}]}",
      "$.fluid[0].radius", "less than one particle spacing"},
     {"end_time_zero", SCENE3(",\"time\":{\"end\":0}"), "$.time.end", "must be > 0"},
-    {"end_time_negative", SCENE3(",\"time\":{\"end\":-1}"), "$.time.end",
-     "value -1 is out of range: must be > 0"},
+    {"end_time_negative", SCENE3(",\"time\":{\"end\":-1}"), "$.time.end", "value -1 is out of range: must be > 0"},
     {"fps_zero", SCENE3(",\"time\":{\"fps\":0}"), "$.time.fps", "must be > 0"},
     {"dt_min_gt_dt_max", SCENE3(",\"time\":{\"dt_min\":0.01,\"dt_max\":0.001}"), "$.time.dt_min",
      "dt_min (0.01 s) is greater than dt_max (0.001 s)"},
     {"solver_unknown", SCENE3(",\"solver\":{\"type\":\"iisph\"}"), "$.solver.type",
      "unknown value \"iisph\" (expected one of \"wcsph\", \"pcisph\", \"dfsph\")"},
-    {"solver_pressure_scale", SCENE3(",\"solver\":{\"pressure_scale\":\"water\"}"),
-     "$.solver.pressure_scale", "unknown value"},
-    {"solver_iterations", SCENE3(",\"solver\":{\"min_iterations\":10,\"max_iterations\":5}"),
-     "$.solver.min_iterations", "greater than max_iterations"},
+    {"solver_pressure_scale", SCENE3(",\"solver\":{\"pressure_scale\":\"water\"}"), "$.solver.pressure_scale",
+     "unknown value"},
+    {"solver_iterations", SCENE3(",\"solver\":{\"min_iterations\":10,\"max_iterations\":5}"), "$.solver.min_iterations",
+     "greater than max_iterations"},
     {"dimension_4", "{\"dimension\":4," DOM3 "," FLUID3 "}", "$.dimension", "must be 2 or 3"},
-    {"dimension_string", "{\"dimension\":\"3d\"," DOM3 "," FLUID3 "}", "$.dimension",
-     "must be 2 or 3"},
-    {"shape_unknown", "{" DOM3 ",\"fluid\":[{\"shape\":\"cube\"}]}", "$.fluid[0].shape",
-     "unknown value \"cube\""},
-    {"shape_missing", "{" DOM3 ",\"fluid\":[{\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}]}",
-     "$.fluid[0].shape", "missing required key"},
+    {"dimension_string", "{\"dimension\":\"3d\"," DOM3 "," FLUID3 "}", "$.dimension", "must be 2 or 3"},
+    {"shape_unknown", "{" DOM3 ",\"fluid\":[{\"shape\":\"cube\"}]}", "$.fluid[0].shape", "unknown value \"cube\""},
+    {"shape_missing", "{" DOM3 ",\"fluid\":[{\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}]}", "$.fluid[0].shape",
+     "missing required key"},
     {"cylinder_axis",
      "{" DOM3 ",\"fluid\":[{\"shape\":\"cylinder\",\"center\":[0.5,0.5,0.5],\"radius\":0.1,"
      "\"height\":0.2,\"axis\":\"w\"}]}",
@@ -551,31 +530,25 @@ static const bad_case bad_cases[] = {
      "{\"dimension\":2,\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
      "\"cylinder\",\"center\":[0.5,0.5],\"radius\":0.1,\"height\":0.2}]}",
      "$.fluid[0].height", "not used in 2D"},
-    {"plane_zero_normal",
-     SCENE3(",\"solids\":[{\"shape\":\"plane\",\"point\":[0,0,0],\"normal\":[0,0,0]}]"),
+    {"plane_zero_normal", SCENE3(",\"solids\":[{\"shape\":\"plane\",\"point\":[0,0,0],\"normal\":[0,0,0]}]"),
      "$.solids[0].normal", "must not be zero"},
-    {"solid_outside_domain",
-     SCENE3(",\"solids\":[{\"shape\":\"sphere\",\"center\":[5,5,5],\"radius\":0.1}]"),
+    {"solid_outside_domain", SCENE3(",\"solids\":[{\"shape\":\"sphere\",\"center\":[5,5,5],\"radius\":0.1}]"),
      "$.solids[0]", "outside the domain"},
-    {"output_format", SCENE3(",\"output\":{\"formats\":[\"vtp\",\"bgeo\"]}"), "$.output.formats[1]",
-     "unknown format"},
-    {"output_field", SCENE3(",\"output\":{\"fields\":[\"vorticity\"]}"), "$.output.fields[0]",
-     "unknown field"},
-    {"camera_eye_target", SCENE3(",\"camera\":{\"eye\":[1,1,1],\"target\":[1,1,1]}"),
-     "$.camera.target", "target equals eye"},
-    {"camera_color_by", SCENE3(",\"camera\":{\"color_by\":\"vorticity\"}"), "$.camera.color_by",
-     "unknown value"},
+    {"output_format", SCENE3(",\"output\":{\"formats\":[\"vtp\",\"bgeo\"]}"), "$.output.formats[1]", "unknown format"},
+    {"output_field", SCENE3(",\"output\":{\"fields\":[\"vorticity\"]}"), "$.output.fields[0]", "unknown field"},
+    {"camera_eye_target", SCENE3(",\"camera\":{\"eye\":[1,1,1],\"target\":[1,1,1]}"), "$.camera.target",
+     "target equals eye"},
+    {"camera_color_by", SCENE3(",\"camera\":{\"color_by\":\"vorticity\"}"), "$.camera.color_by", "unknown value"},
     /* The pairwise / diffuse sub-parsers are reached and report with the same format. */
-    {"pairwise_unknown_key", SCENE3(",\"pairwise\":{\"zzzz_bogus\":1}"), "$.pairwise.zzzz_bogus",
-     "unknown key"},
+    {"pairwise_unknown_key", SCENE3(",\"pairwise\":{\"zzzz_bogus\":1}"), "$.pairwise.zzzz_bogus", "unknown key"},
     {"pairwise_not_object", SCENE3(",\"pairwise\":true"), "$.pairwise", "expected an object"},
-    {"diffuse_unknown_key", SCENE3(",\"diffuse\":{\"zzzz_bogus\":1}"), "$.diffuse.zzzz_bogus",
-     "unknown key"},
+    {"diffuse_unknown_key", SCENE3(",\"diffuse\":{\"zzzz_bogus\":1}"), "$.diffuse.zzzz_bogus", "unknown key"},
     {"seed_fraction", SCENE3(",\"seed\":1.5"), "$.seed", "expected an integer"},
     {"huge_number", SCENE3(",\"support_factor\":1e999"), "$.support_factor", "not a finite number"},
-    /* bubbles in air (docs/film.md) */
-#define BUB(b) "{\"particle_radius\":0.01," DOM3 ",\"phases\":[{\"name\":\"soap\"},{\"name\":\"air\",\"kind\":\"gas\"}]," \
-               "\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"radius\":0.1,\"phase\":\"air\",\"bubble\":" b "}]}"
+/* bubbles in air (docs/film.md) */
+#define BUB(b)                                                                                                 \
+    "{\"particle_radius\":0.01," DOM3 ",\"phases\":[{\"name\":\"soap\"},{\"name\":\"air\",\"kind\":\"gas\"}]," \
+    "\"fluid\":[{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],\"radius\":0.1,\"phase\":\"air\",\"bubble\":" b "}]}"
     {"bubble_not_object", BUB("1"), "$.fluid[0].bubble", "expected an object"},
     {"bubble_no_film", BUB("{\"thickness\":0.01}"), "$.fluid[0].bubble.film", "missing required key"},
     {"bubble_film_unknown", BUB("{\"film\":\"soup\",\"thickness\":0.01}"), "$.fluid[0].bubble.film",
@@ -606,10 +579,8 @@ static char *make_many(const char *key, const char *item, int n)
     size_t cap = 256 + (size_t)n * (strlen(item) + 2);
     char *t = malloc(cap);
     assert_non_null(t);
-    size_t len = (size_t)snprintf(t, cap, "{" DOM3 ",%s\"%s\":[",
-                                  strcmp(key, "fluid") ? FLUID3 "," : "", key);
-    for (int i = 0; i < n; i++)
-        len += (size_t)snprintf(t + len, cap - len, "%s%s", i ? "," : "", item);
+    size_t len = (size_t)snprintf(t, cap, "{" DOM3 ",%s\"%s\":[", strcmp(key, "fluid") ? FLUID3 "," : "", key);
+    for (int i = 0; i < n; i++) len += (size_t)snprintf(t + len, cap - len, "%s%s", i ? "," : "", item);
     snprintf(t + len, cap - len, "]}");
     return t;
 }
@@ -620,16 +591,19 @@ static void test_bad(void **state)
     char *owned = NULL;
     const char *json = c->json;
     if (!json && strcmp(c->name, "too_many_blocks") == 0)
-        json = owned = make_many("fluid", "{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],"
-                                          "\"radius\":0.1}", PFSPH_MAX_BLOCKS + 1);
+        json = owned = make_many("fluid",
+                                 "{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],"
+                                 "\"radius\":0.1}",
+                                 PFSPH_MAX_BLOCKS + 1);
     if (!json && strcmp(c->name, "too_many_solids") == 0)
-        json = owned = make_many("solids", "{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],"
-                                           "\"radius\":0.1}", PFSPH_MAX_SOLIDS + 1);
+        json = owned = make_many("solids",
+                                 "{\"shape\":\"sphere\",\"center\":[0.5,0.5,0.5],"
+                                 "\"radius\":0.1}",
+                                 PFSPH_MAX_SOLIDS + 1);
     pfsph_error err;
     int rc = parse(json, &err);
     free(owned);
-    if (rc != PFSPH_EINPUT)
-        fail_msg("%s: expected PFSPH_EINPUT, got %d (%s)", c->name, rc, err.msg);
+    if (rc != PFSPH_EINPUT) fail_msg("%s: expected PFSPH_EINPUT, got %d (%s)", c->name, rc, err.msg);
     assert_int_equal(err.code, PFSPH_EINPUT);
     if (getenv("PFSPH_TEST_VERBOSE")) print_message("%s\n", err.msg);
     char head[256];

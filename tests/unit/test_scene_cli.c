@@ -8,7 +8,7 @@
 #include "testutil.h"
 
 typedef struct cli_case {
-    const char *file;   /* written into the temporary directory */
+    const char *file; /* written into the temporary directory */
     const char *json;
     const char *expect; /* substring of the message after "<path>: " */
 } cli_case;
@@ -60,10 +60,9 @@ static const cli_case cases[] = {
 static void test_check_thermostat(void **state)
 {
     (void)state;
-    const char *fmt =
-        "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_radius\":0.01,"
-        "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],"
-        "\"pairwise\":{%s\"coefficients\":[{\"phases\":[\"water\",\"water\"],\"sigma\":0.0728}]}}";
+    const char *fmt = "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"particle_radius\":0.01,"
+                      "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],"
+                      "\"pairwise\":{%s\"coefficients\":[{\"phases\":[\"water\",\"water\"],\"sigma\":0.0728}]}}";
     char json[1024], path[512], cmd[2048], out[8192];
     snprintf(json, sizeof json, fmt, "");
     snprintf(path, sizeof path, "%s/thermo_on.json", tu_tmpdir());
@@ -118,8 +117,7 @@ static void test_run_bad_writes_nothing(void **state)
     char path[512], dir[600], cmd[2048], out[4096];
     write_case(&cases[0], path, sizeof path);
     snprintf(dir, sizeof dir, "%s/run_new", tu_tmpdir());
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' run '%s' -o '%s' --quiet", tu_tmpdir(),
-             tu_pfsph_bin(), path, dir);
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' run '%s' -o '%s' --quiet", tu_tmpdir(), tu_pfsph_bin(), path, dir);
     int st = tu_run(cmd, out, sizeof out);
     if (st != 2) fail_msg("exit status %d, expected 2; output: %s", st, out);
     struct stat sb;
@@ -153,9 +151,11 @@ static void test_run_end_overflow(void **state)
     (void)state;
     char path[512], dir[600], cmd[2048], out[4096];
     snprintf(path, sizeof path, "%s/small.json", tu_tmpdir());
-    assert_int_equal(tu_write_file(path, "{\"dimension\":2,\"particle_radius\":0.02,"
-                                         "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
-                                         "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"), 0);
+    assert_int_equal(tu_write_file(path,
+                                   "{\"dimension\":2,\"particle_radius\":0.02,"
+                                   "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
+                                   "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"),
+                     0);
     static const char *const ends[] = {"1e10", "inf", "nan", "1e300", "-1", ""};
     for (size_t i = 0; i < sizeof ends / sizeof ends[0]; i++) {
         snprintf(dir, sizeof dir, "%s/end_run_%zu", tu_tmpdir(), i);
@@ -172,12 +172,11 @@ static void test_run_end_overflow(void **state)
 static void test_check_good(void **state)
 {
     (void)state;
-    static const char *const scenes[] = {"dam_break_2d", "dam_break_3d", "dam_break_cylinder_3d",
-                                         "hydrostatic_tank_2d", "hydrostatic_tank_3d"};
+    static const char *const scenes[] = {"dam_break_2d", "dam_break_3d", "dam_break_cylinder_3d", "hydrostatic_tank_2d",
+                                         "hydrostatic_tank_3d"};
     for (size_t i = 0; i < sizeof scenes / sizeof scenes[0]; i++) {
         char cmd[2048], out[8192];
-        snprintf(cmd, sizeof cmd, "'%s' check '%s/scenes/%s.json'", tu_pfsph_bin(),
-                 tu_source_dir(), scenes[i]);
+        snprintf(cmd, sizeof cmd, "'%s' check '%s/scenes/%s.json'", tu_pfsph_bin(), tu_source_dir(), scenes[i]);
         int st = tu_run(cmd, out, sizeof out);
         if (st != 0) fail_msg("%s: exit status %d; output: %s", scenes[i], st, out);
     }
@@ -185,11 +184,13 @@ static void test_check_good(void **state)
 
 /* Issue 15 item 12: messages that name the JSON path, the right exit status, escaped bytes,
  * the verdict of `pfsph check` last. */
-#define BASE3 "\"dimension\":3,\"particle_radius\":0.02,\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]}," \
-              "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}]"
-#define BODY "\"phases\":[{\"name\":\"water\"},{\"name\":\"s\",\"kind\":\"solid\"}],\"bodies\":[{\"name\":\"b\"," \
-             "\"shape\":\"box\",\"half_extents\":[0.05,0.05,0.05],\"position\":[0.8,0.8,0.8],\"phase\":\"s\"}," \
-             "{\"name\":\"m\",\"shape\":\"mesh\",\"file\":\"%s\",\"phase\":\"s\",\"position\":[0.5,0.5,0.5]}]"
+#define BASE3                                                                                \
+    "\"dimension\":3,\"particle_radius\":0.02,\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]}," \
+    "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}]"
+#define BODY                                                                                             \
+    "\"phases\":[{\"name\":\"water\"},{\"name\":\"s\",\"kind\":\"solid\"}],\"bodies\":[{\"name\":\"b\"," \
+    "\"shape\":\"box\",\"half_extents\":[0.05,0.05,0.05],\"position\":[0.8,0.8,0.8],\"phase\":\"s\"},"   \
+    "{\"name\":\"m\",\"shape\":\"mesh\",\"file\":\"%s\",\"phase\":\"s\",\"position\":[0.5,0.5,0.5]}]"
 
 static int cli(const char *args, char *out, size_t cap)
 {
@@ -235,7 +236,8 @@ static void test_messages(void **state)
     snprintf(args, sizeof args, "check '%s/bytes.json'", tu_tmpdir());
     cli(args, out, sizeof out);
     for (const char *c = out; *c; c++)
-        if ((unsigned char)*c == 0x1b || (unsigned char)*c >= 0x80) fail_msg("raw byte 0x%02x in: %s", (unsigned char)*c, out);
+        if ((unsigned char)*c == 0x1b || (unsigned char)*c >= 0x80)
+            fail_msg("raw byte 0x%02x in: %s", (unsigned char)*c, out);
     expect("garbage.json", "\x01\x02\x9b\x1b]0;title\x07", "check '%s'", 2, "near \"\\x9b\\x1b]0;title\\x07\"");
     /* an output directory that is a file: bad input, exit 2, the JSON path named */
     char file[700];
@@ -294,14 +296,13 @@ static void test_no_boundary_bodies(void **state)
     (void)state;
     char path[600], args[2048], out[8192], dir[700], b[800];
     struct stat sb;
-    const char *json =
-        "{\"dimension\":2,\"particle_radius\":0.02,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
-        "\"time\":{\"end\":0.08},\"phases\":[{\"name\":\"w\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
-        "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}],"
-        "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[0.8,0.8],\"phase\":\"wall\"}],"
-        "\"bodies\":[{\"name\":\"crate\",\"shape\":\"box\",\"half_extents\":[0.05,0.05],"
-        "\"position\":[0.5,0.3],\"phase\":\"wall\"}],"
-        "\"output\":{\"formats\":[\"vtp\",\"ply\"],\"boundary\":%s,\"checkpoint_interval\":1}}";
+    const char *json = "{\"dimension\":2,\"particle_radius\":0.02,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
+                       "\"time\":{\"end\":0.08},\"phases\":[{\"name\":\"w\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
+                       "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}],"
+                       "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[0.8,0.8],\"phase\":\"wall\"}],"
+                       "\"bodies\":[{\"name\":\"crate\",\"shape\":\"box\",\"half_extents\":[0.05,0.05],"
+                       "\"position\":[0.5,0.3],\"phase\":\"wall\"}],"
+                       "\"output\":{\"formats\":[\"vtp\",\"ply\"],\"boundary\":%s,\"checkpoint_interval\":1}}";
     for (int on = 0; on < 2; on++) {
         char text[2048];
         snprintf(text, sizeof text, json, on ? "true" : "false");
@@ -335,8 +336,9 @@ static void test_help(void **state)
     } cases[] = {
         {"--help", {"run ", "check ", "render ", "help ", "--version", "Exit status", NULL}},
         {"help", {"run ", "check ", "render ", NULL}},
-        {"run --help", {"usage: pfsph run", "-o, --output DIR", "--force ", "--resume RUN_DIR ", "--threads N ",
-                        "0 = the default", "--end T ", "--render ", "--quiet ", NULL}},
+        {"run --help",
+         {"usage: pfsph run", "-o, --output DIR", "--force ", "--resume RUN_DIR ", "--threads N ", "0 = the default",
+          "--end T ", "--render ", "--quiet ", NULL}},
         {"run -h", {"usage: pfsph run", NULL}},
         {"help run", {"usage: pfsph run", NULL}},
         {"check --help", {"usage: pfsph check", "verdict", NULL}},
@@ -353,9 +355,11 @@ static void test_help(void **state)
     assert_int_equal(cli("help nosuch", out, sizeof out), 2);
     char path[600], args[2048];
     snprintf(path, sizeof path, "%s/threads0.json", tu_tmpdir());
-    assert_int_equal(tu_write_file(path, "{\"dimension\":2,\"particle_radius\":0.02,\"time\":{\"end\":0.04},"
-                                         "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
-                                         "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"), 0);
+    assert_int_equal(tu_write_file(path,
+                                   "{\"dimension\":2,\"particle_radius\":0.02,\"time\":{\"end\":0.04},"
+                                   "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
+                                   "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"),
+                     0);
     snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads 0", path, tu_tmpdir());
     assert_int_equal(cli(args, out, sizeof out), 0);
     snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads -1", path, tu_tmpdir());

@@ -13,7 +13,6 @@
 
 static const double PI = 3.14159265358979323846;
 
-
 /* A small 2D drop resting on a plate: no gravity and no viscosity, so that a fluid particle's
  * non-pressure acceleration is its pair force alone. */
 static const char *SCENE =
@@ -192,7 +191,8 @@ static const char *BODIES =
     "   \"phase\": \"wall\"}],"
     " \"bodies\": [{\"name\": \"paddle\", \"shape\": \"box\", \"half_extents\": [0.02, 0.04], \"position\": [0.1, 0.2],"
     "   \"kinematic\": true, \"phase\": \"wood\"},"
-    "  {\"name\": \"block\", \"shape\": \"box\", \"half_extents\": [0.03, 0.02], \"position\": [0.3, 0.2], \"phase\": \"wood\"}]}";
+    "  {\"name\": \"block\", \"shape\": \"box\", \"half_extents\": [0.03, 0.02], \"position\": [0.3, 0.2], \"phase\": "
+    "\"wood\"}]}";
 
 static void test_drag(void **state)
 {
@@ -303,8 +303,8 @@ static void test_drag_dynamic(void **state)
     const double sag = g / (w * w);
     double ex = bs.x[0] - target[0], ey = bs.x[1] - (target[1] - sag);
     print_message("dynamic block held at %.6f %.6f (target %.3f %.3f, predicted sag %.5f m): off by %.2e m, speed "
-                  "%.2e m/s; top speed %.3f m/s (cap %.3f)\n", bs.x[0], bs.x[1], target[0], target[1], sag,
-                  hypot(ex, ey), hypot(bs.v[0], bs.v[1]), vtop, vcap);
+                  "%.2e m/s; top speed %.3f m/s (cap %.3f)\n",
+                  bs.x[0], bs.x[1], target[0], target[1], sag, hypot(ex, ey), hypot(bs.v[0], bs.v[1]), vtop, vcap);
     assert_true(hypot(ex, ey) < 1e-4);
     assert_true(hypot(bs.v[0], bs.v[1]) < 1e-3);
     assert_true(vtop > 0.3 * fmin(vcap, 0.37 * w * 0.078)); /* it did move at speed */
@@ -314,8 +314,8 @@ static void test_drag_dynamic(void **state)
     while (pfsph_sim_time(sim) < t1 + 0.05) step(sim);
     pfsph_bodies_get_state(B, 0, &bs);
     double fall = -(bs.v[1] - vy1), want = g * (pfsph_sim_time(sim) - t1);
-    print_message("released: vertical speed grew by %.4f m/s in %.4f s (g t = %.4f)\n", fall,
-                  pfsph_sim_time(sim) - t1, want);
+    print_message("released: vertical speed grew by %.4f m/s in %.4f s (g t = %.4f)\n", fall, pfsph_sim_time(sim) - t1,
+                  want);
     assert_true(fabs(fall - want) < 0.01 * want);
     pfsph_sim_destroy(sim);
     free(sc);

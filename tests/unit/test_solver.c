@@ -62,8 +62,8 @@ static void dt_limits(void **state)
     memset(&c, 0, sizeof c);
     c.dim = 2;
     c.spacing = 0.02f;
-    pfsph_solver_config cfg = {.sound_speed = 20, .c_fast = 30, .gamma = 7, .tolerance = 0.005,
-                               .min_iter = 3, .max_iter = 50, .cfl = 0.4};
+    pfsph_solver_config cfg = {
+        .sound_speed = 20, .c_fast = 30, .gamma = 7, .tolerance = 0.005, .min_iter = 3, .max_iter = 50, .cfl = 0.4};
     pfsph_error err;
     const double d = (double)c.spacing, v = 2, a = 9.81, anp = 4;
     void *w = NULL, *p = NULL;

@@ -121,7 +121,7 @@ static void classify(const world *w, const bool *occ, int *cls)
                 if (id < 0 || !occ[sidx(i, j, k)]) continue;
 #define O(a, b, c) ((a) >= -N && (a) < N && (b) >= -N && (b) < N && (c) >= -N && (c) < N && occ[sidx(a, b, c)])
                 bool outer = !O(i + 1, j, k) || !O(i - 1, j, k) || !O(i, j + 1, k) || !O(i, j - 1, k) ||
-                             (dim == 3 && (!O(i, j, k + 1) || !O(i, j, k - 1)));
+                    (dim == 3 && (!O(i, j, k + 1) || !O(i, j, k - 1)));
                 bool full = true;
                 const int r = 2, rz = dim == 3 ? 2 : 0;
                 for (int c = -rz; c <= rz && full; c++)
@@ -163,8 +163,7 @@ static tally compare(const world *w, const int *cls, const uint8_t *layer, int L
 
 /* Detect two layers and compare each with geometry. max_per100: allowed mistakes per hundred
  * outer particles. */
-static void check_shape(const char *name, int dim, shape_fn in, const double *par, double jitter,
-                        double max_per100)
+static void check_shape(const char *name, int dim, shape_fn in, const double *par, double jitter, double max_per100)
 {
     world *w = malloc(sizeof *w);
     assert_non_null(w);
@@ -198,8 +197,8 @@ static void check_shape(const char *name, int dim, shape_fn in, const double *pa
     print_message("%-22s %5zu particles, jitter %.2f d: layer 1: %4d outer, %3d missed, %3d flagged inside "
                   "the band, %d deep interior flagged (%.2f mistakes per 100, bound %.1f); layer 2: %4d, %3d "
                   "missed, %3d flagged in its band, %d deep flagged (%.2f per 100)\n",
-                  name, n, jitter, t1.outer, t1.missed, t1.band_flagged, t1.deep_flagged, m1, max_per100,
-                  t2.outer, t2.missed, t2.band_flagged, t2.deep_flagged, m2);
+                  name, n, jitter, t1.outer, t1.missed, t1.band_flagged, t1.deep_flagged, m1, max_per100, t2.outer,
+                  t2.missed, t2.band_flagged, t2.deep_flagged, m2);
     assert_int_equal(t1.deep_flagged, 0);
     assert_int_equal(t2.deep_flagged, 0);
     assert_true(m1 <= max_per100);
@@ -285,8 +284,8 @@ static void test_walls_and_groups(void **state)
     for (size_t i = 0; i < n; i++)
         if (w->fluid.y[i] < (pfsph_real)(-3 * w->d) && fabs((double)w->fluid.x[i]) < 6 * w->d)
             bottom_without += L[i] == 1;
-    print_message("bottom row away from the corners: %d particles, %d flagged over a wall, %d without it\n",
-                  nbottom, bottom_with, bottom_without);
+    print_message("bottom row away from the corners: %d particles, %d flagged over a wall, %d without it\n", nbottom,
+                  bottom_with, bottom_without);
     assert_true(nbottom > 0);
     assert_int_equal(bottom_with, 0);
     assert_int_equal(bottom_without, nbottom);
@@ -308,8 +307,8 @@ static void test_walls_and_groups(void **state)
     int seam_one = 0;
     for (size_t i = 0; i < n; i++)
         if (fabs((double)w->fluid.x[i]) < w->d && fabs((double)w->fluid.y[i]) < 2.5 * w->d) seam_one += L[i] == 1;
-    print_message("seam between two groups: %d particles, %d flagged as two groups, %d as one\n", seam,
-                  seam_flagged, seam_one);
+    print_message("seam between two groups: %d particles, %d flagged as two groups, %d as one\n", seam, seam_flagged,
+                  seam_one);
     assert_true(seam > 0);
     assert_int_equal(seam_flagged, seam);
     assert_int_equal(seam_one, 0);
@@ -323,7 +322,6 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_lattice_2d), cmocka_unit_test(test_lattice_3d),
-                                       cmocka_unit_test(test_jittered),
-                                       cmocka_unit_test(test_walls_and_groups)};
+                                       cmocka_unit_test(test_jittered), cmocka_unit_test(test_walls_and_groups)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

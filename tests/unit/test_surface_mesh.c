@@ -64,7 +64,7 @@ static double volume(const pfsph_surface_mesh *m)
         const double *a = m->v + 3 * m->tri[3 * t], *b = m->v + 3 * m->tri[3 * t + 1],
                      *c = m->v + 3 * m->tri[3 * t + 2];
         v += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-             a[2] * (b[0] * c[1] - b[1] * c[0]);
+            a[2] * (b[0] * c[1] - b[1] * c[0]);
     }
     return v / 6;
 }
@@ -112,8 +112,8 @@ static void test_sphere(void **state)
     double vol = volume(&m), vs = 4.0 / 3.0 * PI * R * R * R, dmax = 0, dsum = 0;
     for (size_t i = 0; i < m.nverts; i++) {
         const double *v = m.v + 3 * i;
-        double dr = fabs(sqrt((v[0] - c[0]) * (v[0] - c[0]) + (v[1] - c[1]) * (v[1] - c[1]) +
-                              (v[2] - c[2]) * (v[2] - c[2])) - R);
+        double dr = fabs(
+            sqrt((v[0] - c[0]) * (v[0] - c[0]) + (v[1] - c[1]) * (v[1] - c[1]) + (v[2] - c[2]) * (v[2] - c[2])) - R);
         dsum += dr;
         if (dr > dmax) dmax = dr;
     }
@@ -263,8 +263,8 @@ static void test_far_drop(void **state)
         k++;
     }
     assert_int_equal(k, a.nverts);
-    printf("far drop: %zu + %zu particles, the sphere's %zu vertices unchanged, the drop's %zu\n", n0, n - n0,
-           a.nverts, b.nverts - a.nverts);
+    printf("far drop: %zu + %zu particles, the sphere's %zu vertices unchanged, the drop's %zu\n", n0, n - n0, a.nverts,
+           b.nverts - a.nverts);
     pfsph_surface_mesh_free(&a);
     pfsph_surface_mesh_free(&b);
     free(x);
@@ -384,12 +384,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sphere),
-        cmocka_unit_test(test_box),
-        cmocka_unit_test(test_two_drops),
-        cmocka_unit_test(test_threads),
-        cmocka_unit_test(test_far_drop),
-        cmocka_unit_test(test_contour_2d),
+        cmocka_unit_test(test_sphere),  cmocka_unit_test(test_box),      cmocka_unit_test(test_two_drops),
+        cmocka_unit_test(test_threads), cmocka_unit_test(test_far_drop), cmocka_unit_test(test_contour_2d),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -12,13 +12,12 @@
 
 static pfsph_scene g_scene;
 
-static const char *SCENE =
-    "{\"dimension\":2,\"particle_radius\":0.01,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
-    "\"phases\":[{\"name\":\"w\",\"viscosity\":0.001}],"
-    "\"fluid\":[{\"shape\":\"box\",\"min\":[0.2,0.2],\"max\":[0.4,0.4]}],"
-    "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[0.8,0.8]%s},"
-    "{\"shape\":\"sphere\",\"center\":[0.6,0.3],\"radius\":0.05%s},"
-    "{\"shape\":\"box\",\"min\":[0.5,0.6],\"max\":[0.7,0.7]%s}]}";
+static const char *SCENE = "{\"dimension\":2,\"particle_radius\":0.01,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
+                           "\"phases\":[{\"name\":\"w\",\"viscosity\":0.001}],"
+                           "\"fluid\":[{\"shape\":\"box\",\"min\":[0.2,0.2],\"max\":[0.4,0.4]}],"
+                           "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[0.8,0.8]%s},"
+                           "{\"shape\":\"sphere\",\"center\":[0.6,0.3],\"radius\":0.05%s},"
+                           "{\"shape\":\"box\",\"min\":[0.5,0.6],\"max\":[0.7,0.7]%s}]}";
 
 static int parse3(const char *a, const char *b, const char *c, pfsph_error *err)
 {
@@ -40,7 +39,8 @@ static void test_keys(void **state)
     static const struct {
         const char *key, *path, *msg;
     } bad[] = {
-        {",\"slip\":\"partial\"", "$.solids[1].slip", "unknown value \"partial\" (expected one of \"no-slip\", \"free-slip\")"},
+        {",\"slip\":\"partial\"", "$.solids[1].slip",
+         "unknown value \"partial\" (expected one of \"no-slip\", \"free-slip\")"},
         {",\"slip\":true", "$.solids[1].slip", "expected a string"},
         {",\"viscosity\":-1", "$.solids[1].viscosity", "out of range"},
         {",\"viscosity\":1000", "$.solids[1].viscosity", "out of range"},
@@ -61,7 +61,8 @@ static void test_wall_models(void **state)
 {
     (void)state;
     pfsph_error err;
-    assert_int_equal(parse3(",\"slip\":\"free-slip\"", ",\"viscosity\":0.004", ",\"slip\":\"free-slip\"", &err), PFSPH_OK);
+    assert_int_equal(parse3(",\"slip\":\"free-slip\"", ",\"viscosity\":0.004", ",\"slip\":\"free-slip\"", &err),
+                     PFSPH_OK);
     pfsph_sim *sim = NULL;
     assert_int_equal(pfsph_sim_create(&sim, &g_scene, &err), PFSPH_OK);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);

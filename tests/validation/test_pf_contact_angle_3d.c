@@ -94,8 +94,8 @@ static double drop_angle(const pfsph_ctx *c, int q)
             for (int col = a; col < 5; col++) A[r][col] -= fct * A[a][col];
         }
     }
-    const double xc = -0.5 * A[0][4] / A[0][0], yc = -0.5 * A[1][4] / A[1][1],
-                 zc = -0.5 * A[2][4] / A[2][2], e = A[3][4] / A[3][3];
+    const double xc = -0.5 * A[0][4] / A[0][0], yc = -0.5 * A[1][4] / A[1][1], zc = -0.5 * A[2][4] / A[2][2],
+                 e = A[3][4] / A[3][3];
     const double R = sqrt(xc * xc + yc * yc + zc * zc - e) + 0.5 * d;
     double cs = -yc / R;
     if (cs < -1) cs = -1;
@@ -110,23 +110,20 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     const double HALF = getenv("PF_HALF") ? atof(getenv("PF_HALF")) : 0.03;
     const double K = getenv("PF_K") ? atof(getenv("PF_K")) : 1.7;
     char json[8192];
-    int len = snprintf(
-        json, sizeof json,
-        "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": 0.005, \"gravity\": [0, 0, 0],"
-        " \"domain\": {\"min\": [-0.05, -0.1, %g], \"max\": [%g, 0.3, %g]},"
-        " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"dt_max\": 0.002},"
-        " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}",
-        getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 11, -0.5 * PITCH - 0.05, nd * PITCH + 0.05,
-        0.5 * PITCH + 0.05, getenv("PF_NU") ? getenv("PF_NU") : "0.001");
+    int len = snprintf(json, sizeof json,
+                       "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": 0.005, \"gravity\": [0, 0, 0],"
+                       " \"domain\": {\"min\": [-0.05, -0.1, %g], \"max\": [%g, 0.3, %g]},"
+                       " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"dt_max\": 0.002},"
+                       " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}",
+                       getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 11, -0.5 * PITCH - 0.05, nd * PITCH + 0.05,
+                       0.5 * PITCH + 0.05, getenv("PF_NU") ? getenv("PF_NU") : "0.001");
     for (int q = 0; q < nd; q++)
-        len += snprintf(json + len, sizeof json - (size_t)len,
-                        ", {\"name\": \"p%d\", \"kind\": \"solid\"}", q);
+        len += snprintf(json + len, sizeof json - (size_t)len, ", {\"name\": \"p%d\", \"kind\": \"solid\"}", q);
     len += snprintf(json + len, sizeof json - (size_t)len, "], \"fluid\": [");
     for (int q = 0; q < nd; q++)
         len += snprintf(json + len, sizeof json - (size_t)len,
-                        "%s{\"shape\": \"box\", \"min\": [%g, 0, %g], \"max\": [%g, %g, %g]}",
-                        q ? ", " : "", q * PITCH + 0.5 * PITCH - HALF, -HALF,
-                        q * PITCH + 0.5 * PITCH + HALF, 2 * HALF, HALF);
+                        "%s{\"shape\": \"box\", \"min\": [%g, 0, %g], \"max\": [%g, %g, %g]}", q ? ", " : "",
+                        q * PITCH + 0.5 * PITCH - HALF, -HALF, q * PITCH + 0.5 * PITCH + HALF, 2 * HALF, HALF);
     len += snprintf(json + len, sizeof json - (size_t)len, "], \"solids\": [");
     for (int q = 0; q < nd; q++)
         len += snprintf(json + len, sizeof json - (size_t)len,
@@ -141,8 +138,8 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     const double caa = 4.0 / (pfsph_pairwise_sigma_factor(3, 0.01) * pfsph_pairwise_lambda(3, K * 0.02) * 1e6);
     for (int q = 0; q < nd; q++)
         if (ratio)
-            len += snprintf(json + len, sizeof json - (size_t)len,
-                            ", {\"phases\": [\"water\", \"p%d\"], \"c\": %.9g}", q, ratio[q] * caa);
+            len += snprintf(json + len, sizeof json - (size_t)len, ", {\"phases\": [\"water\", \"p%d\"], \"c\": %.9g}",
+                            q, ratio[q] * caa);
         else
             len += snprintf(json + len, sizeof json - (size_t)len,
                             ", {\"phases\": [\"water\", \"p%d\"], \"contact_angle\": %g}", q, target[q]);
@@ -153,7 +150,8 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     pfsph_error err = {0};
     int rc;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
-    print_message("%zu fluid particles, %zu boundary particles\n", c->fluid->n, c->boundary ? c->boundary->n : (size_t)0);
+    print_message("%zu fluid particles, %zu boundary particles\n", c->fluid->n,
+                  c->boundary ? c->boundary->n : (size_t)0);
     const double t_avg = getenv("PF_TAVG") ? atof(getenv("PF_TAVG")) : 0.5 * t_end;
     double sum[MAXDROP] = {0}, sum2[MAXDROP] = {0}, th[MAXDROP], low[MAXDROP];
     int cnt[MAXDROP] = {0};
@@ -182,8 +180,8 @@ static void run(const double *target, const double *ratio, int nd, double t_end,
     for (int q = 0; q < nd; q++) {
         assert_true(cnt[q] > 0);
         const double mean = sum[q] / cnt[q], sd = sqrt(fmax(0, sum2[q] / cnt[q] - mean * mean));
-        print_message("target %5.1f deg%s: measured %6.1f deg (sd %.1f over %d samples, %.2f-%.2f s)\n",
-                      target[q], ratio ? " (Eq. 21 of the ratio)" : "", mean, sd, cnt[q], t_avg, t_end);
+        print_message("target %5.1f deg%s: measured %6.1f deg (sd %.1f over %d samples, %.2f-%.2f s)\n", target[q],
+                      ratio ? " (Eq. 21 of the ratio)" : "", mean, sd, cnt[q], t_avg, t_end);
         th[q] = mean;
     }
     for (int q = 0; q < nd; q++) assert_true(low[q] < 1.0);

@@ -55,8 +55,7 @@ static void create_drop(drop *dr)
     char json[2048], thermo[96] = "", tol[64] = "";
     if (getenv("PF_TOL")) snprintf(tol, sizeof tol, ", \"tolerance\": %s", getenv("PF_TOL"));
     if (getenv("PF_THETA"))
-        snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},",
-                 getenv("PF_THETA"));
+        snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},", getenv("PF_THETA"));
     snprintf(json, sizeof json,
              "{\"dimension\": 2, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0],"
              " \"domain\": {\"min\": [-1, -1], \"max\": [1, 1]},"
@@ -169,8 +168,8 @@ static void test_laplace(void **state)
     for (int i = 0; i < nr; i++) x[i] = 1.0 / dr[i].Re, y[i] = dr[i].p, Rmax = fmax(Rmax, dr[i].Re);
     const tu_line fit = tu_line_fit(nr, x, y);
     const double slope = fit.slope, icpt = fit.icpt, r2 = fit.r2;
-    print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n",
-                  slope, slope / SIGMA, icpt, 0.25 * SIGMA / Rmax, r2);
+    print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n", slope, slope / SIGMA,
+                  icpt, 0.25 * SIGMA / Rmax, r2);
 #ifndef __SANITIZE_ADDRESS__
     assert_true(fabs(slope / SIGMA - 1) <= 0.15);
     assert_true(fabs(icpt) <= 0.25 * SIGMA / Rmax);

@@ -53,20 +53,18 @@ static void create_drop(drop *dr)
     const double d = 0.01;
     char json[2048], thermo[96] = "";
     if (getenv("PF_THETA"))
-        snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},",
-                 getenv("PF_THETA"));
-    snprintf(json, sizeof json,
-             "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0, 0],"
-             " \"domain\": {\"min\": [-1, -1, -1], \"max\": [1, 1, 1]},"
-             " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": 0.002},"
-             " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.001}],"
-             " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0, 0], \"radius\": %g}],"
-             " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
-             " \"sigma\": %g}]}}",
-             getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d,
-             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "dfsph",
-             getenv("PF_SOLVER_KEYS") ? getenv("PF_SOLVER_KEYS") : ", \"tolerance\": 0.0001", dr->Rs * d,
-             thermo, SIGMA);
+        snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},", getenv("PF_THETA"));
+    snprintf(
+        json, sizeof json,
+        "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0, 0],"
+        " \"domain\": {\"min\": [-1, -1, -1], \"max\": [1, 1, 1]},"
+        " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": 0.002},"
+        " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.001}],"
+        " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0, 0], \"radius\": %g}],"
+        " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
+        " \"sigma\": %g}]}}",
+        getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d, getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "dfsph",
+        getenv("PF_SOLVER_KEYS") ? getenv("PF_SOLVER_KEYS") : ", \"tolerance\": 0.0001", dr->Rs * d, thermo, SIGMA);
     dr->sim = tu_sim_from_json(json, "laplace.json");
     const size_t n = pfsph_sim_ctx(dr->sim)->fluid->n;
     dr->Re = cbrt(3.0 * (double)n * d * d * d / (4.0 * PI));
@@ -142,8 +140,8 @@ static void run_drop(drop *dr, double t0, double t_end)
             o += snprintf(dr->log + o, sizeof dr->log - (size_t)o, "  blocks:");
             for (int b = 0; b < NB; b++) o += snprintf(dr->log + o, sizeof dr->log - (size_t)o, " %.1f", bm[b]);
             o += snprintf(dr->log + o, sizeof dr->log - (size_t)o,
-                          "\n  R from gyration sqrt(5/3) Rg = %.3f d (R_e %.3f d); shells [Pa]:",
-                          rg / (double)m / d, dr->Re / d);
+                          "\n  R from gyration sqrt(5/3) Rg = %.3f d (R_e %.3f d); shells [Pa]:", rg / (double)m / d,
+                          dr->Re / d);
             for (int k = 0; k < 16 && pcnt[k] && o < (int)sizeof dr->log; k++)
                 o += snprintf(dr->log + o, sizeof dr->log - (size_t)o, " %d:%.1f", k, prof[k] / (double)pcnt[k]);
             if (o < (int)sizeof dr->log) snprintf(dr->log + o, sizeof dr->log - (size_t)o, "\n");
@@ -204,8 +202,8 @@ static void test_laplace(void **state)
     for (int i = 0; i < nr; i++) x[i] = 2.0 / dr[i].Re, y[i] = dr[i].p, Rmax = fmax(Rmax, dr[i].Re);
     const tu_line fit = tu_line_fit(nr, x, y);
     const double slope = fit.slope, icpt = fit.icpt, r2 = fit.r2;
-    print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n",
-                  slope, slope / SIGMA, icpt, 0.25 * SIGMA / Rmax, r2);
+    print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n", slope, slope / SIGMA,
+                  icpt, 0.25 * SIGMA / Rmax, r2);
 #ifndef __SANITIZE_ADDRESS__
     assert_true(fabs(slope / SIGMA - 1) <= 0.15);
     assert_true(fabs(icpt) <= 0.25 * SIGMA / Rmax);

@@ -211,9 +211,9 @@ enum { NMAX = 128, SMOOTH = 5 };
 typedef struct run_result {
     int n, nk, ngas;
     double t[NMAX], yc[NMAX], vy[NMAX], circ[NMAX], aspect[NMAX], hw[NMAX];
-    double vmax, t_vmax;      /* largest 0.2 s running mean of the gas's mean vertical velocity */
+    double vmax, t_vmax;                          /* largest 0.2 s running mean of the gas's mean vertical velocity */
     double circ_min, t_circ_min, hw_min, asp_min; /* after 0.5 s */
-    double circ_mean, circ_sd, asp_mean, asp_sd; /* over the samples after 0.2 s */
+    double circ_mean, circ_sd, asp_mean, asp_sd;  /* over the samples after 0.2 s */
     unsigned long long steps;
 } run_result;
 
@@ -223,8 +223,8 @@ static void run(int n, double t_end, int rest, run_result *r)
     const double nu = getenv("PF_NU") ? atof(getenv("PF_NU")) : 0.01;
     char json[8192];
     snprintf(json, sizeof json, SCENE, 0.5 * d, rest ? 0.0 : -0.98, -w - d, -w - d, 1 + w + d, 2 + w + d,
-             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", nu, nu, -w, -w, 1 + w, -w, 1 + w, 2 + w,
-             -w, 1 + w, getenv("PF_VCORR") ? getenv("PF_VCORR") : "true", getenv("PF_PW") ? getenv("PF_PW") : "");
+             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", nu, nu, -w, -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w,
+             getenv("PF_VCORR") ? getenv("PF_VCORR") : "true", getenv("PF_PW") ? getenv("PF_PW") : "");
     static pfsph_scene sc;
     pfsph_error err = {0};
     int rc = pfsph_scene_parse(&sc, json, "hysing bubble", &err);
@@ -351,8 +351,8 @@ static void test_hysing(void **state)
                "%.3f of Hysing's), circularity min %.4f at %.2f s (Hysing %.4f at 1.9 s), aspect min %.4f, h/w min "
                "%.4f, steps %llu\n",
                rr[i]->n, rr[i]->vmax, rr[i]->t_vmax, H_VMAX, rr[i]->vmax / H_VMAX, rr[i]->yc[rr[i]->nk], H_YC3,
-               (rr[i]->yc[rr[i]->nk] - 0.5) / (H_YC3 - 0.5), rr[i]->circ_min, rr[i]->t_circ_min, H_CMIN,
-               rr[i]->asp_min, rr[i]->hw_min, rr[i]->steps);
+               (rr[i]->yc[rr[i]->nk] - 0.5) / (H_YC3 - 0.5), rr[i]->circ_min, rr[i]->t_circ_min, H_CMIN, rr[i]->asp_min,
+               rr[i]->hw_min, rr[i]->steps);
     printf("summary: rise velocity 1-3 s %.4f / %.4f (ratio %.3f), 0.5-1.5 s %.4f / %.4f (ratio %.3f), vmax ratio "
            "%.3f\n",
            ua, ub, ub / ua, ua1, ub1, ub1 / ua1, b.vmax / a.vmax);

@@ -41,8 +41,7 @@ static void test_rectangle_to_disc(void **state)
      * mean sqrt(pi/4) of its rms. */
     const double a_mean = sqrt(PI / 4) * sqrt(2 * theta * d / (3 * PI * R));
     const double ratio_floor = (1 - 2 * a_mean) / (1 + 2 * a_mean);
-    print_message("R = %.2f d, capillary period T = %.3f s, thermal floor of the ratio %.4f\n",
-                  R / d, T, ratio_floor);
+    print_message("R = %.2f d, capillary period T = %.3f s, thermal floor of the ratio %.4f\n", R / d, T, ratio_floor);
 #ifdef __SANITIZE_ADDRESS__
     /* the code paths only: a 20 x 10 block for 0.5 s */
     tu_relax r = tu_shape_relax(2, 20, 10, 1, 0.5, 0.25, 0.05);

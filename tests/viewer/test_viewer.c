@@ -150,8 +150,10 @@ static void test_live_2d(void **state)
     write_scene(dir, "live2d.json", SCENE2D, scene, sizeof scene);
     snprintf(shot, sizeof shot, "%s/live.png", dir);
     snprintf(dump, sizeof dump, "%s/dump", dir);
-    snprintf(cmd, sizeof cmd, "%s view %s --screenshot %s --frames 20 --dump %s --no-overlay --hide walls "
-             "--color-by phase --threads 2", tu_pfsph_bin(), scene, shot, dump);
+    snprintf(cmd, sizeof cmd,
+             "%s view %s --screenshot %s --frames 20 --dump %s --no-overlay --hide walls "
+             "--color-by phase --threads 2",
+             tu_pfsph_bin(), scene, shot, dump);
     int st = tu_run(cmd, out, sizeof out);
     print_message("%s", out);
     assert_int_equal(st, 0);
@@ -292,8 +294,8 @@ static void compare_replay(const char *scene_text, const char *name, int frame, 
     double q = iou(ca, cb, (size_t)(a.w / BLK) * ((a.h - 20) / BLK), &na, &nb);
     double diff = colour_diff(&a, &b, &both);
     print_message("%s frame %d [render %s / view %s]: %zu blocks (renderer) / %zu (viewer), IoU %.4f (at least %.2f); "
-                  "mean colour difference %.4f (at most %.2f) over %zu pixels\n", name, frame, rargs, vargs, na, nb, q,
-                  min_iou, diff, max_diff, both);
+                  "mean colour difference %.4f (at most %.2f) over %zu pixels\n",
+                  name, frame, rargs, vargs, na, nb, q, min_iou, diff, max_diff, both);
     assert_true(na > 100);
     assert_true(q >= min_iou);
     assert_true(diff <= max_diff);
@@ -386,11 +388,8 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_bad_input),
-        cmocka_unit_test(test_live_2d),
-        cmocka_unit_test(test_replay_2d),
-        cmocka_unit_test(test_replay_3d),
-        cmocka_unit_test(test_replay_meshes),
+        cmocka_unit_test(test_bad_input), cmocka_unit_test(test_live_2d),       cmocka_unit_test(test_replay_2d),
+        cmocka_unit_test(test_replay_3d), cmocka_unit_test(test_replay_meshes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
