@@ -65,7 +65,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", err.msg);
         return 2;
     }
-    s->solver = PFSPH_SOLVER_PCISPH;
+    pfsph_scene_set_solver(s, "pcisph");
     pfsph_sim *sim = NULL;
     if ((rc = pfsph_sim_create(&sim, s, &err))) {
         fprintf(stderr, "%s\n", err.msg);

@@ -576,11 +576,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         cfg->rho_common = rhi;
         cfg->c_fast = sim->sound_speed * sqrt(rhi / rlo); /* c^2 = B gamma rho_common / rho0 */
     }
-    cfg->tolerance = s->pcisph_tolerance;
-    cfg->min_iter = s->pcisph_min_iter;
-    cfg->max_iter = s->pcisph_max_iter;
-    cfg->div_tolerance = s->div_tolerance;
-    cfg->div_max_iter = s->div_max_iter;
+    cfg->settings = s->solver_settings;
     cfg->cfl = s->cfl;
     if ((rc = sim->solver->create(&sim->solver_state, c, cfg, err))) goto fail;
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
@@ -854,12 +850,10 @@ static int st_forces(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     pfsph_real *nz[3] = {NULL, NULL, NULL};
     if (sim->scr_noise >= 0)
         for (int a = 0; a < 3; a++) nz[a] = sim->scr[sim->scr_noise + a];
-    sim->ctx.pressure_done = 0;
     if (sim->solver->eos && !sim->pw) { /* pressure in the same walk (solver.h, eos) */
         pfsph_real *const ap[3] = {sim->scr[SCR_APX], sim->scr[SCR_APY], sim->scr[SCR_APZ]};
         sim->solver->eos(sim->solver_state, &sim->ctx);
         pfsph__forces_and_pressure(&sim->ctx, sim->scr_noise >= 0 ? nz : NULL, sim->fluid.p, ap);
-        sim->ctx.pressure_done = 1;
     } else if (sim->scr_noise >= 0) { /* with the thermostat's random forces, fused (viscosity.c) */
         pfsph__nonpressure_thermo(&sim->ctx, nz);
     } else {
@@ -899,7 +893,8 @@ static int st_pressure(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     (void)err;
     pfsph_real *const ap[3] = {sim->scr[SCR_APX], sim->scr[SCR_APY], sim->scr[SCR_APZ]};
     pfsph_solve_stats out = {0, 0, 0};
-    sim->solver->solve(sim->solver_state, &sim->ctx, ap, sim->scr + SCR_COMMON, &out);
+    if (sim->solver->eos && !sim->pw) sim->solver->report(sim->solver_state, &sim->ctx, sim->scr + SCR_COMMON, &out);
+    else sim->solver->solve(sim->solver_state, &sim->ctx, ap, sim->scr + SCR_COMMON, &out);
     sim->stats.iterations = out.iterations;
     sim->stats.density_err_avg = out.density_err_avg;
     return PFSPH_OK;
@@ -929,7 +924,6 @@ static int st_integrate(pfsph_sim *sim, blowup_info *bad, pfsph_error *err)
     const pfsph_real fdt = (pfsph_real)dt;
     double amax2 = 0, anp2 = 0;
     c->nlist = c->nlist_b = NULL; /* the particles move: this step's lists no longer hold */
-    c->pressure_done = 0;
     pfsph_real *ek = sim->scr[SCR_EK];
     double emax = 0, v2max = 0;
     int bad_ = 0;

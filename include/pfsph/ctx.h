@@ -39,8 +39,6 @@ typedef struct pfsph_ctx {
     pfsph_real wall_nu_max;   /* largest wall_nu */
     pfsph_real *ax, *ay, *az; /* per-step non-pressure acceleration of fluid particles */
     pfsph_real *nd;           /* per-step number density of fluid particles (Eq. 23) */
-    int pressure_done;        /* this step's forces stage also wrote fluid->p and the pressure
-                               * acceleration (one walk, solver eos; src/sim.c st_forces) */
     /* the model (copied from the scene by the simulation; physics never sees the scene) */
     double gravity[3];                   /* m/s^2 */
     double domain_min[3], domain_max[3]; /* fluid leaving it is removed */

@@ -9,6 +9,8 @@
 #include "pfsph/types.h"
 
 #define PFSPH_NAME_LEN 64
+/* most scene keys a pressure solver may have of its own (src/physics/solver.h) */
+#define PFSPH_SOLVER_MAX_KEYS 8
 
 enum pfsph_phase_kind { PFSPH_PHASE_FLUID = 0, PFSPH_PHASE_GAS = 1, PFSPH_PHASE_SOLID = 2 };
 

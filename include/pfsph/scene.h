@@ -17,8 +17,6 @@
 #define PFSPH_MAX_BODIES 32
 #define PFSPH_MAX_KEYFRAMES 16
 
-/* Pressure solvers (src/physics/solver.h); names as in the scene: pfsph_scene_solver_name. */
-enum pfsph_solver { PFSPH_SOLVER_WCSPH = 0, PFSPH_SOLVER_PCISPH = 1, PFSPH_SOLVER_DFSPH = 2 };
 enum pfsph_shape {
     PFSPH_SHAPE_BOX = 0,
     PFSPH_SHAPE_SPHERE,    /* a disc in 2D */
@@ -138,7 +136,10 @@ typedef struct pfsph_scene {
     double support_factor;               /* h = support_factor * spacing, default 2 */
     double gravity[3];                   /* m/s^2 */
     double domain_min[3], domain_max[3]; /* particles leaving it are removed */
-    int solver;                          /* enum pfsph_solver */
+    /* the pressure solver: its name in the registry (src/physics/solver.h) and its own keys'
+     * values, in the order of its row's keys */
+    char solver[PFSPH_NAME_LEN];
+    double solver_settings[PFSPH_SOLVER_MAX_KEYS];
     /* time stepping */
     double cfl;            /* dt <= cfl * spacing / vmax */
     double dt_min, dt_max; /* s */
@@ -150,13 +151,6 @@ typedef struct pfsph_scene {
     double sound_speed; /* m/s; 0 = automatic (10 x estimated max speed) */
     double gamma;       /* Tait exponent, default 7 */
     int pressure_scale; /* enum pfsph_pressure_scale: the Tait pressure's rho0 */
-    /* PCISPH and DFSPH density solve */
-    double pcisph_tolerance; /* average relative density error; default 0.005 (PCISPH),
-                                  0.001 (DFSPH) */
-    int pcisph_min_iter, pcisph_max_iter;
-    /* DFSPH divergence solve */
-    double div_tolerance; /* mean |D delta/Dt| dt / delta0, default 0.001 */
-    int div_max_iter;     /* 0: no divergence solve; default 100 */
     /* phases */
     int nphases;
     pfsph_phase phases[PFSPH_MAX_PHASES];
@@ -188,8 +182,12 @@ int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err);
 /* The embedded default scene (a small 3D dam break against an obstacle), as JSON text. */
 const char *pfsph_scene_default_json(void);
 
-/* The solver's name as the scene writes it ("wcsph", "pcisph", "dfsph"). */
+/* The solver's name as the scene writes it ("wcsph", "pcisph", ...). */
 const char *pfsph_scene_solver_name(const pfsph_scene *s);
+/* Choose the solver called name with its default settings; PFSPH_EINPUT if there is none. */
+int pfsph_scene_set_solver(pfsph_scene *s, const char *name);
+/* The value of the solver's own key (e.g. "tolerance"), or NAN if its solver has no such key. */
+double pfsph_scene_solver_setting(const pfsph_scene *s, const char *key);
 
 /* Index of the phase called name, or -1. */
 int pfsph_scene_phase_index(const pfsph_scene *s, const char *name);

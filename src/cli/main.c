@@ -19,6 +19,7 @@
 #include "pfsph/run.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
+#include "physics/solver.h"
 #ifdef PFSPH_HAVE_VIEWER
 #include "view/view.h"
 #endif
@@ -482,19 +483,12 @@ static int cmd_check(int argc, char **argv)
     if (pfsph_scene_density_range(&s, &rho_lo, &rho_hi) && rho_lo > 0 && rho_hi > rho_lo) {
         double ratio = rho_hi / rho_lo;
         printf("density ratio %.4g between fluid phases", ratio);
-        if (s.solver == PFSPH_SOLVER_WCSPH && s.pressure_scale == PFSPH_PRESSURE_COMMON)
-            printf(": one pressure scale, the lightest phase's sound speed is %.3gx the "
-                   "solver's (the time step shrinks by as much)\n",
-                   sqrt(ratio));
-        else if (s.solver == PFSPH_SOLVER_PCISPH && ratio > 10.0 + 1e-9)
-            printf(": PCISPH is tested to 10 and diverged at 100 (docs/pairwise.md, \"Density "
-                   "ratios\"); use solver \"wcsph\" with \"pressure_scale\": \"common\"\n");
-        else if (s.solver == PFSPH_SOLVER_DFSPH && ratio > 10.0 + 1e-9)
-            printf(": DFSPH is tested to 10 (test_pf_rising_bubble); higher ratios are untested, "
-                   "solver \"wcsph\" with \"pressure_scale\": \"common\" is tested to 1000\n");
-        else if (s.solver == PFSPH_SOLVER_WCSPH && ratio > 100.0 + 1e-9)
-            printf(": per-phase pressure scales are tested to 100 and blew up at 1000 "
-                   "(docs/pairwise.md, \"Density ratios\"); use \"pressure_scale\": \"common\"\n");
+        const pfsph_solver_ops *ops = pfsph_solver_find(s.solver);
+        char buf[256];
+        const char *advice = ops && ops->ratio_advice
+                                 ? ops->ratio_advice(ratio, s.pressure_scale == PFSPH_PRESSURE_COMMON, buf, sizeof buf)
+                                 : NULL;
+        if (advice) printf(": %s\n", advice);
         else printf("\n");
     }
     if (s.nbodies) {

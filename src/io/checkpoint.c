@@ -72,7 +72,7 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
     h_vec(h, s->gravity, 3);
     h_vec(h, s->domain_min, 3);
     h_vec(h, s->domain_max, 3);
-    h_int(h, s->solver);
+    h_str(h, s->solver);
     h_f64(h, s->cfl);
     h_f64(h, s->dt_min);
     h_f64(h, s->dt_max);
@@ -81,13 +81,7 @@ uint64_t pfsph_scene_hash(const pfsph_scene *s)
     h_f64(h, s->sound_speed);
     h_f64(h, s->gamma);
     if (s->pressure_scale) h_int(h, s->pressure_scale); /* older checkpoints stay resumable */
-    h_f64(h, s->pcisph_tolerance);
-    h_int(h, s->pcisph_min_iter);
-    h_int(h, s->pcisph_max_iter);
-    if (s->solver == PFSPH_SOLVER_DFSPH) { /* only then, so that older checkpoints stay resumable */
-        h_f64(h, s->div_tolerance);
-        h_int(h, s->div_max_iter);
-    }
+    h_vec(h, s->solver_settings, PFSPH_SOLVER_MAX_KEYS);
     h_int(h, s->nphases);
     for (int i = 0; i < s->nphases && i < PFSPH_MAX_PHASES; i++) {
         const pfsph_phase *p = &s->phases[i];
@@ -618,8 +612,9 @@ static int check_clock(const pfsph_scene *s, int32_t fr, long expect_frame, int3
     if (st->stats.dt > s->dt_max * (1 + 1e-9))
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: dt %g s above time.dt_max %g s", name,
                           st->stats.dt, s->dt_max);
-    if (st->stats.iterations < 0 || st->stats.iterations > s->pcisph_max_iter)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %d PCISPH iterations", name,
+    const double max_iter = pfsph_scene_solver_setting(s, "max_iterations"); /* NAN: not an iterative solver */
+    if (st->stats.iterations < 0 || st->stats.iterations > (isnan(max_iter) ? 0 : max_iter))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %d pressure iterations", name,
                           (int)st->stats.iterations);
     for (int k = 0; k < PFSPH_NSTAGES; k++)
         if (!(st->stage_s[k] >= 0) || !isfinite(st->stage_s[k]))

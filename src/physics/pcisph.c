@@ -12,6 +12,19 @@
 
 enum { XP, YP, ZP, NDP, ERR, NSCR };
 
+/* its scene keys under $.solver, in the order of the scene's solver_settings */
+enum { K_TOL, K_MIN, K_MAX, NKEYS };
+static const pfsph_solver_key keys[NKEYS] = {
+    {"tolerance", 0.005, 1e-5, 0.1, 0, "mean relative density error a step's corrections stop at"},
+    {"min_iterations", 3, 1, 1000, 1, "corrections per step at least"},
+    {"max_iterations", 50, 1, 10000, 1, "corrections per step at most"},
+};
+
+static int check(const double *v, const char **key, char *msg, size_t len)
+{
+    return pfsph__check_iterations(v[K_MIN], v[K_MAX], key, msg, len);
+}
+
 typedef struct pcisph {
     double proto; /* |sum grad W|^2 + sum |grad W|^2 of a full lattice neighbourhood */
     double tol, c, cfl;
@@ -26,9 +39,9 @@ static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config 
     pcisph *p = calloc(1, sizeof *p);
     if (!p) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
     p->proto = prototype(&ctx->kern, ctx->dim, ctx->spacing);
-    p->tol = cfg->tolerance;
-    p->min_iter = cfg->min_iter;
-    p->max_iter = cfg->max_iter;
+    p->tol = cfg->settings[K_TOL];
+    p->min_iter = (int)cfg->settings[K_MIN];
+    p->max_iter = (int)cfg->settings[K_MAX];
     p->c = cfg->sound_speed;
     p->cfl = cfg->cfl;
     *state = p;
@@ -123,8 +136,22 @@ static const char *hint(const void *state, const pfsph_ctx *ctx)
     return "lower time.cfl or dt_max; check pairwise coefficients and viscosity";
 }
 
+static const char *ratio_advice(double ratio, int common_scale, char *buf, size_t len)
+{
+    (void)common_scale;
+    (void)buf;
+    (void)len;
+    return ratio > 10.0 + 1e-9 ? "PCISPH is tested to 10 and diverged at 100 (docs/pairwise.md, \"Density "
+                                 "ratios\"); use solver \"wcsph\" with \"pressure_scale\": \"common\""
+                               : NULL;
+}
+
 const pfsph_solver_ops pfsph_solver_pcisph = {
     .name = "pcisph",
+    .keys = keys,
+    .nkeys = NKEYS,
+    .check = check,
+    .ratio_advice = ratio_advice,
     .nscratch = NSCR,
     .create = create,
     .destroy = destroy,

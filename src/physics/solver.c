@@ -1,10 +1,18 @@
-/* The table of pressure solvers, looked up by the scene's solver name. */
+/* The registry of pressure solvers, looked up by the scene's solver name. A solver is one file
+ * defining `const pfsph_solver_ops pfsph_solver_<name>` and one word in PFSPH_SOLVERS. */
 #include "physics/solver.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
-static const pfsph_solver_ops *const solvers[] = {&pfsph_solver_wcsph, &pfsph_solver_pcisph, &pfsph_solver_dfsph, NULL};
+/* The registry: one word per solver, in the order `pfsph check` and the docs list them. */
+#define PFSPH_SOLVERS(X) X(wcsph) X(pcisph) X(dfsph)
+
+#define PFSPH_SOLVER_DECLARE(n) extern const pfsph_solver_ops pfsph_solver_##n;
+PFSPH_SOLVERS(PFSPH_SOLVER_DECLARE)
+#define PFSPH_SOLVER_ROW(n) &pfsph_solver_##n,
+static const pfsph_solver_ops *const solvers[] = {PFSPH_SOLVERS(PFSPH_SOLVER_ROW) NULL};
 
 const pfsph_solver_ops *pfsph_solver_find(const char *name)
 {
@@ -18,4 +26,19 @@ const pfsph_solver_ops *pfsph_solver_at(int i)
     return i >= 0 && i < (int)(sizeof solvers / sizeof *solvers) - 1 ? solvers[i] : NULL;
 }
 
+int pfsph_solver_key_index(const pfsph_solver_ops *ops, const char *key)
+{
+    for (int k = 0; ops && key && k < ops->nkeys; k++)
+        if (!strcmp(ops->keys[k].name, key)) return k;
+    return -1;
+}
+
 double pfsph__dt_force(double spacing, double a) { return a > 0 ? 0.25 * sqrt(spacing / a) : INFINITY; }
+
+int pfsph__check_iterations(double min_iter, double max_iter, const char **key, char *msg, size_t len)
+{
+    if (min_iter <= max_iter) return 0;
+    *key = "min_iterations";
+    snprintf(msg, len, "min_iterations (%d) is greater than max_iterations (%d)", (int)min_iter, (int)max_iter);
+    return 1;
+}

@@ -1,10 +1,19 @@
-/* The pressure-solver interface. A solver is a table of functions that the time step calls
- * (src/sim.c walks its stage table and calls these at fixed points); solvers are found by the
- * scene's solver name in one table (solver.c). Adding a solver: docs/architecture.md. */
+/* The pressure-solver interface and its registry. A solver is one file defining a table row: its
+ * name, its scene keys with defaults and ranges, and the functions the pressure stages call.
+ * Adding a solver is that file and its name in PFSPH_SOLVERS (solver.c): docs/architecture.md. */
 #ifndef PFSPH_SOLVER_H
 #define PFSPH_SOLVER_H
 
 #include "pfsph/ctx.h"
+
+/* One scene key of a solver, under $.solver: its default and the accepted range. The scene
+ * stores the values in the order of the row's keys (pfsph_scene.solver_settings). */
+typedef struct pfsph_solver_key {
+    const char *name;
+    double def, min, max;
+    int integer; /* non-zero: an integer */
+    const char *doc;
+} pfsph_solver_key;
 
 /* The scene's solver settings, resolved by the simulation (sound speed chosen, pressure
  * scale decided), so that a solver reads no scene. */
@@ -13,11 +22,8 @@ typedef struct pfsph_solver_config {
     double c_fast;      /* sound speed of the lightest phase (= sound_speed unless rho_common) */
     double gamma;       /* Tait exponent */
     double rho_common;  /* > 0: one Tait pressure scale for all phases [kg/m^3]; 0: per phase */
-    double tolerance;   /* average relative density error a solve stops at (PCISPH, DFSPH) */
-    int min_iter, max_iter;
-    double div_tolerance; /* DFSPH: mean |D delta / Dt| dt / delta0 the divergence solve stops at */
-    int div_max_iter;     /* DFSPH: 0 switches the divergence solve off */
     double cfl;
+    const double *settings; /* the solver's own keys' values, in the order of its row's keys */
 } pfsph_solver_config;
 
 /* What one solve reports (stats.csv columns). */
@@ -29,6 +35,15 @@ typedef struct pfsph_solve_stats {
 
 typedef struct pfsph_solver_ops {
     const char *name; /* as in the scene's solver.type */
+    const pfsph_solver_key *keys; /* its own scene keys (NULL when none) */
+    int nkeys;                    /* at most PFSPH_SOLVER_MAX_KEYS */
+    /* Optional: checks across keys (v in the order of keys); on failure points *key at the key
+     * to blame (under $.solver), writes a message and returns non-zero. */
+    int (*check)(const double *v, const char **key, char *msg, size_t len);
+    /* Optional: what `pfsph check` says of a density ratio > 1 between fluid phases under this
+     * solver (common_scale: "pressure_scale": "common"), written to buf or a constant; NULL:
+     * nothing to add. */
+    const char *(*ratio_advice)(double ratio, int common_scale, char *buf, size_t len);
     int nscratch;     /* per-fluid-particle scratch arrays the solver needs */
     int nscratch4;    /* the last nscratch4 of them hold 4 values per particle (packed x, y, z, w) */
     /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
@@ -40,10 +55,12 @@ typedef struct pfsph_solver_ops {
     int np_cap_without_viscosity;
     /* Optional (may be NULL): the pressure from the density alone (an equation of state),
      * written to fluid->p. Given, and without pair forces (which read last step's p), the
-     * forces stage writes p and computes the pressure acceleration in the viscosity's
-     * neighbour walk (one walk instead of two; viscosity.c) and sets ctx->pressure_done for
-     * solve, which then finds ap filled. */
+     * schedule fuses: the forces stage writes p and computes the pressure acceleration in the
+     * viscosity's neighbour walk (one walk instead of two; viscosity.c), and the pressure stage
+     * calls `report` instead of `solve`. A solver with eos must have report. */
     void (*eos)(void *state, const pfsph_ctx *ctx);
+    /* With eos: the stats of a step whose pressure the forces stage computed. */
+    void (*report)(void *state, const pfsph_ctx *ctx, pfsph_real *const *scratch, pfsph_solve_stats *out);
     /* Solver state for the fluid of ctx; NULL state is allowed. */
     int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg, pfsph_error *err);
     void (*destroy)(void *state); /* NULL is a no-op */
@@ -73,8 +90,11 @@ typedef struct pfsph_solver_ops {
 const pfsph_solver_ops *pfsph_solver_find(const char *name);
 /* The i-th solver of the table (NULL past the end): for listings and tests. */
 const pfsph_solver_ops *pfsph_solver_at(int i);
+/* The index of key in the row's keys, or -1. */
+int pfsph_solver_key_index(const pfsph_solver_ops *ops, const char *key);
 
-extern const pfsph_solver_ops pfsph_solver_wcsph, pfsph_solver_pcisph, pfsph_solver_dfsph;
+/* Shared by the iterative solvers' `check`: min_iterations <= max_iterations. */
+int pfsph__check_iterations(double min_iter, double max_iter, const char **key, char *msg, size_t len);
 
 /* Shared by the solvers: the force criterion 0.25 sqrt(d / a) (Monaghan 1992), infinite for a
  * = 0. */

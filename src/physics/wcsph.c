@@ -1,6 +1,7 @@
 /* Weakly compressible SPH: pressure from the Tait equation (DF Eq. 3), one force evaluation
  * per step, time step limited by the sound speed (Monaghan 1994; Becker & Teschner 2007). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "core/reduce.h"
@@ -36,15 +37,11 @@ static void eos(void *state, const pfsph_ctx *c)
     pfsph__tait(c, c->nd, w->B, w->gamma, w->rho_common, c->fluid->p);
 }
 
-static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsph_real *const *scr,
-                  pfsph_solve_stats *out)
+/* the mean compression of the step (stats.csv) */
+static void report(void *state, const pfsph_ctx *c, pfsph_real *const *scr, pfsph_solve_stats *out)
 {
-    pfsph_particles *f = c->fluid;
-    const size_t n = f->n;
-    if (!c->pressure_done) { /* else the forces stage did both in one walk */
-        eos(state, c);
-        pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, f->p, ap[0], ap[1], ap[2]);
-    }
+    (void)state;
+    const size_t n = c->fluid->n;
     pfsph_real *er = scr[0];
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
@@ -53,6 +50,15 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
     }
     out->density_err_avg = n ? pfsph__sum(er, n) / (double)n : 0;
     out->iterations = 0;
+}
+
+static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsph_real *const *scr,
+                  pfsph_solve_stats *out)
+{
+    pfsph_particles *f = c->fluid;
+    eos(state, c);
+    pfsph__pressure_accel(c, f->x, f->y, f->z, c->nd, f->p, ap[0], ap[1], ap[2]);
+    report(state, c, scr, out);
 }
 
 /* acoustic CFL with the fastest sound speed, and the force criterion on the total acceleration */
@@ -79,10 +85,27 @@ static const char *hint(const void *state, const pfsph_ctx *ctx)
     return "the time step is too large for the stiffness: lower time.cfl or dt_max, or raise solver.sound_speed";
 }
 
+static const char *ratio_advice(double ratio, int common_scale, char *buf, size_t len)
+{
+    if (common_scale) {
+        snprintf(buf, len,
+                 "one pressure scale, the lightest phase's sound speed is %.3gx the solver's (the time step "
+                 "shrinks by as much)",
+                 sqrt(ratio));
+        return buf;
+    }
+    if (ratio > 100.0 + 1e-9)
+        return "per-phase pressure scales are tested to 100 and blew up at 1000 (docs/pairwise.md, \"Density "
+               "ratios\"); use \"pressure_scale\": \"common\"";
+    return NULL;
+}
+
 const pfsph_solver_ops pfsph_solver_wcsph = {
     .name = "wcsph",
+    .ratio_advice = ratio_advice,
     .nscratch = 1,
     .eos = eos,
+    .report = report,
     .create = create,
     .destroy = destroy,
     .solve = solve,

@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/solver.h"
 #include "scene/json_util.h"
 #include "scene/shapes.h"
 
@@ -38,7 +39,6 @@ typedef struct parser {
 
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 static const char *const kind_names[] = {"fluid", "gas", "solid", NULL};
-static const char *const solver_names[] = {"wcsph", "pcisph", "dfsph", NULL}; /* enum order */
 static const char *const pressure_scale_names[] = {"phase", "common", NULL};  /* enum order */
 
 static void path_key(char *out, size_t cap, const char *path, const char *key)
@@ -279,44 +279,64 @@ static int parse_domain(parser *p, const cJSON *root)
     return PFSPH_OK;
 }
 
+/* The solver block: the keys every solver shares, then the chosen solver's own (its registry row
+ * gives names, defaults and ranges). Keys of other solvers are accepted and range-checked, so
+ * that switching "type" is a one-word change, but only the chosen solver's are kept. */
 static int parse_solver(parser *p, const cJSON *root)
 {
     pfsph_scene *s = p->s;
     const cJSON *o = get(root, "solver");
     if (!o) return PFSPH_OK;
-    static const char *const keys[] = {"type",
-                                       "tolerance",
-                                       "min_iterations",
-                                       "max_iterations",
-                                       "sound_speed",
-                                       "gamma",
-                                       "pressure_scale",
-                                       "divergence_tolerance",
-                                       "divergence_max_iterations",
-                                       NULL};
+    static const char *const common[] = {"type", "sound_speed", "gamma", "pressure_scale"};
+    const char *keys[4 + 8 * PFSPH_SOLVER_MAX_KEYS + 1];
+    const char *names[9];
+    int nk = 0, nn = 0;
+    for (int k = 0; k < 4; k++) keys[nk++] = common[k];
+    for (int i = 0; pfsph_solver_at(i); i++) {
+        const pfsph_solver_ops *ops = pfsph_solver_at(i);
+        if (nn < 8) names[nn++] = ops->name;
+        for (int k = 0; k < ops->nkeys; k++) {
+            int seen = 0;
+            for (int m = 0; m < nk && !seen; m++) seen = !strcmp(keys[m], ops->keys[k].name);
+            if (!seen && nk < (int)(sizeof keys / sizeof *keys) - 1) keys[nk++] = ops->keys[k].name;
+        }
+    }
+    keys[nk] = NULL;
+    names[nn] = NULL;
     const char *P = "$.solver";
     TRY(pfsph__json_check_keys(o, P, keys, &p->ctx));
-    TRY(json_enum(p, o, P, "type", solver_names, &s->solver));
-    /* DFSPH needs a tighter default: at 0.005 its 2D tank at rest kept vmax ~0.2 m/s
-     * (docs/solvers.md, "DFSPH"), and fewer minimum corrections */
-    if (s->solver == PFSPH_SOLVER_DFSPH) {
-        s->pcisph_tolerance = 0.001;
-        /* its warm start is often within tolerance already: one correction suffices (the 7k
-         * dam break to 1 s: 13.4 s wall with 1, 15.5 s with 2, 19.1 s with PCISPH's 3) */
-        s->pcisph_min_iter = 1;
+    if (get(o, "type")) {
+        int which = 0;
+        TRY(json_enum(p, o, P, "type", names, &which));
+        pfsph_scene_set_solver(s, names[which]);
     }
-    TRY(pfsph__json_number(o, P, "tolerance", 1e-5, 0.1, &s->pcisph_tolerance, &p->ctx));
-    TRY(pfsph__json_int(o, P, "min_iterations", 1, 1000, &s->pcisph_min_iter, &p->ctx));
-    TRY(pfsph__json_int(o, P, "max_iterations", 1, 10000, &s->pcisph_max_iter, &p->ctx));
-    if (s->pcisph_min_iter > s->pcisph_max_iter)
-        return pfsph__json_fail(&p->ctx, "$.solver.min_iterations",
-                                "min_iterations (%d) is greater than max_iterations (%d)", s->pcisph_min_iter,
-                                s->pcisph_max_iter);
+    const pfsph_solver_ops *self = pfsph_solver_find(s->solver);
+    for (int i = 0; pfsph_solver_at(i); i++) {
+        const pfsph_solver_ops *ops = pfsph_solver_at(i);
+        for (int k = 0; k < ops->nkeys; k++) {
+            const pfsph_solver_key *key = &ops->keys[k];
+            double v = key->def;
+            if (key->integer) {
+                int iv = (int)key->def;
+                TRY(pfsph__json_int(o, P, key->name, (long)key->min, (long)key->max, &iv, &p->ctx));
+                v = iv;
+            } else {
+                TRY(pfsph__json_number(o, P, key->name, key->min, key->max, &v, &p->ctx));
+            }
+            int own = ops == self ? k : -1;
+            if (own >= 0) s->solver_settings[own] = v;
+        }
+    }
+    char msg[256];
+    const char *bad = NULL;
+    if (self && self->check && self->check(s->solver_settings, &bad, msg, sizeof msg)) {
+        char kp[512];
+        path_key(kp, sizeof kp, P, bad);
+        return pfsph__json_fail(&p->ctx, kp, "%s", msg);
+    }
     TRY(pfsph__json_number(o, P, "sound_speed", 0.0, 1e5, &s->sound_speed, &p->ctx));
     TRY(pfsph__json_number(o, P, "gamma", 1.0, 10.0, &s->gamma, &p->ctx));
     TRY(json_enum(p, o, P, "pressure_scale", pressure_scale_names, &s->pressure_scale));
-    TRY(pfsph__json_number(o, P, "divergence_tolerance", 1e-6, 0.1, &s->div_tolerance, &p->ctx));
-    TRY(pfsph__json_int(o, P, "divergence_max_iterations", 0, 10000, &s->div_max_iter, &p->ctx));
     return PFSPH_OK;
 }
 
@@ -987,7 +1007,7 @@ void pfsph_scene_defaults(pfsph_scene *s)
     s->particle_radius = 0.01;
     s->support_factor = 2.0;
     s->gravity[1] = -9.81;
-    s->solver = PFSPH_SOLVER_PCISPH;
+    pfsph_scene_set_solver(s, "pcisph");
     s->cfl = 0.4;
     s->dt_min = 1e-6;
     s->dt_max = 0.005;
@@ -997,11 +1017,6 @@ void pfsph_scene_defaults(pfsph_scene *s)
     s->threads = 0;
     s->sound_speed = 0.0;
     s->gamma = 7.0;
-    s->pcisph_tolerance = 0.005;
-    s->pcisph_min_iter = 3;
-    s->pcisph_max_iter = 50;
-    s->div_tolerance = 0.001;
-    s->div_max_iter = 100;
     pfsph_pairwise_defaults(&s->pairwise);
     pfsph_diffuse_defaults(&s->diffuse);
     pfsph_film_defaults(&s->film);
@@ -1022,9 +1037,22 @@ void pfsph_scene_defaults(pfsph_scene *s)
     snprintf(s->camera.color_by, sizeof s->camera.color_by, "phase");
 }
 
-const char *pfsph_scene_solver_name(const pfsph_scene *s)
+const char *pfsph_scene_solver_name(const pfsph_scene *s) { return s->solver; }
+
+int pfsph_scene_set_solver(pfsph_scene *s, const char *name)
 {
-    return s->solver >= 0 && s->solver <= PFSPH_SOLVER_DFSPH ? solver_names[s->solver] : "?";
+    const pfsph_solver_ops *ops = pfsph_solver_find(name);
+    if (!ops) return PFSPH_EINPUT;
+    snprintf(s->solver, sizeof s->solver, "%s", ops->name);
+    memset(s->solver_settings, 0, sizeof s->solver_settings);
+    for (int k = 0; k < ops->nkeys && k < PFSPH_SOLVER_MAX_KEYS; k++) s->solver_settings[k] = ops->keys[k].def;
+    return PFSPH_OK;
+}
+
+double pfsph_scene_solver_setting(const pfsph_scene *s, const char *key)
+{
+    int k = pfsph_solver_key_index(pfsph_solver_find(s->solver), key);
+    return k >= 0 ? s->solver_settings[k] : NAN;
 }
 
 int pfsph_scene_phase_index(const pfsph_scene *s, const char *name)

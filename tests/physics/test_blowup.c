@@ -67,7 +67,7 @@ static void test_density_explosion(void **state)
     static pfsph_scene s;
     pfsph_error err = {0};
     assert_int_equal(pfsph_scene_parse(&s, SCENE, "explode", &err), PFSPH_OK);
-    s.solver = PFSPH_SOLVER_PCISPH;
+    pfsph_scene_set_solver(&s, "pcisph");
     pfsph_sim *sim;
     assert_int_equal(pfsph_sim_create(&sim, &s, &err), PFSPH_OK);
     const pfsph_particles *f = pfsph_sim_ctx(sim)->fluid;

@@ -68,10 +68,9 @@ static void test_full_scene(void **state)
     assert_true(s->support_factor == 2.5);
     assert_true(s->gravity[1] == -10 && s->gravity[2] == 1);
     assert_true(s->domain_min[0] == -1 && s->domain_max[2] == 4);
-    assert_int_equal(s->solver, PFSPH_SOLVER_WCSPH);
-    assert_true(s->pcisph_tolerance == 0.01);
-    assert_int_equal(s->pcisph_min_iter, 2);
-    assert_int_equal(s->pcisph_max_iter, 20);
+    assert_string_equal(s->solver, "wcsph");
+    /* other solvers' keys are accepted (switching "type" is one word) but WCSPH keeps none */
+    assert_true(isnan(pfsph_scene_solver_setting(s, "tolerance")));
     assert_true(s->sound_speed == 30 && s->gamma == 3);
     assert_true(s->end_time == 2.5 && s->fps == 30 && s->cfl == 0.3);
     assert_true(s->dt_min == 1e-5 && s->dt_max == 0.002);
@@ -131,10 +130,10 @@ static void test_defaults(void **state)
     assert_int_equal(s->dim, 3);
     assert_true(s->support_factor == 2.0);
     assert_true(s->gravity[0] == 0 && s->gravity[1] == -9.81 && s->gravity[2] == 0);
-    assert_int_equal(s->solver, PFSPH_SOLVER_PCISPH);
-    assert_true(s->pcisph_tolerance == 0.005);
-    assert_int_equal(s->pcisph_min_iter, 3);
-    assert_int_equal(s->pcisph_max_iter, 50);
+    assert_string_equal(s->solver, "pcisph");
+    assert_true(pfsph_scene_solver_setting(s, "tolerance") == 0.005);
+    assert_true(pfsph_scene_solver_setting(s, "min_iterations") == 3);
+    assert_true(pfsph_scene_solver_setting(s, "max_iterations") == 50);
     assert_true(s->sound_speed == 0 && s->gamma == 7);
     assert_true(s->end_time == 1.0 && s->fps == 25 && s->cfl == 0.4);
     assert_true(s->dt_min == 1e-6 && s->dt_max == 0.005);
@@ -165,7 +164,25 @@ static void test_defaults(void **state)
     pfsph_scene_defaults(&g_scene);
     assert_int_equal(g_scene.dim, 3);
     assert_true(g_scene.particle_radius == 0.01);
-    assert_true(g_scene.pcisph_tolerance == 0.005);
+    assert_true(pfsph_scene_solver_setting(&g_scene, "tolerance") == 0.005);
+
+    /* the chosen solver keeps its own keys, from its registry row */
+    expect_ok("{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0."
+              "1,0.1,0.1]}],"
+              "\"solver\":{\"type\":\"pcisph\",\"tolerance\":0.01,\"min_"
+              "iterations\":2,"
+              "\"max_iterations\":20}}");
+    assert_true(pfsph_scene_solver_setting(&g_scene, "tolerance") == 0.01);
+    assert_true(pfsph_scene_solver_setting(&g_scene, "min_iterations") == 2);
+    assert_true(pfsph_scene_solver_setting(&g_scene, "max_iterations") == 20);
+    assert_true(isnan(pfsph_scene_solver_setting(&g_scene, "divergence_tolerance")));
+    /* DFSPH's own defaults (tighter tolerance, one minimum correction) */
+    expect_ok("{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[0."
+              "1,0.1,0.1]}],"
+              "\"solver\":{\"type\":\"dfsph\"}}");
+    assert_true(pfsph_scene_solver_setting(&g_scene, "tolerance") == 0.001);
+    assert_true(pfsph_scene_solver_setting(&g_scene, "min_iterations") == 1);
+    assert_true(pfsph_scene_solver_setting(&g_scene, "divergence_max_iterations") == 100);
 }
 
 static void test_2d(void **state)
@@ -299,7 +316,7 @@ static void test_default_scene(void **state)
     if (rc) fail_msg("%s", err.msg);
     const pfsph_scene *s = &g_scene;
     assert_int_equal(s->dim, 3);
-    assert_int_equal(s->solver, PFSPH_SOLVER_WCSPH); /* the solver whose hydrostatic pressure is validated */
+    assert_string_equal(s->solver, "wcsph"); /* the solver whose hydrostatic pressure is validated */
     assert_string_equal(s->output.dir, "pfsph_default_run");
     assert_true(s->output.vtp && s->output.ply);
     assert_true(s->fps == 25 && s->end_time >= 1.0 && s->end_time <= 1.5);
