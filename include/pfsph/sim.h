@@ -4,33 +4,9 @@
 #ifndef PFSPH_SIM_H
 #define PFSPH_SIM_H
 
+#include "core/stage.h"
 #include "pfsph/ctx.h"
 #include "pfsph/scene.h"
-
-enum pfsph_stage {
-    PFSPH_STAGE_GRID,
-    PFSPH_STAGE_DENSITY,
-    PFSPH_STAGE_FORCES,
-    PFSPH_STAGE_PAIRWISE,
-    PFSPH_STAGE_PRESSURE,
-    PFSPH_STAGE_INTEGRATE,
-    PFSPH_STAGE_DIFFUSE,
-    PFSPH_STAGE_BODIES,
-    PFSPH_STAGE_FILM,
-    PFSPH_STAGE_OUTPUT,
-    PFSPH_NSTAGES
-};
-extern const char *const pfsph_stage_names[PFSPH_NSTAGES];
-
-typedef struct pfsph_step_stats {
-    double dt;
-    double vmax;            /* m/s */
-    double density_err_avg; /* mean of (rho - rho0) / rho0 over fluid, compressed side only */
-    double density_err_max;
-    double ekin;        /* J */
-    int iterations;     /* pressure iterations of the last step (PCISPH, DFSPH density solve) */
-    int div_iterations; /* divergence-solve iterations of the last step (0 without one) */
-} pfsph_step_stats;
 
 typedef struct pfsph_sim pfsph_sim;
 
@@ -49,6 +25,28 @@ void pfsph_sim_prime_output(pfsph_sim *sim);
  * (interior) .. layers, fluid order; boundary particles cover; with bubbles each bubble on its
  * own. For the frames' `surface_layer` field. Returns PFSPH_OK or PFSPH_ENOMEM. */
 int pfsph_sim_surface_layers(const pfsph_sim *sim, int layers, uint8_t *out);
+
+/* The fields a frame carries that the step does not keep, computed now by the output stages
+ * (surface layers; with pair forces the mechanical pressure) into buffers the simulation owns,
+ * valid until the next step: read them with the two functions below. */
+int pfsph_sim_output(pfsph_sim *sim, pfsph_error *err);
+const uint8_t *pfsph_sim_output_surface_layer(const pfsph_sim *sim);
+/* NULL without pair forces. */
+const pfsph_real *pfsph_sim_output_mechanical_pressure(const pfsph_sim *sim);
+
+/* The schedule (core/stage.h): insert a stage before (after = 0) or after (after = 1) the stage
+ * called anchor, e.g. a halo exchange around the density stage. If the stage has a create, it is
+ * called now and its state destroyed with the simulation; else state is handed to run as given.
+ * Insert before the first step: the step's arrays are laid out again (and zeroed) when the
+ * stage asks for scratch or breaks a hand-over that shared arrays. PFSPH_EINPUT: no such anchor,
+ * a name already in use, a full schedule. */
+int pfsph_sim_insert_stage(pfsph_sim *sim, const char *anchor, int after, const pfsph_stage_ops *stage, void *state,
+                           pfsph_error *err);
+int pfsph_sim_stage_count(const pfsph_sim *sim);
+/* The i-th stage's name (NULL past the end). */
+const char *pfsph_sim_stage_name(const pfsph_sim *sim, int i);
+/* What the stages share, for a stage inserted from outside (core/stage.h). */
+pfsph_step *pfsph_sim_step_state(pfsph_sim *sim);
 
 double pfsph_sim_time(const pfsph_sim *sim);
 uint64_t pfsph_sim_steps(const pfsph_sim *sim);

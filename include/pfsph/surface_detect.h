@@ -36,4 +36,8 @@ typedef struct pfsph_surface_opts {
  * Deterministic for any thread count; allocates nothing. */
 void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uint8_t *layer, uint8_t *work);
 
+/* The frames' surface layers of the fluid as it is now (up to `layers`), boundary particles
+ * covering, each bubble on its own when `bubbles`; allocates its work. PFSPH_OK or PFSPH_ENOMEM. */
+int pfsph__surface_layers(const pfsph_ctx *ctx, bool bubbles, int layers, uint8_t *out);
+
 #endif

@@ -486,8 +486,8 @@ static int cmd_check(int argc, char **argv)
         const pfsph_solver_ops *ops = pfsph_solver_find(s.solver);
         char buf[256];
         const char *advice = ops && ops->ratio_advice
-                                 ? ops->ratio_advice(ratio, s.pressure_scale == PFSPH_PRESSURE_COMMON, buf, sizeof buf)
-                                 : NULL;
+            ? ops->ratio_advice(ratio, s.pressure_scale == PFSPH_PRESSURE_COMMON, buf, sizeof buf)
+            : NULL;
         if (advice) printf(": %s\n", advice);
         else printf("\n");
     }

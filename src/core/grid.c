@@ -1,6 +1,8 @@
 /* Counting-sort uniform grid (see grid.h for the layout and why). */
 #include "pfsph/grid.h"
 
+#include "core/stage.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -163,3 +165,18 @@ size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real rad
     }
     return cnt;
 }
+
+/* The grid stage: the fluid sorted into its cells (particles that left the domain removed), in
+ * the order every later walk of the step relies on. */
+static int grid_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    st->removed_before = st->removed;
+    if (pfsph_grid_sort(st->ctx->grid, st->ctx->fluid, &st->removed))
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sorting the fluid into the grid");
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_grid = {
+    .name = "grid", .slot = PFSPH_STAGE_GRID, .reads = PFSPH_D_POS, .writes = PFSPH_D_ORDER, .run = grid_run};

@@ -3,7 +3,10 @@
 #include "pfsph/surface_detect.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "core/stage.h"
 
 /* One peel: for each particle still in (layer[i] == 0, or every particle on the first pass)
  * out[i] = 1 when its sphere has an uncovered point. Neighbours already peeled do not cover. */
@@ -130,3 +133,37 @@ void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uin
             if (work[i]) layer[i] = (uint8_t)L;
     }
 }
+
+/* Output: the outer two layers of surface particles of every fluid frame (docs/film.md). The
+ * particles moved since the step's sort by at most a step's travel: one cell more each way keeps
+ * every neighbour within the radius in the ranges walked. With bubbles each bubble on its own. */
+int pfsph__surface_layers(const pfsph_ctx *c, bool bubbles, int layers, uint8_t *out)
+{
+    const size_t n = c->fluid->n;
+    uint8_t *work = layers > 1 ? malloc(n ? n : 1) : NULL;
+    if (layers > 1 && !work) return PFSPH_ENOMEM;
+    int reach = c->grid->reach + 1;
+    pfsph_surface_opts o = {.radius = 0,
+                            .layers = layers,
+                            .group = bubbles ? c->fluid->bubble : NULL,
+                            .boundary = true,
+                            .reach = reach > 3 ? 3 : reach};
+    pfsph_surface_detect(c, &o, out, work);
+    free(work);
+    return PFSPH_OK;
+}
+
+static int surface_layers_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    if (pfsph__surface_layers(st->ctx, st->film != NULL, 2, st->out_layer))
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the surface layers");
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_surface_layers = {.name = "surface_layers",
+                                                    .slot = PFSPH_STAGE_OUTPUT,
+                                                    .reads = PFSPH_D_POS | PFSPH_D_ORDER,
+                                                    .writes = PFSPH_D_OUTPUT,
+                                                    .run = surface_layers_run};

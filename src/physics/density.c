@@ -6,6 +6,8 @@
 #include "core/hits.h"
 #include "core/nlist.h"
 #include "physics/pair_terms.h"
+#include "physics/solver.h"
+#include "physics/stages.h"
 
 void pfsph__number_density(const pfsph_ctx *ctx, const pfsph_real *x, const pfsph_real *y, const pfsph_real *z,
                            pfsph_real *nd)
@@ -133,3 +135,59 @@ int pfsph__number_density_list(const pfsph_ctx *ctx, pfsph_real *nd, pfsph_nlist
     rc = pfsph_nlist_finish(l, over, &S);
     return rc ? rc : pfsph_nlist_finish(lb, bover, &SB);
 }
+
+/* compression (rho / rho0 - 1) that stops a run as unstable */
+#define PFSPH_DENSITY_ERROR_LIMIT 0.5
+
+int pfsph__density_check(pfsph_step *st, pfsph_blowup *bad)
+{
+    pfsph_ctx *c = st->ctx;
+    pfsph_particles *f = c->fluid;
+    const size_t n = f->n;
+    pfsph_real ndmax = 0;
+#pragma omp parallel for schedule(static) reduction(max : ndmax)
+    for (size_t i = 0; i < n; i++) {
+        f->rho[i] = c->mass[f->phase[i]] * c->nd[i];
+        if (c->nd[i] > ndmax) ndmax = c->nd[i];
+    }
+    /* A particle compressed by half again its rest density means the pressure solve has lost
+     * control (PCISPH aims at 0.5%, WCSPH at Mach 0.1 stays near 1%): stop before the pressure
+     * solve turns it into NaN. */
+    if ((double)ndmax / (double)c->nd0 - 1 > PFSPH_DENSITY_ERROR_LIMIT) {
+        size_t wi = 0;
+        for (size_t i = 1; i < n; i++)
+            if (c->nd[i] > c->nd[wi]) wi = i;
+        return pfsph__blowup(bad, wi, "relative density error", (double)ndmax / (double)c->nd0 - 1);
+    }
+    return PFSPH_OK;
+}
+
+/* Number density; with neighbour lists (solvers that walk the neighbours many times a step)
+ * the density's walk also fills them: positions stay put until the integration, and the loop
+ * drops the lists after any stage that writes positions or the order. */
+static int density_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    pfsph_ctx *c = st->ctx;
+    pfsph_particles *f = c->fluid;
+    c->nlist = c->nlist_b = NULL;
+    if (st->solver->neighbour_lists) {
+        const double q = (double)c->h / (double)c->spacing; /* a full neighbourhood, and a quarter */
+        const double guess = 1.25 * (c->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q);
+        int rc = pfsph__number_density_list(c, c->nd, st->nlist, st->nlist_b, guess);
+        if (rc)
+            return pfsph_fail(err, rc, "cannot build the neighbour lists (%s)",
+                              rc == PFSPH_ENOMEM ? "out of memory" : "internal error");
+        c->nlist = st->nlist;
+        c->nlist_b = st->nlist_b;
+    } else {
+        pfsph__number_density(c, f->x, f->y, f->z, c->nd);
+    }
+    return pfsph__density_check(st, bad);
+}
+
+const pfsph_stage_ops pfsph_stage_density = {.name = "density",
+                                             .slot = PFSPH_STAGE_DENSITY,
+                                             .reads = PFSPH_D_POS | PFSPH_D_ORDER,
+                                             .writes = PFSPH_D_DENSITY | PFSPH_D_NLIST,
+                                             .run = density_run};

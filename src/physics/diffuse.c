@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "pfsph/rng.h"
+#include "physics/stages.h"
 
 #define TWO_PI 6.283185307179586
 
@@ -567,3 +568,18 @@ int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t c
     d->refused = refused;
     return PFSPH_OK;
 }
+
+static int diffuse_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_diffuse_step(st->df, st->ctx);
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_diffuse = {.name = "diffuse",
+                                             .slot = PFSPH_STAGE_DIFFUSE,
+                                             .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_ORDER | PFSPH_D_DT,
+                                             .writes = PFSPH_D_DIFFUSE,
+                                             .run = diffuse_run};

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "physics/stages.h"
+
 /* Closer than this to a particle already there, a site is skipped for the layer: the issue's
  * bound on entry spacing, with the lattice's own d between sites of one layer and between
  * consecutive layers of a free jet. */
@@ -333,3 +335,30 @@ int pfsph_emitters_set_state(pfsph_emitters *em, int i, const pfsph_emitter_stat
     if (!rc) em->z[i].st = *st;
     return rc;
 }
+
+/* New particles at the nozzles, after everything moved. Their entry speed counts in the next
+ * step's CFL condition through stats.vmax. The fluid's arrays are reserved for the scene's end
+ * time; a longer run (--end) grows them by half at least (st->reserve). */
+static int emit_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    pfsph_particles *f = st->ctx->fluid;
+    size_t due = pfsph_emitters_due(st->em, st->time, st->ctx->dt);
+    if (!due) {
+        pfsph_emitters_step(st->em, f, st->ctx, st->time, st->ctx->dt, &(double){0}); /* keeps the debt */
+        return PFSPH_OK;
+    }
+    int rc = st->reserve(st, f->n + due, err);
+    if (rc) return rc;
+    double vin = 0;
+    pfsph_emitters_step(st->em, f, st->ctx, st->time, st->ctx->dt, &vin);
+    if (vin > st->stats.vmax) st->stats.vmax = vin;
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_emit = {.name = "emit",
+                                          .slot = PFSPH_STAGE_INTEGRATE,
+                                          .reads = PFSPH_D_DT,
+                                          .writes = PFSPH_D_ORDER | PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_STATS,
+                                          .run = emit_run};

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "pfsph/surface_detect.h"
+#include "physics/stages.h"
 
 struct pfsph_film {
     uint8_t *layer;
@@ -108,3 +109,20 @@ int pfsph_film_update(pfsph_film *fm, const pfsph_ctx *ctx)
 const uint8_t *pfsph_film_layers(const pfsph_film *fm) { return fm->layer; }
 double pfsph_film_fraction(const pfsph_film *fm, int k) { return fm->frac[k]; }
 long pfsph_film_surface_count(const pfsph_film *fm, int k) { return fm->ns[k]; }
+
+/* bubbles in air: each bubble's surface layer and its film fraction (PF Section 4.2.2), on the
+ * positions this step's forces see */
+static int film_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    if (pfsph_film_update(st->film, st->ctx) < 0)
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory in the film stage");
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_film = {.name = "film",
+                                          .slot = PFSPH_STAGE_FILM,
+                                          .reads = PFSPH_D_POS | PFSPH_D_ORDER,
+                                          .writes = PFSPH_D_FILM,
+                                          .run = film_run};

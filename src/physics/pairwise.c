@@ -12,6 +12,8 @@
 #include "pfsph/eigen.h"
 #include "pfsph/film.h"
 #include "physics/pair_terms.h"
+#include "physics/solver.h"
+#include "physics/stages.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -458,3 +460,112 @@ void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx
         out[i] = (pfsph_real)((double)ctx->nd[i] / dim * (kin + 0.5 * (vir[i] + pv)));
     }
 }
+
+/* ---- the stages this module owns ---- */
+
+/* particle shifting, if the scene asks (docs/pairwise.md); uses last step's ctx->dt */
+static int shift_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_pairwise_shift(st->pw, st->ctx);
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_shift = {.name = "shift",
+                                           .slot = PFSPH_STAGE_PAIRWISE,
+                                           .reads = PFSPH_D_POS | PFSPH_D_ORDER,
+                                           .writes = PFSPH_D_POS,
+                                           .run = shift_run};
+
+/* With pair forces and a solver without neighbour lists or pre_forces (WCSPH, PCISPH): the
+ * density in the pair forces' walk, whose k h neighbourhood holds the h one (one walk instead of
+ * two: the density pass was ~7 % of a pair-force step). The pair accelerations go to pair_a for
+ * the pairwise stage (explicitly handed over: PFSPH_D_PAIR_ACC). */
+static int pair_density_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)err;
+    pfsph_ctx *c = st->ctx;
+    c->nlist = c->nlist_b = NULL;
+    pfsph_pairwise_apply_density(st->pw, c, c->nd, st->pair_a);
+    return pfsph__density_check(st, bad);
+}
+
+const pfsph_stage_ops pfsph_stage_pair_density = {.name = "density",
+                                                  .slot = PFSPH_STAGE_PAIRWISE,
+                                                  .reads = PFSPH_D_POS | PFSPH_D_ORDER | PFSPH_D_VEL | PFSPH_D_FILM,
+                                                  .writes = PFSPH_D_DENSITY | PFSPH_D_PAIR_ACC,
+                                                  .run = pair_density_run};
+
+static int pairwise_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_pairwise_apply(st->pw, st->ctx);
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_pairwise = {.name = "pairwise",
+                                              .slot = PFSPH_STAGE_PAIRWISE,
+                                              .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_FILM,
+                                              .writes = PFSPH_D_ACC,
+                                              .run = pairwise_run};
+
+/* the pair accelerations pair_density computed, added as pfsph_pairwise_apply adds them */
+static int pairwise_add_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_ctx *c = st->ctx;
+    const pfsph_real *px = st->pair_a[0], *py = st->pair_a[1], *pz = st->pair_a[2];
+    const size_t n = c->fluid->n;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        c->ax[i] += px[i];
+        c->ay[i] += py[i];
+        c->az[i] += pz[i];
+    }
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_pairwise_add = {.name = "pairwise",
+                                                  .slot = PFSPH_STAGE_PAIRWISE,
+                                                  .reads = PFSPH_D_PAIR_ACC,
+                                                  .writes = PFSPH_D_ACC,
+                                                  .run = pairwise_add_run};
+
+/* Output: the mechanical pressure, with the pressure the solver pushed with: DFSPH's divergence
+ * solve pushes too (its wall_pressure); with its density pressure alone the interior of a 3D drop
+ * read -15 Pa for +133 Pa. */
+int pfsph__mechanical_pressure(const pfsph_step *st, pfsph_real *out)
+{
+    const pfsph_ctx *c = st->ctx;
+    double *vir = malloc((c->fluid->n ? c->fluid->n : 1) * sizeof(double));
+    if (!vir) return PFSPH_ENOMEM;
+    const pfsph_real *p = st->solver->wall_pressure && c->fluid->n
+        ? st->solver->wall_pressure(st->solver_state, c, st->solver_scratch)
+        : NULL;
+    pfsph_pairwise_mechanical_pressure(st->pw, c, p, vir, out);
+    free(vir);
+    return PFSPH_OK;
+}
+
+static int mechanical_pressure_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    if (pfsph__mechanical_pressure(st, st->out_mech_p))
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the mechanical pressure");
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_mechanical_pressure = {.name = "mechanical_pressure",
+                                                         .slot = PFSPH_STAGE_OUTPUT,
+                                                         .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY |
+                                                             PFSPH_D_PRESSURE | PFSPH_D_SOLVER,
+                                                         .writes = PFSPH_D_OUTPUT,
+                                                         .run = mechanical_pressure_run};

@@ -2,6 +2,8 @@
  * defining `const pfsph_solver_ops pfsph_solver_<name>` and one word in PFSPH_SOLVERS. */
 #include "physics/solver.h"
 
+#include "physics/stages.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -42,3 +44,61 @@ int pfsph__check_iterations(double min_iter, double max_iter, const char **key, 
     snprintf(msg, len, "min_iterations (%d) is greater than max_iterations (%d)", (int)min_iter, (int)max_iter);
     return 1;
 }
+
+/* ---- the pressure solver's stages ---- */
+
+/* a divergence-free solver (DFSPH) corrects the velocities before the non-pressure forces */
+static int divergence_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_solve_stats out = {0, 0, 0};
+    st->solver->pre_forces(st->solver_state, st->ctx, st->solver_scratch, &out);
+    st->stats.div_iterations = out.div_iterations;
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_divergence = {.name = "divergence",
+                                                .slot = PFSPH_STAGE_PRESSURE,
+                                                .reads = PFSPH_D_POS | PFSPH_D_DENSITY | PFSPH_D_NLIST | PFSPH_D_DT,
+                                                .writes = PFSPH_D_VEL | PFSPH_D_SOLVER | PFSPH_D_STATS,
+                                                .run = divergence_run};
+
+static int pressure_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_solve_stats out = {0, 0, 0};
+    st->solver->solve(st->solver_state, st->ctx, st->ap, st->solver_scratch, &out);
+    st->stats.iterations = out.iterations;
+    st->stats.density_err_avg = out.density_err_avg;
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_pressure = {.name = "pressure",
+                                              .slot = PFSPH_STAGE_PRESSURE,
+                                              .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_ACC |
+                                                  PFSPH_D_NLIST | PFSPH_D_DT,
+                                              .writes = PFSPH_D_PRESSURE | PFSPH_D_AP | PFSPH_D_SOLVER | PFSPH_D_STATS,
+                                              .run = pressure_run};
+
+/* the forces stage computed the pressure (pfsph_stage_forces_eos): the solver only reports */
+static int pressure_report_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_solve_stats out = {0, 0, 0};
+    st->solver->report(st->solver_state, st->ctx, st->solver_scratch, &out);
+    st->stats.iterations = out.iterations;
+    st->stats.density_err_avg = out.density_err_avg;
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_pressure_report = {.name = "pressure",
+                                                     .slot = PFSPH_STAGE_PRESSURE,
+                                                     .reads = PFSPH_D_DENSITY,
+                                                     .writes = PFSPH_D_SOLVER | PFSPH_D_STATS,
+                                                     .run = pressure_report_run};

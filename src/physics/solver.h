@@ -34,7 +34,7 @@ typedef struct pfsph_solve_stats {
 } pfsph_solve_stats;
 
 typedef struct pfsph_solver_ops {
-    const char *name; /* as in the scene's solver.type */
+    const char *name;             /* as in the scene's solver.type */
     const pfsph_solver_key *keys; /* its own scene keys (NULL when none) */
     int nkeys;                    /* at most PFSPH_SOLVER_MAX_KEYS */
     /* Optional: checks across keys (v in the order of keys); on failure points *key at the key
@@ -44,8 +44,8 @@ typedef struct pfsph_solver_ops {
      * solver (common_scale: "pressure_scale": "common"), written to buf or a constant; NULL:
      * nothing to add. */
     const char *(*ratio_advice)(double ratio, int common_scale, char *buf, size_t len);
-    int nscratch;     /* per-fluid-particle scratch arrays the solver needs */
-    int nscratch4;    /* the last nscratch4 of them hold 4 values per particle (packed x, y, z, w) */
+    int nscratch;  /* per-fluid-particle scratch arrays the solver needs */
+    int nscratch4; /* the last nscratch4 of them hold 4 values per particle (packed x, y, z, w) */
     /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
      * solver that walks the neighbours many times per step (memory: src/core/nlist.h). */
     int neighbour_lists;

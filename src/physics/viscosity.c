@@ -7,6 +7,8 @@
 #include "physics/pair_terms.h"
 #include "physics/pressure.h"
 #include "pfsph/thermostat.h"
+#include "physics/solver.h"
+#include "physics/stages.h"
 
 /* particle i as its fluid pairs see it */
 typedef struct visc_i {
@@ -363,3 +365,41 @@ void pfsph__forces_and_pressure(const pfsph_ctx *ctx, pfsph_real *const noise[3]
         nonpressure(ctx, NULL, 0, 1, p, ap);
     }
 }
+
+/* ---- the stages this module owns ---- */
+
+/* gravity and viscosity (with the thermostat's random forces, fused, when it is on) */
+static int forces_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    if (st->noise[0]) pfsph__nonpressure_thermo(st->ctx, st->noise);
+    else pfsph__nonpressure(st->ctx);
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_forces = {.name = "forces",
+                                            .slot = PFSPH_STAGE_FORCES,
+                                            .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_DT,
+                                            .writes = PFSPH_D_ACC | PFSPH_D_NOISE,
+                                            .run = forces_run};
+
+/* A solver whose pressure follows from the density alone (its eos), without pair forces (their
+ * stage would sit between and read last step's pressure): the pressure and its acceleration in
+ * the viscosity's walk, two walks a step instead of three, the same bits (solver.h, eos). */
+static int forces_eos_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    st->solver->eos(st->solver_state, st->ctx);
+    pfsph__forces_and_pressure(st->ctx, st->noise[0] ? st->noise : NULL, st->ctx->fluid->p, st->ap);
+    return PFSPH_OK;
+}
+
+const pfsph_stage_ops pfsph_stage_forces_eos = {.name = "forces",
+                                                .slot = PFSPH_STAGE_FORCES,
+                                                .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_DT,
+                                                .writes = PFSPH_D_ACC | PFSPH_D_NOISE | PFSPH_D_PRESSURE | PFSPH_D_AP,
+                                                .run = forces_eos_run};

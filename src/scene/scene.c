@@ -39,7 +39,7 @@ typedef struct parser {
 
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 static const char *const kind_names[] = {"fluid", "gas", "solid", NULL};
-static const char *const pressure_scale_names[] = {"phase", "common", NULL};  /* enum order */
+static const char *const pressure_scale_names[] = {"phase", "common", NULL}; /* enum order */
 
 static void path_key(char *out, size_t cap, const char *path, const char *key)
 {
