@@ -6,6 +6,8 @@
 
 #include <math.h>
 
+#include "core/vec.h"
+
 void pfsph_eigen_sym2(const double a[2][2], double w[2], double v[2][2])
 {
     double p = a[0][0], q = a[0][1], r = a[1][1];
@@ -81,15 +83,6 @@ int pfsph_eigen_sym3(const double a[3][3], double w[3], double v[3][3])
     return sweep;
 }
 
-static inline void cross3(const double a[3], const double b[3], double c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static inline double dot3(const double a[3], const double b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
 /* The eigenvector of the simple eigenvalue e of the (scaled) matrix m: the largest of the cross
  * products of two rows of m - e I, which spans their orthogonal complement. */
 static void evec_simple(const double m[3][3], double e, double out[3])
@@ -98,10 +91,10 @@ static void evec_simple(const double m[3][3], double e, double out[3])
     const double r1[3] = {m[0][1], m[1][1] - e, m[1][2]};
     const double r2[3] = {m[0][2], m[1][2], m[2][2] - e};
     double c[3][3];
-    cross3(r0, r1, c[0]);
-    cross3(r0, r2, c[1]);
-    cross3(r1, r2, c[2]);
-    const double d0 = dot3(c[0], c[0]), d1 = dot3(c[1], c[1]), d2 = dot3(c[2], c[2]);
+    vec3_cross(r0, r1, c[0]);
+    vec3_cross(r0, r2, c[1]);
+    vec3_cross(r1, r2, c[2]);
+    const double d0 = vec3_dot(c[0], c[0]), d1 = vec3_dot(c[1], c[1]), d2 = vec3_dot(c[2], c[2]);
     int k = d0 >= d1 ? (d0 >= d2 ? 0 : 2) : (d1 >= d2 ? 1 : 2);
     const double d = k == 0 ? d0 : (k == 1 ? d1 : d2);
     if (!(d > 0)) { /* m - e I of rank < 2: only for an all-equal spectrum, where any axis is one */
@@ -125,13 +118,13 @@ static void evec_plane(const double m[3][3], const double u0[3], double e, doubl
         const double inv = 1.0 / sqrt(u0[1] * u0[1] + u0[2] * u0[2]);
         U[0] = 0, U[1] = u0[2] * inv, U[2] = -u0[1] * inv;
     }
-    cross3(u0, U, V);
+    vec3_cross(u0, U, V);
     double mU[3], mV[3];
     for (int a = 0; a < 3; a++) {
         mU[a] = m[a][0] * U[0] + m[a][1] * U[1] + m[a][2] * U[2];
         mV[a] = m[a][0] * V[0] + m[a][1] * V[1] + m[a][2] * V[2];
     }
-    double m00 = dot3(U, mU) - e, m01 = dot3(U, mV), m11 = dot3(V, mV) - e;
+    double m00 = vec3_dot(U, mU) - e, m01 = vec3_dot(U, mV), m11 = vec3_dot(V, mV) - e;
     const double a00 = fabs(m00), a01 = fabs(m01), a11 = fabs(m11);
     double cu = 1, cv = 0; /* out = cu U + cv V */
     if (a00 >= a11) {
@@ -245,11 +238,11 @@ void pfsph_eigen_sym3_fast(const double a[3][3], double w[3], double v[3][3])
     if (far > 0) {  /* the largest is the farther from the middle one */
         evec_simple(m, e[0], u[0]);
         evec_plane(m, u[0], e[1], u[1]);
-        cross3(u[0], u[1], u[2]);
+        vec3_cross(u[0], u[1], u[2]);
     } else {
         evec_simple(m, e[2], u[2]);
         evec_plane(m, u[2], e[1], u[1]);
-        cross3(u[1], u[2], u[0]);
+        vec3_cross(u[1], u[2], u[0]);
     }
     for (int k = 0; k < 3; k++) {
         w[k] = e[k] * s;
