@@ -22,6 +22,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "io/colormap.h"
 #include "pfsph/bodies.h"
 #include "pfsph/io.h"
 #include "pfsph/meshing.h"
@@ -517,7 +518,7 @@ static size_t add_sprites(app *A, size_t n0, const pfsph_particles *ps, double r
         } else if (kind == 3 || A->by == BY_PHASE) {
             if (ph < sc->nphases) memcpy(col, sc->phases[ph].color, sizeof col);
         } else {
-            pfsph_viridis((field(ps, i, A->by) - lo) / (hi - lo), col);
+            pfsph__viridis((field(ps, i, A->by) - lo) / (hi - lo), col);
         }
         s->cr = col[0], s->cg = col[1], s->cb = col[2];
         m++;
