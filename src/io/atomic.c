@@ -178,8 +178,10 @@ int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_
     return PFSPH_OK;
 }
 
-int pfsph__reader_open(const char *path, unsigned char **buf, size_t *len, double *time, pfsph_error *err)
+int pfsph__reader_open(const char *path, void *out, size_t out_size, unsigned char **buf, size_t *len, double *time,
+                       pfsph_error *err)
 {
+    memset(out, 0, out_size);
     if (time) *time = 0;
     return pfsph__read_file(path, buf, len, err);
 }

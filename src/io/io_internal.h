@@ -34,10 +34,11 @@ void pfsph__afile_abort(pfsph__afile *a);
 /* Read a whole file into a malloc'ed buffer with one extra NUL byte after the data. */
 int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_error *err);
 
-/* The start of every frame reader (PLY, VTP, surface PLY): the whole file into *buf as
- * pfsph__read_file does, and *time 0 until the file says otherwise (time may be NULL). The
- * caller frees *buf. */
-int pfsph__reader_open(const char *path, unsigned char **buf, size_t *len, double *time, pfsph_error *err);
+/* The start of every frame reader (PLY, VTP, surface PLY): out (out_size bytes) cleared, so
+ * that a refused file leaves it empty; *time 0 until the file says otherwise (time may be NULL);
+ * the whole file into *buf as pfsph__read_file does. The caller frees *buf. */
+int pfsph__reader_open(const char *path, void *out, size_t out_size, unsigned char **buf, size_t *len, double *time,
+                       pfsph_error *err);
 /* A malformed input file: fails with "<path>: invalid <what>: <reason>" (PFSPH_EINPUT), the
  * reason printf-formatted (at most 511 characters); the reason names the line or the array. */
 int pfsph__bad_input(pfsph_error *err, const char *path, const char *what, const char *fmt, ...)

@@ -119,10 +119,9 @@ int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, doubl
 
 int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time, pfsph_error *err)
 {
-    memset(m, 0, sizeof *m);
     unsigned char *buf;
     size_t len;
-    int rc = pfsph__reader_open(path, &buf, &len, time, err);
+    int rc = pfsph__reader_open(path, m, sizeof *m, &buf, &len, time, err);
     if (rc != PFSPH_OK) return rc;
     static const pfsph__ply_spec spec = {.what = "surface PLY", .elems = {"vertex", "face"}, .lists = true};
 #define BAD(...) PFSPH__BAD(spec.what, __VA_ARGS__)

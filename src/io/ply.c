@@ -69,10 +69,9 @@ int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_
 
 int pfsph_read_ply(const char *path, pfsph_particles *ps, double *time, pfsph_error *err)
 {
-    memset(ps, 0, sizeof *ps);
     unsigned char *buf;
     size_t len;
-    int rc = pfsph__reader_open(path, &buf, &len, time, err);
+    int rc = pfsph__reader_open(path, ps, sizeof *ps, &buf, &len, time, err);
     if (rc != PFSPH_OK) return rc;
     static const pfsph__ply_spec spec = {.what = "PLY file", .elems = {"vertex"}, .unique = true};
 #define BAD(...) PFSPH__BAD(spec.what, __VA_ARGS__)

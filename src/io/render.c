@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/colormap.h"
 #include "io/render_internal.h"
 #include "pfsph/io.h"
 #include "pfsph/meshing.h"
@@ -207,27 +208,6 @@ oom:
 
 /* ---- driver --------------------------------------------------------------------------- */
 
-/* A fixed colour scale for speed over the whole run (per-frame ranges flicker): the free-fall
- * speed sqrt(2 g H) over the fluid's height H in the first frame, the largest speed a
- * gravity-driven flow such as a dam break reaches, or what emitted fluid reaches when more.
- * 0 (per-frame range) without gravity or fluid. */
-static double speed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
-{
-    double g2 = 0, ve = pfsph_scene_emitter_speed(sc);
-    for (int k = 0; k < 3; k++) g2 += sc->gravity[k] * sc->gravity[k];
-    if (!(g2 > 0) || fluid->n == 0) return ve;
-    double g = sqrt(g2), lo = DBL_MAX, hi = -DBL_MAX;
-    for (size_t i = 0; i < fluid->n; i++) {
-        double h = -(fluid->x[i] * sc->gravity[0] + fluid->y[i] * sc->gravity[1] +
-                     (sc->dim == 3 ? fluid->z[i] * sc->gravity[2] : 0.0)) /
-            g;
-        if (!isfinite(h)) continue;
-        if (h < lo) lo = h;
-        if (h > hi) hi = h;
-    }
-    return fmax(ve, hi > lo ? sqrt(2 * g * (hi - lo)) : 0);
-}
-
 static int color_code(const char *s)
 {
     if (!s || !*s || strcmp(s, "phase") == 0) return PFSPH__COLOR_PHASE;
@@ -352,7 +332,7 @@ int pfsph_render_run(const char *run_dir, const pfsph_render_opts *o, int *count
         if (di >= 0 && (rc = pfsph__read_frame(fdir, "diffuse_", f, dl.ply[di], &dif, NULL, err))) goto out;
         if (i == i0) {
             pfsph__rcam_frame(&x.c, sc, &fluid, bi >= 0 ? &bnd : NULL);
-            x.vref = speed_scale(sc, &fluid);
+            x.vref = pfsph__speed_scale(sc, &fluid);
         }
         pfsph_surface_mesh liq, bm;
         /* the liquid needs its normals (smooth shading); a file without them counts as absent */

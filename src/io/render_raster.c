@@ -58,10 +58,6 @@ static void field_range(const pfsph_particles *ps, int by, double *lo, double *h
     if (!(*hi > *lo)) *hi = *lo + (fabs(*lo) > 0 ? 1e-3 * fabs(*lo) : 1.0);
 }
 
-static const float DIFFUSE_COL[3][3] = {{0.98f, 0.98f, 0.98f},  /* spray */
-                                        {0.80f, 0.82f, 0.85f},  /* foam */
-                                        {0.55f, 0.78f, 0.98f}}; /* bubble */
-
 int pfsph__splat_add_set(pfsph__splat_set *ss, const cam *c, const pfsph_particles *ps, double rad, int layer,
                          int kind /* 0 fluid, 1 boundary, 2 diffuse, 3 bodies */, const pfsph_scene *sc, int by,
                          double vref, int ssf, const pfsph_cutaway *cw, double range[2])
@@ -94,7 +90,7 @@ int pfsph__splat_add_set(pfsph__splat_set *ss, const cam *c, const pfsph_particl
             else s->col[0] = 0.78f, s->col[1] = 0.78f, s->col[2] = 0.80f;
         } else if (kind == 2) {
             int t = ps->phase[i] < 3 ? ps->phase[i] : 0;
-            memcpy(s->col, DIFFUSE_COL[t], sizeof s->col);
+            memcpy(s->col, PFSPH__DIFFUSE_COL[t], sizeof s->col);
         } else if (by == PFSPH__COLOR_PHASE || kind == 3) {
             int ph = ps->phase[i];
             if (ph < sc->nphases) memcpy(s->col, sc->phases[ph].color, sizeof s->col);

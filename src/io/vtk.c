@@ -276,10 +276,9 @@ static const unsigned char *find_bytes(const unsigned char *h, size_t hl, const 
 
 int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_error *err)
 {
-    memset(ps, 0, sizeof *ps);
     unsigned char *buf;
     size_t len;
-    int rc = pfsph__reader_open(path, &buf, &len, time, err);
+    int rc = pfsph__reader_open(path, ps, sizeof *ps, &buf, &len, time, err);
     if (rc != PFSPH_OK) return rc;
 #define BAD(...) PFSPH__BAD("VTP file", __VA_ARGS__)
 

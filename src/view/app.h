@@ -134,8 +134,6 @@ extern const char *const pfsph_vby_name[PFSPH_VBY_COUNT];
 
 /* ---- frame.c ---------------------------------------------------------------------------- */
 void pfsph_vframe_free(pfsph_vframe *f);
-/* The renderer's fixed speed scale for the fluid of the first frame. */
-double pfsph_vspeed_scale(const pfsph_scene *sc, const pfsph_particles *fluid);
 /* Draw A->shown (and the overlay unless --no-overlay) into the frame. */
 void pfsph_vframe_draw(pfsph_vapp *A);
 

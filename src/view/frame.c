@@ -60,27 +60,6 @@ static void field_range(const pfsph_vapp *A, const pfsph_particles *ps, int by, 
     if (!(*hi > *lo)) *hi = *lo + (fabs(*lo) > 0 ? 1e-3 * fabs(*lo) : 1.0);
 }
 
-/* The renderer's fixed speed scale: free fall over the first frame's fluid height, or what
- * emitted fluid reaches when more. */
-double pfsph_vspeed_scale(const pfsph_scene *sc, const pfsph_particles *fluid)
-{
-    double g2 = 0, ve = pfsph_scene_emitter_speed(sc);
-    for (int k = 0; k < 3; k++) g2 += sc->gravity[k] * sc->gravity[k];
-    if (!(g2 > 0) || fluid->n == 0) return ve;
-    double g = sqrt(g2), lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < fluid->n; i++) {
-        double h = -(fluid->x[i] * sc->gravity[0] + fluid->y[i] * sc->gravity[1] +
-                     (sc->dim == 3 ? fluid->z[i] * sc->gravity[2] : 0.0)) /
-            g;
-        if (!isfinite(h)) continue;
-        lo = fmin(lo, h);
-        hi = fmax(hi, h);
-    }
-    return fmax(ve, hi > lo ? sqrt(2 * g * (hi - lo)) : 0);
-}
-
-static const float DIFFUSE_COL[3][3] = {{0.98f, 0.98f, 0.98f}, {0.80f, 0.82f, 0.85f}, {0.55f, 0.78f, 0.98f}};
-
 /* kind: 0 fluid, 1 walls, 2 diffuse, 3 bodies (as the renderer colours them) */
 static size_t add_sprites(pfsph_vapp *A, size_t n0, const pfsph_particles *ps, double rad, double zoff, int kind,
                           double lo, double hi, const pfsph_cutaway *cw)
@@ -112,7 +91,7 @@ static size_t add_sprites(pfsph_vapp *A, size_t n0, const pfsph_particles *ps, d
             if (ph < sc->nphases && sc->phases[ph].color_set) memcpy(col, sc->phases[ph].color, sizeof col);
             else col[0] = 0.78f, col[1] = 0.78f, col[2] = 0.80f;
         } else if (kind == 2) {
-            memcpy(col, DIFFUSE_COL[ph < 3 ? ph : 0], sizeof col);
+            memcpy(col, PFSPH__DIFFUSE_COL[ph < 3 ? ph : 0], sizeof col);
         } else if (kind == 3 || A->by == PFSPH_VBY_PHASE) {
             if (ph < sc->nphases) memcpy(col, sc->phases[ph].color, sizeof col);
         } else {

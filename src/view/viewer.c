@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "io/colormap.h"
 #include "pfsph/render.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
@@ -271,7 +272,7 @@ int pfsph_view_main(int argc, char **argv)
     for (int k = 0; k < 3; k++) A->depth = fmax(A->depth, A->scene->domain_max[k] - A->scene->domain_min[k]);
     pfsph_vcam_init(&A->cam, &rc0, ctr);
     A->cam0 = A->cam;
-    A->vref = pfsph_vspeed_scale(A->scene, &f0->fluid);
+    A->vref = pfsph__speed_scale(A->scene, &f0->fluid);
     if (!A->is_live && o->frame >= 0) {
         int k = pfsph_frame_list_find(&A->R.fluid, o->frame);
         if ((rc = pfsph_vreplay_load(&A->R, k, &A->rf, &err))) goto fail;
