@@ -1,5 +1,6 @@
 /* Atomic file output (temporary file in the same directory, fsync, rename) and whole-file reads,
- * used by every writer so a crash or a full disk never leaves a half-written frame behind. */
+ * used by every writer so a crash or a full disk never leaves a half-written frame behind; and
+ * the start and the refusals shared by the frame readers. */
 #include "io/io_internal.h"
 
 #include <errno.h>
@@ -177,6 +178,24 @@ int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_
     return PFSPH_OK;
 }
 
+int pfsph__reader_open(const char *path, void *out, size_t out_size, unsigned char **buf, size_t *len, double *time,
+                       pfsph_error *err)
+{
+    memset(out, 0, out_size);
+    if (time) *time = 0;
+    return pfsph__read_file(path, buf, len, err);
+}
+
+int pfsph__bad_input(pfsph_error *err, const char *path, const char *what, const char *fmt, ...)
+{
+    char m[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(m, sizeof m, fmt, ap);
+    va_end(ap);
+    return pfsph_fail(err, PFSPH_EINPUT, "%s: invalid %s: %s", path, what, m);
+}
+
 int pfsph__enc_init(pfsph__enc *e, pfsph__afile *a, pfsph_error *err)
 {
     memset(e, 0, sizeof *e);
@@ -219,6 +238,17 @@ int pfsph__enc_flush(pfsph__enc *e)
     e->len = 0;
     if (rc != PFSPH_OK) e->failed = 1;
     return rc;
+}
+
+int pfsph__enc_commit(pfsph__enc *e, pfsph__afile *af, pfsph_error *err)
+{
+    int rc = pfsph__enc_flush(e);
+    pfsph__enc_free(e);
+    if (rc != PFSPH_OK) {
+        pfsph__afile_abort(af);
+        return rc;
+    }
+    return pfsph__afile_commit(af, err);
 }
 
 void pfsph__enc_free(pfsph__enc *e)

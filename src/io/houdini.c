@@ -28,13 +28,7 @@ int pfsph_write_houdini_geo(const char *path, const pfsph_particles *ps, double 
                           (double)ps->z[i], (double)ps->vx[i], (double)ps->vy[i], (double)ps->vz[i], (double)ps->rho[i],
                           (double)ps->p[i], ps->phase[i], ps->id[i]);
     pfsph__enc_printf(&e, "beginExtra\nendExtra\n");
-    rc = pfsph__enc_flush(&e);
-    pfsph__enc_free(&e);
-    if (rc != PFSPH_OK) {
-        pfsph__afile_abort(&af);
-        return rc;
-    }
-    return pfsph__afile_commit(&af, err);
+    return pfsph__enc_commit(&e, &af, err);
 }
 
 #define BAD(...)                                                           \

@@ -34,6 +34,26 @@ void pfsph__afile_abort(pfsph__afile *a);
 /* Read a whole file into a malloc'ed buffer with one extra NUL byte after the data. */
 int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_error *err);
 
+/* The start of every frame reader (PLY, VTP, surface PLY): out (out_size bytes) cleared, so
+ * that a refused file leaves it empty; *time 0 until the file says otherwise (time may be NULL);
+ * the whole file into *buf as pfsph__read_file does. The caller frees *buf. */
+int pfsph__reader_open(const char *path, void *out, size_t out_size, unsigned char **buf, size_t *len, double *time,
+                       pfsph_error *err);
+/* A malformed input file: fails with "<path>: invalid <what>: <reason>" (PFSPH_EINPUT), the
+ * reason printf-formatted (at most 511 characters); the reason names the line or the array. */
+int pfsph__bad_input(pfsph_error *err, const char *path, const char *what, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+/* In a reader holding `rc`, `err` and `path`, with a `done:` label that cleans up: refuse the
+ * file as pfsph__bad_input does and go to done. */
+#define PFSPH__BAD(what, ...)                                \
+    do {                                                     \
+        rc = pfsph__bad_input(err, path, what, __VA_ARGS__); \
+        goto done;                                           \
+    } while (0)
+
 /* Scalar type codes of the on-disk formats. */
 enum pfsph__type {
     PFSPH__T_NONE = 0,
@@ -49,14 +69,6 @@ enum pfsph__type {
     PFSPH__T_F64
 };
 size_t pfsph__type_size(int type);
-/* A PLY scalar type name ("float", "uint8", ...) as its code; PFSPH__T_NONE if unknown. */
-int pfsph__ply_type(const char *s);
-/* The next line of a PLY header at *pos (CR-LF tolerated), copied into line[cap]: 0, or 1 when
- * no end_header comes within the header limit, 2 when the line does not fit. Shared by the
- * particle and the surface readers. */
-int pfsph__ply_header_line(const unsigned char *buf, size_t len, size_t *pos, char *line, size_t cap);
-/* "comment time T" sets *time (when time is not NULL); other comments are ignored. */
-void pfsph__ply_comment_time(const char *line, double *time);
 /* Decode one little-endian value of the given type as a double (exact for every type we write:
  * float, double, uint8, uint32). */
 double pfsph__get_as_double(int type, const unsigned char *src);
@@ -102,6 +114,9 @@ void pfsph__enc_printf(pfsph__enc *e, const char *fmt, ...)
 #endif
     ;
 int pfsph__enc_flush(pfsph__enc *e);
+/* The end of a writer: flush and free the buffer, then commit the file (pfsph__afile_commit),
+ * or remove it when anything failed. */
+int pfsph__enc_commit(pfsph__enc *e, pfsph__afile *af, pfsph_error *err);
 void pfsph__enc_free(pfsph__enc *e);
 
 static inline void pfsph__enc_put(pfsph__enc *e, const void *v, size_t size)

@@ -10,18 +10,8 @@
 #include <string.h>
 
 #include "io/io_internal.h"
+#include "io/ply_header.h"
 #include "pfsph/io.h"
-
-static int finish(pfsph__enc *e, pfsph__afile *af, pfsph_error *err)
-{
-    int rc = pfsph__enc_flush(e);
-    pfsph__enc_free(e);
-    if (rc != PFSPH_OK) {
-        pfsph__afile_abort(af);
-        return rc;
-    }
-    return pfsph__afile_commit(af, err);
-}
 
 int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
 {
@@ -52,7 +42,7 @@ int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, doubl
         for (int k = 0; k < 3; k++) pfsph__enc_put(&e, &m->tri[3 * t + k], 4);
         pfsph__enc_put(&e, &m->phase[t], 1);
     }
-    return finish(&e, &af, err);
+    return pfsph__enc_commit(&e, &af, err);
 }
 
 int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
@@ -71,7 +61,7 @@ int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, doubl
         uint32_t a = m->tri[3 * t] + 1, b = m->tri[3 * t + 1] + 1, c = m->tri[3 * t + 2] + 1;
         pfsph__enc_printf(&e, "f %u//%u %u//%u %u//%u\n", a, a, b, b, c, c);
     }
-    return finish(&e, &af, err);
+    return pfsph__enc_commit(&e, &af, err);
 }
 
 /* VTP PolyData of a mesh or an outline: points, Normals (point data), cells of `arity` indices
@@ -117,7 +107,7 @@ static int write_polydata_vtp(const char *path, const double *v, const float *nr
                       cells);
     for (size_t t = 0; t < ncells; t++) pfsph__enc_printf(&e, "%d\n", phase[t]);
     pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
-    return finish(&e, &af, err);
+    return pfsph__enc_commit(&e, &af, err);
 }
 
 int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
@@ -127,99 +117,37 @@ int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, doubl
 
 /* ---- reader ---------------------------------------------------------------------------- */
 
-#define SURF_MAX_PROPS 32
-
-typedef struct surf_prop {
-    int type;
-    size_t offset; /* within a vertex record; faces: after the index list */
-    char name[80];
-} surf_prop;
-
 int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time, pfsph_error *err)
 {
-    memset(m, 0, sizeof *m);
-    if (time) *time = 0;
     unsigned char *buf;
     size_t len;
-    int rc = pfsph__read_file(path, &buf, &len, err);
+    int rc = pfsph__reader_open(path, m, sizeof *m, &buf, &len, time, err);
     if (rc != PFSPH_OK) return rc;
-#define BAD(...)                                                                     \
-    do {                                                                             \
-        char m_[400];                                                                \
-        snprintf(m_, sizeof m_, __VA_ARGS__);                                        \
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid surface PLY: %s", path, m_); \
-        goto done;                                                                   \
-    } while (0)
-    surf_prop vp[SURF_MAX_PROPS], fp[SURF_MAX_PROPS];
-    int nvp = 0, nfp = 0, elem = 0; /* elem: 0 none yet, 1 vertex, 2 face */
-    size_t vrec = 0, frec = 0;      /* bytes of a vertex record; of a face's scalars */
-    uint64_t nv = 0, nt = 0;
-    int cnt_type = PFSPH__T_NONE, idx_type = PFSPH__T_NONE;
-    bool have_format = false, have_face = false;
-    size_t pos = 0, lineno = 0;
-    char line[256];
-    for (;;) {
-        switch (pfsph__ply_header_line(buf, len, &pos, line, sizeof line)) {
-        case 1: BAD("no end_header line");
-        case 2: BAD("header line %zu too long", lineno + 1);
-        default: break;
-        }
-        lineno++;
-        char w[5][80];
-        int nw = sscanf(line, "%79s %79s %79s %79s %79s", w[0], w[1], w[2], w[3], w[4]);
-        if (lineno == 1) {
-            if (nw != 1 || strcmp(w[0], "ply") != 0) BAD("missing 'ply' magic");
-            continue;
-        }
-        if (nw <= 0) continue;
-        if (strcmp(w[0], "end_header") == 0) break;
-        if (strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0) {
-            pfsph__ply_comment_time(line, time);
-            continue;
-        }
-        if (strcmp(w[0], "format") == 0) {
-            if (nw != 3 || strcmp(w[1], "binary_little_endian") || strcmp(w[2], "1.0"))
-                BAD("format must be binary_little_endian 1.0");
-            have_format = true;
-        } else if (strcmp(w[0], "element") == 0) {
-            /* pfsph's order: vertices, then faces (every reader of ours and Blender's agree) */
-            bool isv = nw == 3 && !strcmp(w[1], "vertex") && elem == 0;
-            bool isf = nw == 3 && !strcmp(w[1], "face") && elem == 1;
-            if (!isv && !isf) BAD("line %zu: expected 'element vertex N' then 'element face N'", lineno);
-            if (pfsph__parse_u64(w[2], isv ? &nv : &nt) != 0) BAD("line %zu: bad element count", lineno);
-            elem = isv ? 1 : 2;
-            have_face = have_face || isf;
-        } else if (strcmp(w[0], "property") == 0) {
-            if (elem == 0) BAD("line %zu: property before element", lineno);
-            if (nw == 5 && !strcmp(w[1], "list")) {
-                if (elem != 2 || nfp || cnt_type != PFSPH__T_NONE ||
-                    (strcmp(w[4], "vertex_indices") && strcmp(w[4], "vertex_index")))
-                    BAD("line %zu: the only list must be the face's first property, vertex_indices", lineno);
-                cnt_type = pfsph__ply_type(w[2]);
-                idx_type = pfsph__ply_type(w[3]);
-                if (cnt_type != PFSPH__T_U8 || (idx_type != PFSPH__T_U32 && idx_type != PFSPH__T_I32))
-                    BAD("line %zu: vertex_indices must be 'list uchar uint' (or int)", lineno);
-                continue;
+    static const pfsph__ply_spec spec = {.what = "surface PLY", .elems = {"vertex", "face"}, .lists = true};
+#define BAD(...) PFSPH__BAD(spec.what, __VA_ARGS__)
+    pfsph__ply_header h;
+    rc = pfsph__ply_header_read(buf, len, path, &spec, &h, time, err);
+    if (rc != PFSPH_OK) goto done;
+    /* one list: the face's first property, its vertex indices */
+    for (int e = 0; e < h.nelems; e++)
+        for (int k = 0; k < h.elem[e].nprops; k++) {
+            const pfsph__ply_prop *p = &h.elem[e].prop[k];
+            if (e == 1 && k == 0) {
+                if (!p->list) BAD("line %zu: vertex_indices must come first", p->line);
+                if (strcmp(p->name, "vertex_indices") && strcmp(p->name, "vertex_index"))
+                    BAD("line %zu: the only list must be the face's first property, vertex_indices", p->line);
+                if (p->count_type != PFSPH__T_U8 || (p->type != PFSPH__T_U32 && p->type != PFSPH__T_I32))
+                    BAD("line %zu: vertex_indices must be 'list uchar uint' (or int)", p->line);
+            } else if (p->list) {
+                BAD("line %zu: the only list must be the face's first property, vertex_indices", p->line);
             }
-            if (nw != 3) BAD("line %zu: bad property", lineno);
-            int t = pfsph__ply_type(w[1]);
-            if (t == PFSPH__T_NONE) BAD("line %zu: unknown type '%s'", lineno, w[1]);
-            surf_prop *pr = elem == 1 ? vp : fp;
-            int *np = elem == 1 ? &nvp : &nfp;
-            size_t *rec = elem == 1 ? &vrec : &frec;
-            if (*np == SURF_MAX_PROPS) BAD("too many properties");
-            if (elem == 2 && cnt_type == PFSPH__T_NONE) BAD("line %zu: vertex_indices must come first", lineno);
-            pr[*np].type = t;
-            pr[*np].offset = *rec;
-            snprintf(pr[*np].name, sizeof pr[*np].name, "%s", w[2]);
-            *rec += pfsph__type_size(t);
-            (*np)++;
-        } else {
-            BAD("line %zu: unexpected '%s'", lineno, w[0]);
         }
-    }
-    if (!have_format) BAD("no format line");
-    if (!have_face || cnt_type == PFSPH__T_NONE) BAD("no face element with vertex_indices");
+    if (h.nelems < 2 || h.elem[1].nprops == 0) BAD("no face element with vertex_indices");
+    const pfsph__ply_prop *vp = h.elem[0].prop, *fp = h.elem[1].prop;
+    const int nvp = h.elem[0].nprops, nfp = h.elem[1].nprops;
+    const size_t vrec = h.elem[0].rec, frec = h.elem[1].rec, pos = h.data; /* frec: the face's scalars */
+    const uint64_t nv = h.elem[0].count, nt = h.elem[1].count;
+    const int idx_type = fp[0].type;
     if (nv >= (1u << 31) || nt >= (1u << 31)) BAD("too many vertices or faces");
     int ix[3] = {-1, -1, -1}, in[3] = {-1, -1, -1}, itag = -1;
     static const char *const pn[6] = {"x", "y", "z", "nx", "ny", "nz"};
@@ -234,7 +162,7 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
     if (ix[0] < 0 || ix[1] < 0 || ix[2] < 0) BAD("missing x, y or z");
     const bool normals = in[0] >= 0 && in[1] >= 0 && in[2] >= 0;
     /* the face's tag: the liquid's phase, or the body of a body surface */
-    for (int k = 0; k < nfp; k++)
+    for (int k = 1; k < nfp; k++)
         if ((!strcmp(fp[k].name, "phase") || !strcmp(fp[k].name, "body")) && fp[k].type == PFSPH__T_U8) itag = k;
     const size_t isz = 4, frecord = 1 + 3 * isz + frec;
     size_t avail = len - pos;

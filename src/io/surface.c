@@ -5,17 +5,6 @@
 #include "io/io_internal.h"
 #include "pfsph/surface_io.h"
 
-static int finish(pfsph__enc *e, pfsph__afile *af, pfsph_error *err)
-{
-    int rc = pfsph__enc_flush(e);
-    pfsph__enc_free(e);
-    if (rc != PFSPH_OK) {
-        pfsph__afile_abort(af);
-        return rc;
-    }
-    return pfsph__afile_commit(af, err);
-}
-
 int pfsph_write_surfaces_ply(const char *path, const pfsph_mesh *meshes, int n, const pfsph_body_pose *poses,
                              double time, pfsph_error *err)
 {
@@ -52,7 +41,7 @@ int pfsph_write_surfaces_ply(const char *path, const pfsph_mesh *meshes, int n, 
         }
         base += (uint32_t)meshes[b].nverts;
     }
-    return finish(&e, &af, err);
+    return pfsph__enc_commit(&e, &af, err);
 }
 
 int pfsph_write_surfaces_vtp(const char *path, const pfsph_mesh *meshes, int n, const pfsph_body_pose *poses,
@@ -105,5 +94,5 @@ int pfsph_write_surfaces_vtp(const char *path, const pfsph_mesh *meshes, int n, 
     for (int b = 0; b < n; b++)
         for (size_t t = 0; t < meshes[b].ntris; t++) pfsph__enc_printf(&e, "%d\n", b);
     pfsph__enc_printf(&e, "</DataArray>\n</CellData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
-    return finish(&e, &af, err);
+    return pfsph__enc_commit(&e, &af, err);
 }

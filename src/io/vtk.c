@@ -188,13 +188,7 @@ int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_
         }
     }
     pfsph__enc_printf(&e, "\n  </AppendedData>\n</VTKFile>\n");
-    rc = pfsph__enc_flush(&e);
-    pfsph__enc_free(&e);
-    if (rc != PFSPH_OK) {
-        pfsph__afile_abort(&af);
-        return rc;
-    }
-    return pfsph__afile_commit(&af, err);
+    return pfsph__enc_commit(&e, &af, err);
 }
 
 /* ---- reader ---------------------------------------------------------------------------- */
@@ -282,19 +276,11 @@ static const unsigned char *find_bytes(const unsigned char *h, size_t hl, const 
 
 int pfsph_read_vtp(const char *path, pfsph_particles *ps, double *time, pfsph_error *err)
 {
-    memset(ps, 0, sizeof *ps);
-    if (time) *time = 0;
     unsigned char *buf;
     size_t len;
-    int rc = pfsph__read_file(path, &buf, &len, err);
+    int rc = pfsph__reader_open(path, ps, sizeof *ps, &buf, &len, time, err);
     if (rc != PFSPH_OK) return rc;
-#define BAD(...)                                                                  \
-    do {                                                                          \
-        char m_[512];                                                             \
-        snprintf(m_, sizeof m_, __VA_ARGS__);                                     \
-        rc = pfsph_fail(err, PFSPH_EINPUT, "%s: invalid VTP file: %s", path, m_); \
-        goto done;                                                                \
-    } while (0)
+#define BAD(...) PFSPH__BAD("VTP file", __VA_ARGS__)
 
     rd_array *ar = calloc(MAX_ARRAYS, sizeof *ar);
     if (!ar) {

@@ -1,11 +1,14 @@
 /* OpenGL drawing for the viewer (draw.h). Shading, colours, background and the two-layer
- * composite follow the PNG renderer (src/io/render.c) so that both show the same picture. */
+ * composite follow the PNG renderer (src/io/render_raster.c, render.c) so that both show the
+ * same picture. */
 #include "view/draw.h"
 
 #include <epoxy/gl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "io/colormap.h"
 
 typedef struct layer {
     GLuint fbo, col, depth;
@@ -77,8 +80,9 @@ static const char *SPRITE_FS =
     "  gl_FragDepth = clamp(cl.z / cl.w * 0.5 + 0.5, 0.0, 1.0);\n"
     "}\n";
 
-/* Meshes: the liquid shaded as render.c's shade_water, bodies as its shade_solid, both on the
- * normal in camera coordinates (x right, y up, z towards the viewer) as the renderer has it. */
+/* Meshes: the liquid shaded as render_raster.c's pfsph__shade_water, bodies as its
+ * pfsph__shade_solid, both on the normal in camera coordinates (x right, y up, z towards the
+ * viewer) as the renderer has it. */
 static const char *MESH_VS = "#version 330 core\n"
                              "layout(location = 0) in vec3 pos;\n"
                              "layout(location = 1) in vec3 nrm;\n"
@@ -480,29 +484,13 @@ void pfsph_vdraw_rect(pfsph_vdraw *d, float x, float y, float w, float h, const 
     quad4(d, x, y, w, h, rgba, rgba);
 }
 
-void pfsph_viridis(double t, float out[3])
-{
-    static const float st[5][3] = {{0.267f, 0.005f, 0.329f},
-                                   {0.229f, 0.322f, 0.546f},
-                                   {0.128f, 0.567f, 0.551f},
-                                   {0.369f, 0.789f, 0.383f},
-                                   {0.993f, 0.906f, 0.144f}};
-    if (!(t > 0)) t = 0;
-    if (t > 1) t = 1;
-    double u = t * 4;
-    int i = (int)u;
-    if (i > 3) i = 3;
-    double f = u - i;
-    for (int k = 0; k < 3; k++) out[k] = (float)((1 - f) * st[i][k] + f * st[i + 1][k]);
-}
-
 void pfsph_vdraw_colorbar(pfsph_vdraw *d, float x, float y, float w, float h)
 {
     const int seg = 32;
     for (int i = 0; i < seg; i++) {
         float a[4] = {0, 0, 0, 1}, b[4] = {0, 0, 0, 1};
-        pfsph_viridis((double)i / seg, a);
-        pfsph_viridis((double)(i + 1) / seg, b);
+        pfsph__viridis((double)i / seg, a);
+        pfsph__viridis((double)(i + 1) / seg, b);
         quad4(d, x + w * i / seg, y, w / seg, h, a, b);
     }
 }

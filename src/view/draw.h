@@ -48,7 +48,7 @@ void pfsph_vdraw_mesh(pfsph_vdraw *d, const pfsph_vmesh *m, int water);
 /* Composite the layers over the background into the frame. */
 void pfsph_vdraw_composite(pfsph_vdraw *d);
 /* Overlay, in pixels from the top left: a filled rectangle, text (3x5 font scaled by sc; letters
- * are drawn upper case), and the viridis colour bar. */
+ * are drawn upper case), and the colour bar of io/colormap.h. */
 void pfsph_vdraw_rect(pfsph_vdraw *d, float x, float y, float w, float h, const float rgba[4]);
 float pfsph_vdraw_text(pfsph_vdraw *d, float x, float y, float sc, const char *s, const float rgba[4]);
 void pfsph_vdraw_colorbar(pfsph_vdraw *d, float x, float y, float w, float h);
@@ -58,8 +58,5 @@ void pfsph_vdraw_overlay(pfsph_vdraw *d);
 void pfsph_vdraw_present(pfsph_vdraw *d, int fb_w, int fb_h);
 /* Read the frame as 8-bit RGB rows, top first (w * h * 3 bytes). */
 void pfsph_vdraw_read(pfsph_vdraw *d, uint8_t *rgb);
-
-/* The viridis map of the PNG renderer, t in 0..1. */
-void pfsph_viridis(double t, float out[3]);
 
 #endif
