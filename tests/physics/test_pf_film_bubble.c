@@ -492,7 +492,7 @@ int main(int argc, char **argv)
                                        cmocka_unit_test(test_blow_bubble)};
     if (getenv("FILM_ONLY")) { /* studies: one test by number */
         const struct CMUnitTest one[1] = {tests[atoi(getenv("FILM_ONLY")) % 3]};
-        return cmocka_run_group_tests(one, NULL, NULL);
+        return tu_run_group(one, NULL, NULL);
     }
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -205,5 +205,5 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     omp_set_num_threads(1); /* 400-1000 particles: threads only add synchronisation */
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_square_to_disc), cmocka_unit_test(test_cube_to_sphere)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }
