@@ -37,6 +37,50 @@ void tu_init(int argc, char **argv)
     else if ((e = getenv("PFSPH_BIN"))) g_bin = e;
 }
 
+/* ---- skips (see testutil.h) ---- */
+
+#define TU_MAX_SKIPS 64
+static int g_nskip;
+static const char *g_skip_test[TU_MAX_SKIPS], *g_skip_why[TU_MAX_SKIPS];
+
+void tu_skip_(const char *test, const char *reason)
+{
+    print_message("%s: skipped: %s\n", test, reason);
+    if (g_nskip < TU_MAX_SKIPS) g_skip_test[g_nskip] = test, g_skip_why[g_nskip] = reason;
+    g_nskip++;
+    _skip(__FILE__, __LINE__); /* cmocka's skip(): marks the test skipped and jumps out of it */
+}
+
+int tu_run_group_(const char *name, const struct CMUnitTest *tests, size_t n, CMFixtureFunction setup,
+                  CMFixtureFunction teardown)
+{
+    g_nskip = 0;
+    const int failed = _cmocka_run_group_tests(name, tests, n, setup, teardown);
+    if (g_nskip == 0) return failed;
+    print_message("%d of %zu tests skipped:\n", g_nskip, n);
+    for (int i = 0; i < g_nskip && i < TU_MAX_SKIPS; i++) print_message("  %s: %s\n", g_skip_test[i], g_skip_why[i]);
+    if (failed) return failed;
+    if ((size_t)g_nskip >= n) {
+        print_message("nothing ran: exit status %d (skipped)\n", TU_SKIPPED);
+        return TU_SKIPPED;
+    }
+    return 0;
+}
+
+void tu_skip_program(const char *reason)
+{
+    fflush(stdout);
+    fprintf(stderr, "skipped: %s\n", reason);
+    exit(TU_SKIPPED);
+}
+
+void tu_release_only(void)
+{
+#ifdef __SANITIZE_ADDRESS__
+    tu_skip_program("a validation measurement: too slow under AddressSanitizer, it runs in Release");
+#endif
+}
+
 const char *tu_source_dir(void) { return g_src; }
 const char *tu_pfsph_bin(void) { return g_bin; }
 

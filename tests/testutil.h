@@ -7,6 +7,32 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+/* Skips. A test that cannot run here (no display, no Blender or ParaView, no ffmpeg, a
+ * measurement that an instrumented build falsifies) says so with tu_skip, never with cmocka's
+ * skip(): cmocka counts a skip as a pass in the exit status, so the program would read
+ * "Passed". tu_run_group returns TU_SKIPPED when every test of the group skipped, and CMake sets
+ * SKIP_RETURN_CODE to it on every test, so that ctest reports "Not Run (Skipped)"; a group where
+ * only some skip passes and lists what it skipped, and why, after cmocka's summary. */
+#define TU_SKIPPED 77 /* the exit status of a skipped test program (automake's convention) */
+#undef skip
+#define skip() tu_skip_needs_a_reason /* use tu_skip(reason) */
+/* Skips the calling test (a cmocka test function) and records why; does not return. */
+#define tu_skip(reason) tu_skip_(__func__, reason)
+void tu_skip_(const char *test, const char *reason);
+/* Runs a cmocka group (an array of struct CMUnitTest, as cmocka_run_group_tests does): the
+ * number of failed tests, else TU_SKIPPED when all of them skipped, else 0. */
+#define tu_run_group(tests, setup, teardown) \
+    tu_run_group_(#tests, tests, sizeof(tests) / sizeof((tests)[0]), setup, teardown)
+int tu_run_group_(const char *name, const struct CMUnitTest *tests, size_t n, CMFixtureFunction setup,
+                  CMFixtureFunction teardown);
+/* The whole program cannot run here: prints why and exits with TU_SKIPPED (from main, or from
+ * the one test of a one-test group). */
+_Noreturn void tu_skip_program(const char *reason);
+/* A validation test (a measurement over seconds of simulated time, run in Release: CI's last
+ * step) calls this first: under AddressSanitizer (the asan preset, 4-10x slower) it skips the
+ * program, since a run short enough would measure nothing; elsewhere it returns. */
+void tu_release_only(void);
+
 /* Source directory (argv[1] / PFSPH_SOURCE_DIR) and pfsph program (argv[2] / PFSPH_BIN). */
 void tu_init(int argc, char **argv);
 const char *tu_source_dir(void);

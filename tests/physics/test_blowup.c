@@ -138,5 +138,5 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_blowup_diagnosis),
                                        cmocka_unit_test(test_density_explosion), cmocka_unit_test(test_pcisph_tiny_dt)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -264,5 +264,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_sinking_disc),
         cmocka_unit_test(test_left_domain_feels_nothing),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -103,5 +103,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_stack),
         cmocka_unit_test(test_mesh_on_box),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

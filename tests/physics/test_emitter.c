@@ -348,5 +348,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_mass_2d),  cmocka_unit_test(test_mass_3d),           cmocka_unit_test(test_entry_spacing),
         cmocka_unit_test(test_blow_gas), cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_resume),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -96,5 +96,5 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_wcsph), cmocka_unit_test(test_pcisph),
                                        cmocka_unit_test(test_dfsph)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -50,7 +50,7 @@ static void run_into(const char *run, char *out, size_t cap, int *status)
 static void test_full_fs(void **state)
 {
     (void)state;
-    if (mount_tmpfs("size=384k") != 0) skip();
+    if (mount_tmpfs("size=384k") != 0) tu_skip("cannot mount a tmpfs here (needs root)");
     char run[600], out[4096];
     int st;
     snprintf(run, sizeof run, "%s/run", g_mnt);
@@ -87,7 +87,7 @@ static void test_full_fs(void **state)
 static void test_readonly_fs(void **state)
 {
     (void)state;
-    if (mount_tmpfs("ro,size=64k") != 0) skip();
+    if (mount_tmpfs("ro,size=64k") != 0) tu_skip("cannot mount a tmpfs here (needs root)");
     char run[600], out[4096];
     int st;
     snprintf(run, sizeof run, "%s/run", g_mnt);
@@ -104,5 +104,5 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test_teardown(test_full_fs, teardown),
                                        cmocka_unit_test_teardown(test_readonly_fs, teardown)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

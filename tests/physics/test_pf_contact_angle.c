@@ -15,7 +15,8 @@
  * is averaged over samples every 0.05 s from 3 s to 6 s (one sample scatters by 5-10 degrees
  * at temperature) and must lie within 10 degrees of the target; each drop's lowest particle
  * must stay within a spacing of the plate (a drop that jumps off has no contact angle).
- * Under AddressSanitizer (~4x slower) the drops run 1 s and only the code paths are checked.
+ * Under AddressSanitizer (~4x slower) the drops run 1 s and must lie within 25 degrees (the
+ * 30/150 test skips there).
  * Knobs for studies: PF_T (end time [s], default 6), PF_K (1.7), PF_NU (0.001), PF_HALF
  * (half width of the starting square [m], 0.08), PF_PW (extra pairwise keys), PF_ANG ("a,b,c":
  * targets), PF_RATIO ("a,b,c": Eq. 21 adhesion ratios c_wa / c_aa given as coefficients,
@@ -192,8 +193,14 @@ static void test_contact_angles(void **state)
 #endif
     double t_end = getenv("PF_T") ? atof(getenv("PF_T")) : 6.0;
 #ifdef __SANITIZE_ADDRESS__
+#ifdef PF_CA_ENDS
+    tu_release_only();
+#endif
+    /* 1 s: the 60-degree drop is still spreading. Averaged over 0.5-1 s, seeds 11 and 1-5
+     * (Release, PF_T=1) read 72.9-76.2, 93.3-103.3 and 110.4-117.7 degrees: 16 degrees from
+     * the target at most */
     t_end = 1.0;
-    const double tol = 180; /* code paths only: too short for the angles to settle */
+    const double tol = 25;
 #else
     const double tol = 10;
 #endif

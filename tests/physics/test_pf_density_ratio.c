@@ -123,5 +123,5 @@ int main(int argc, char **argv)
 #else
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_ratio_100), cmocka_unit_test(test_ratio_1000)};
 #endif
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -23,7 +23,8 @@
  *   at this size. The bound is that mean less three deviations. The earlier run to 2 s (bound
  *   0.93 over 1-2 s) averaged the end of the relaxation itself (seed 5 creeps 0.83 / 0.85 / 0.90
  *   / 0.92 at 0.8 / 1.2 / 1.6 / 2 s), so eight seeds read 0.88-0.98 there and 0.93 was a coin
- *   flip; it failed once the pair-force pass's rounding changed (0.9289);
+ *   flip; it failed once the pair-force pass's rounding changed (0.9289). Under AddressSanitizer
+ *   the run is 1 s and the bound over 0.5-1 s 0.70 (the figures at the code);
  * - closed film: no gas particle (a = 0) farther from the centroid than the film polygon at its
  *   angle, at any sample.
  * Two bubbles (discs of radius 8 d, 2 x 200 particles) driven together at 0.2 m/s each: they
@@ -177,9 +178,13 @@ static void test_bubble_at_rest(void **state)
     double max_dl = 0, max_dg = 0, avg_ratio = 0;
     int navg = 0, outside = 0;
 #ifdef __SANITIZE_ADDRESS__
-    const double dt = 0.05, T = 1.0; /* ~5x slower: the code paths and the bookkeeping only */
+    /* ~5x slower: 1 s, the bookkeeping as below and a relaxation half done. Over 0.5-1 s
+     * seeds 1-7 (FILM_SEED, FILM_T=1, Release; the test's is 1) read 0.901 / 0.860 / 0.869 /
+     * 0.797 / 0.818 / 0.893 / 0.893 from 0.53: mean 0.861, deviation 0.040, and the bound is
+     * the mean less four deviations */
+    const double dt = 0.05, T = 1.0, ratio_min = 0.70;
 #else
-    const double dt = 0.05, T = getenv("FILM_T") ? atof(getenv("FILM_T")) : 4.0;
+    const double dt = 0.05, T = getenv("FILM_T") ? atof(getenv("FILM_T")) : 4.0, ratio_min = 0.88;
 #endif
     const int ns = (int)lround(T / dt);
     bubble_m m = m0;
@@ -201,15 +206,13 @@ static void test_bubble_at_rest(void **state)
     }
     avg_ratio /= navg;
     print_message("over %g s: largest change of the film liquid %.3f %%, of the enclosed gas %.3f %% (bound 2 %%); "
-                  "moment ratio over the second half %.4f (bound 0.88); a %.4f -> %.4f; gas particles outside the "
+                  "moment ratio over the second half %.4f (bound %.2f); a %.4f -> %.4f; gas particles outside the "
                   "film, summed over the samples: %d\n",
-                  T, 100 * max_dl, 100 * max_dg, avg_ratio, m0.a, m.a, outside);
+                  T, 100 * max_dl, 100 * max_dg, avg_ratio, ratio_min, m0.a, m.a, outside);
     assert_int_equal(pfsph_sim_removed(sim), 0);
     assert_true(max_dl <= 0.02);
     assert_true(max_dg <= 0.02);
-#ifndef __SANITIZE_ADDRESS__
-    assert_true(avg_ratio >= 0.88);
-#endif
+    assert_true(avg_ratio >= ratio_min);
     assert_int_equal(outside, 0);
     free(A);
     pfsph_sim_destroy(sim);
@@ -492,7 +495,7 @@ int main(int argc, char **argv)
                                        cmocka_unit_test(test_blow_bubble)};
     if (getenv("FILM_ONLY")) { /* studies: one test by number */
         const struct CMUnitTest one[1] = {tests[atoi(getenv("FILM_ONLY")) % 3]};
-        return cmocka_run_group_tests(one, NULL, NULL);
+        return tu_run_group(one, NULL, NULL);
     }
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

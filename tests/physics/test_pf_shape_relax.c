@@ -192,9 +192,10 @@ static void test_cube_to_sphere(void **state)
 {
     (void)state;
 #ifdef __SANITIZE_ADDRESS__
-    /* ~4x slower under ASan: the 512-particle cube, shape and clusters only (its moment
-     * ratio is not asserted) */
-    relax(3, 8, "1.3867", 0.5, 0.0);
+    /* ~4x slower under ASan: the 512-particle cube for 0.5 s. Its moment ratio over the second
+     * half read 0.943 / 0.923 / 0.910 / 0.934 / 0.936 / 0.947 for seeds 1-6 (Release; the
+     * test's is 1), mean 0.932, deviation 0.013: the bound is the mean less four deviations */
+    relax(3, 8, "1.3867", 0.5, 0.88);
 #else
     relax(3, 10, "1.3867", getenv("PF_T") ? atof(getenv("PF_T")) : 1.5, 0.92);
 #endif
@@ -205,5 +206,5 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     omp_set_num_threads(1); /* 400-1000 particles: threads only add synchronisation */
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_square_to_disc), cmocka_unit_test(test_cube_to_sphere)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

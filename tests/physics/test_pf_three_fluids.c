@@ -150,5 +150,5 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_fig4b), cmocka_unit_test(test_fig4c),
                                        cmocka_unit_test(test_fig4d)};
 #endif
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

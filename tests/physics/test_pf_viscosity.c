@@ -104,19 +104,15 @@ static void test_viscosity(void **state)
 {
     (void)state;
     const double nu = 8e-3;
-#ifdef __SANITIZE_ADDRESS__
-    (void)nu_eff(nu, 1, 0.3); /* code paths only */
-    return;
-#else
+    /* the same under ASan: 2 s of CPU in Release, the short fits would save a quarter */
     const double on = nu_eff(nu, 1, 2.0), off = nu_eff(nu, 0, 2.0);
     assert_true(fabs(on / nu - 1) <= 0.25);
     assert_true(off / nu >= 1.5);
-#endif
 }
 
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_viscosity)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -363,5 +363,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_checkpoint_at_last_frame),
         cmocka_unit_test(test_progress),
     };
-    return cmocka_run_group_tests(tests, setup, NULL);
+    return tu_run_group(tests, setup, NULL);
 }

@@ -383,5 +383,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_contour_run),  cmocka_unit_test(test_refusals),
         cmocka_unit_test(test_diffuse_type), cmocka_unit_test(test_houdini_roundtrip),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

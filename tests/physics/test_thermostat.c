@@ -283,5 +283,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_noise),   cmocka_unit_test(test_temperature), cmocka_unit_test(test_liquidity),
         cmocka_unit_test(test_threads), cmocka_unit_test(test_resume),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -102,5 +102,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_free_and_no_slip),
         cmocka_unit_test(test_wall_viscosity),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

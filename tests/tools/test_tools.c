@@ -72,7 +72,7 @@ static const char *json_after(const char *out, const char *tag)
 static void test_paraview(void **state)
 {
     (void)state;
-    if (!have("pvpython")) skip();
+    if (!have("pvpython")) tu_skip("no pvpython (ParaView)");
     char cmd[4096], out[16384];
     snprintf(cmd, sizeof cmd, "pvpython '%s/tools/paraview/pfsph_pvd_info.py' '%s/fluid.pvd'", tu_source_dir(), g_run);
     int st = tu_run(cmd, out, sizeof out);
@@ -101,7 +101,7 @@ static void test_paraview(void **state)
 static void test_paraview_2d(void **state)
 {
     (void)state;
-    if (!have("pvpython")) skip();
+    if (!have("pvpython")) tu_skip("no pvpython (ParaView)");
     char scene[1400], run[1400], cmd[4096], out[16384];
     snprintf(scene, sizeof scene, "%s/outline.json", tu_tmpdir());
     snprintf(run, sizeof run, "%s/outline", tu_tmpdir());
@@ -149,7 +149,7 @@ static long ply_faces(const char *path)
 static void test_blender_load(void **state)
 {
     (void)state;
-    if (!have("blender")) skip();
+    if (!have("blender")) tu_skip("no blender");
     char cmd[4096], out[16384], want[256], path[1400];
     snprintf(cmd, sizeof cmd, "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_load.py' -- '%s'",
              tu_source_dir(), g_run);
@@ -199,7 +199,7 @@ static void test_blender_load(void **state)
 static void test_blender_render(void **state)
 {
     (void)state;
-    if (!have("blender")) skip();
+    if (!have("blender")) tu_skip("no blender");
     char cmd[4096], out[16384], png[1400];
     snprintf(cmd, sizeof cmd,
              "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_render.py' -- '%s' '%s/png' "
@@ -228,5 +228,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_blender_load),
         cmocka_unit_test(test_blender_render),
     };
-    return cmocka_run_group_tests(tests, setup, NULL);
+    return tu_run_group(tests, setup, NULL);
 }

@@ -269,5 +269,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_carving_counts),    cmocka_unit_test(test_hundred_blocks),
         cmocka_unit_test(test_large_counts_fast),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

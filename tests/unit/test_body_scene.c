@@ -248,5 +248,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_parse_ok),  cmocka_unit_test(test_parse_errors), cmocka_unit_test(test_bad_obj_cli),
         cmocka_unit_test(test_keyframes), cmocka_unit_test(test_overlap),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -475,5 +475,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_scene_key),        cmocka_unit_test(test_crafted_ids),
         cmocka_unit_test(test_crafted_clock),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -693,5 +693,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_determinism),      cmocka_unit_test(test_fluid_untouched),
         cmocka_unit_test(test_gas_not_counted),  cmocka_unit_test(test_removed_in_solid),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

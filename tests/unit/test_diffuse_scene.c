@@ -158,5 +158,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_defaults), cmocka_unit_test(test_all_keys), cmocka_unit_test(test_errors),
         cmocka_unit_test(test_scenes),   cmocka_unit_test(test_plot),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

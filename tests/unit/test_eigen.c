@@ -254,5 +254,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_sym3_random),
         cmocka_unit_test(test_sym3_fast),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -250,5 +250,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bubble_key),
         cmocka_unit_test(test_state_checks),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -386,5 +386,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_neighbours_2d), cmocka_unit_test(test_neighbours_3d), cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_edge_cases),    cmocka_unit_test(test_near),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

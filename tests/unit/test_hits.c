@@ -162,5 +162,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_terms),
         cmocka_unit_test(test_cos_pair),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

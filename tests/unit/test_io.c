@@ -537,7 +537,7 @@ static void test_vtp_opens_in_vtk(void **state)
         snprintf(cmd, sizeof cmd, "%s -c 'import vtk' >/dev/null 2>&1", pythons[i]);
         if (tu_run(cmd, out, sizeof out) == 0) py = pythons[i];
     }
-    if (!py) skip();
+    if (!py) tu_skip("no python3 with the vtk module");
     pfsph_particles ps;
     make_set(&ps, 1234, 3);
     char path[512], script[512];
@@ -580,5 +580,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_vtp_corrupt),      cmocka_unit_test(test_ply_corrupt),
         cmocka_unit_test(test_vtp_opens_in_vtk), cmocka_unit_test(test_surface_ply_roundtrip),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -195,5 +195,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_derivative),    cmocka_unit_test(test_gradient_antisymmetry),
         cmocka_unit_test(test_lattice_sum),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

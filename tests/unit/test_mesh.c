@@ -757,5 +757,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_sample_primitives),
         cmocka_unit_test(test_sample_large),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -201,5 +201,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_two_walks),
         cmocka_unit_test(test_one_walk),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -772,5 +772,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_film_eq24),     cmocka_unit_test(test_film_momentum_threads),
         cmocka_unit_test(test_density_fused),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -353,5 +353,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_cap_wall_velocity), cmocka_unit_test(test_oracle_threads),
         cmocka_unit_test(test_scene_keys),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

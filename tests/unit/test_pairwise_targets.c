@@ -362,5 +362,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_parse),
         cmocka_unit_test(test_scenes),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

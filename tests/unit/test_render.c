@@ -316,7 +316,7 @@ static void test_render_video(void **state)
 {
     (void)state;
     char out[256];
-    if (tu_run("command -v ffmpeg", out, sizeof out) != 0) skip();
+    if (tu_run("command -v ffmpeg", out, sizeof out) != 0) tu_skip("no ffmpeg");
     const char *run = make_run("video", SCENE_2D);
     char p[700];
     pfsph_io_opts o = {.dim = 2};
@@ -350,5 +350,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_render_errors),
         cmocka_unit_test(test_render_video),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

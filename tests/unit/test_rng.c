@@ -117,5 +117,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_uniformity),
         cmocka_unit_test(test_independence),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -654,5 +654,5 @@ int main(int argc, char **argv)
         struct CMUnitTest t = {bad_cases[i].name, test_bad, NULL, NULL, (void *)&bad_cases[i]};
         tests[NFIXED + i] = t;
     }
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -330,5 +330,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_drag),
         cmocka_unit_test(test_drag_dynamic),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

@@ -129,5 +129,5 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(every_scene_solver_runs), cmocka_unit_test(rows_are_complete),
                                        cmocka_unit_test(dt_limits)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

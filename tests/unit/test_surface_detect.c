@@ -323,5 +323,5 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_lattice_2d), cmocka_unit_test(test_lattice_3d),
                                        cmocka_unit_test(test_jittered), cmocka_unit_test(test_walls_and_groups)};
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

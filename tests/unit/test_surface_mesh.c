@@ -387,5 +387,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_sphere),  cmocka_unit_test(test_box),      cmocka_unit_test(test_two_drops),
         cmocka_unit_test(test_threads), cmocka_unit_test(test_far_drop), cmocka_unit_test(test_contour_2d),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }

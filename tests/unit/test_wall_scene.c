@@ -139,5 +139,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_permute_keeps_wall),
         cmocka_unit_test(test_hash),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return tu_run_group(tests, NULL, NULL);
 }
