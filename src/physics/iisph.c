@@ -30,6 +30,19 @@ typedef pfsph_real v4r __attribute__((vector_size(4 * sizeof(pfsph_real))));
 typedef pfsph_real v4r_u __attribute__((vector_size(4 * sizeof(pfsph_real)), aligned(sizeof(pfsph_real)), may_alias));
 #define ld4(p) (*(const v4r_u *)(p))
 
+/* its scene keys under $.solver, in the order of the scene's solver_settings (PCISPH's defaults) */
+enum { K_TOL, K_MIN, K_MAX, NKEYS };
+static const pfsph_solver_key keys[NKEYS] = {
+    {"tolerance", 0.005, 1e-5, 0.1, 0, "mean relative density error the Jacobi iteration stops at"},
+    {"min_iterations", 3, 1, 1000, 1, "Jacobi iterations per step at least"},
+    {"max_iterations", 50, 1, 10000, 1, "Jacobi iterations per step at most"},
+};
+
+static int check(const double *v, const char **key, char *msg, size_t len)
+{
+    return pfsph__check_iterations(v[K_MIN], v[K_MAX], key, msg, len);
+}
+
 typedef struct iisph {
     double tol, cfl, c;
     int min_iter, max_iter;
@@ -40,9 +53,9 @@ static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config 
     (void)ctx;
     iisph *S = calloc(1, sizeof *S);
     if (!S) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-    S->tol = cfg->tolerance;
-    S->min_iter = cfg->min_iter;
-    S->max_iter = cfg->max_iter;
+    S->tol = cfg->settings[K_TOL];
+    S->min_iter = (int)cfg->settings[K_MIN];
+    S->max_iter = (int)cfg->settings[K_MAX];
     S->cfl = cfg->cfl;
     S->c = cfg->sound_speed;
     *state = S;
@@ -266,6 +279,9 @@ static const char *hint(const void *state, const pfsph_ctx *ctx)
 
 const pfsph_solver_ops pfsph_solver_iisph = {
     .name = "iisph",
+    .keys = keys,
+    .nkeys = NKEYS,
+    .check = check,
     .nscratch = NSCR,
     .nscratch4 = NSCR4,
     .neighbour_lists = 1,

@@ -9,7 +9,7 @@
 #include <string.h>
 
 /* The registry: one word per solver, in the order `pfsph check` and the docs list them. */
-#define PFSPH_SOLVERS(X) X(wcsph) X(pcisph) X(dfsph)
+#define PFSPH_SOLVERS(X) X(wcsph) X(pcisph) X(dfsph) X(iisph)
 
 #define PFSPH_SOLVER_DECLARE(n) extern const pfsph_solver_ops pfsph_solver_##n;
 PFSPH_SOLVERS(PFSPH_SOLVER_DECLARE)
