@@ -11,7 +11,7 @@
 
 #include <omp.h>
 
-#include "pfsph/omp_env.h"
+#include "cli/omp_env.h"
 #include "pfsph/grid.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"

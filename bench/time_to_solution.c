@@ -10,7 +10,7 @@
 #include <cjson/cJSON.h>
 #include <omp.h>
 
-#include "pfsph/omp_env.h"
+#include "cli/omp_env.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 

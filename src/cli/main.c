@@ -9,7 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "pfsph/omp_env.h"
+#include "cli/omp_env.h"
 #include "pfsph/bodies.h"
 #include "pfsph/emitter.h"
 #include "pfsph/houdini.h"

@@ -6,8 +6,9 @@
 
 #include "pfsph/types.h"
 
-/* Real-valued persistent fields, in the order of the union below. */
-enum pfsph_field {
+/* Real-valued persistent fields, in the order of the union below (the public pfsph_field,
+ * include/pfsph.h, is what an embedder reads them through). */
+enum pfsph_field_slot {
     PFSPH_F_X,
     PFSPH_F_Y,
     PFSPH_F_Z,

@@ -1,5 +1,5 @@
-/* OpenMP's wait policy for programs (omp_env.h). */
-#include "pfsph/omp_env.h"
+/* OpenMP's wait policy for programs (omp_env.h): part of the program, never of the library. */
+#include "cli/omp_env.h"
 
 #include <stdlib.h>
 #include <unistd.h>

@@ -67,6 +67,9 @@ int pfsph_sim_mechanical_pressure(const pfsph_sim *sim, pfsph_real *out);
 const double *pfsph_sim_stage_cpu_seconds(const pfsph_sim *sim);
 const double *pfsph_sim_stage_seconds(const pfsph_sim *sim);
 size_t pfsph_sim_removed(const pfsph_sim *sim);
+/* After fluid velocities were written between steps (include/pfsph.h, pfsph_sim_field_write):
+ * the next step's time step follows the speeds as they are now, not the last step's measure. */
+void pfsph_sim_velocities_written(pfsph_sim *sim);
 /* Account time spent outside the step (output) to a stage. */
 void pfsph_sim_add_stage_time(pfsph_sim *sim, int stage, double seconds);
 /* Speed of sound used by WCSPH (scene value or the automatic one) [m/s]. */
