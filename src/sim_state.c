@@ -169,3 +169,10 @@ int pfsph_sim_restore(pfsph_sim *sim, const pfsph_sim_state *st, const pfsph_par
     sim->ctx.dt = st->stats.dt;
     return PFSPH_OK;
 }
+
+/* fluid velocities written between steps (the embedding API): the next dt from today's speeds */
+void pfsph_sim_velocities_written(pfsph_sim *sim)
+{
+    size_t worst;
+    sim->st.stats.vmax = pfsph__max_speed(&sim->fluid, &worst);
+}
