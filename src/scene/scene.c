@@ -14,249 +14,18 @@
 #include "scene/shapes.h"
 
 /* ---------------------------------------------------------------------------------------- */
-/* Limits of the accepted ranges (documented in docs/scene-format.md). */
-#define COORD_MAX 1e6               /* m */
-#define VEL_MAX 1e3                 /* m/s */
-#define GRAVITY_MAX 1e3             /* m/s^2 */
-#define SEED_MAX 9007199254740992.0 /* 2^53: integers a JSON double holds exactly */
-
-static const float palette[][3] = {
-    {0.20f, 0.40f, 0.90f}, {0.90f, 0.50f, 0.15f}, {0.20f, 0.75f, 0.35f}, {0.85f, 0.20f, 0.25f},
-    {0.60f, 0.30f, 0.80f}, {0.95f, 0.85f, 0.20f}, {0.20f, 0.80f, 0.80f}, {0.80f, 0.50f, 0.60f},
-};
-static const float solid_grey[3] = {0.60f, 0.60f, 0.62f};
-
-typedef struct parser {
-    pfsph_scene *s;
-    pfsph_jctx ctx;
-} parser;
-
-#define TRY(expr)            \
-    do {                     \
-        int rc_ = (expr);    \
-        if (rc_) return rc_; \
-    } while (0)
+#include "scene/scene_parser.h"
 
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 static const char *const kind_names[] = {"fluid", "gas", "solid", NULL};
 static const char *const pressure_scale_names[] = {"phase", "common", NULL}; /* enum order */
-
-static void path_key(char *out, size_t cap, const char *path, const char *key)
-{
-    snprintf(out, cap, "%s.%s", path, key);
-}
-
-static void path_index(char *out, size_t cap, const char *path, int i) { snprintf(out, cap, "%s[%d]", path, i); }
-
-static const cJSON *get(const cJSON *obj, const char *key) { return cJSON_GetObjectItemCaseSensitive(obj, key); }
-
-static int require(parser *p, const cJSON *obj, const char *path, const char *key)
-{
-    if (get(obj, key)) return PFSPH_OK;
-    char kp[512];
-    path_key(kp, sizeof kp, path, key);
-    return pfsph__json_fail(&p->ctx, kp, "missing required key \"%s\"", key);
-}
-
-/* A vector with as many components as the scene has dimensions; z = 0 in 2D. */
-static int vecd(parser *p, const cJSON *obj, const char *path, const char *key, double lo, double hi, double *out)
-{
-    if (!get(obj, key)) return PFSPH_OK;
-    TRY(pfsph__json_vec(obj, path, key, p->s->dim, lo, hi, out, &p->ctx));
-    if (p->s->dim == 2) out[2] = 0.0;
-    return PFSPH_OK;
-}
-
-/* A string that must be one of names (NULL-terminated); *out becomes its index. */
-static int json_enum(parser *p, const cJSON *obj, const char *path, const char *key, const char *const *names, int *out)
-{
-    const cJSON *v = get(obj, key);
-    if (!v) return PFSPH_OK;
-    char kp[512];
-    path_key(kp, sizeof kp, path, key);
-    char list[256] = "";
-    size_t n = 0;
-    for (int i = 0; names[i]; i++) {
-        int w = snprintf(list + n, sizeof list - n, "%s\"%s\"", i ? ", " : "", names[i]);
-        if (w > 0 && (size_t)w < sizeof list - n) n += (size_t)w;
-    }
-    if (!cJSON_IsString(v) || !v->valuestring)
-        return pfsph__json_fail(&p->ctx, kp, "expected a string, one of %s", list);
-    for (int i = 0; names[i]; i++)
-        if (strcmp(v->valuestring, names[i]) == 0) {
-            *out = i;
-            return PFSPH_OK;
-        }
-    return pfsph__json_fail(&p->ctx, kp, "unknown value \"%.60s\" (expected one of %s)", v->valuestring, list);
-}
-
-/* A number that must be strictly positive (the helpers check closed ranges only). */
-static int positive(parser *p, const cJSON *obj, const char *path, const char *key, double hi, double *out)
-{
-    double v = *out;
-    TRY(pfsph__json_number(obj, path, key, -HUGE_VAL, hi, &v, &p->ctx));
-    if (!(v > 0.0)) {
-        char kp[512];
-        path_key(kp, sizeof kp, path, key);
-        return pfsph__json_fail(&p->ctx, kp, "value %g is out of range: must be > 0 and <= %g", v, hi);
-    }
-    *out = v;
-    return PFSPH_OK;
-}
-
-/* An array (possibly absent); error when it is not an array or has more than max entries. */
-static int array_of(parser *p, const cJSON *root, const char *path, const char *key, int max, const cJSON **out)
-{
-    const cJSON *v = get(root, key);
-    *out = NULL;
-    if (!v) return PFSPH_OK;
-    char kp[512];
-    path_key(kp, sizeof kp, path, key);
-    if (!cJSON_IsArray(v))
-        return pfsph__json_fail(&p->ctx, kp, "expected an array, got %s",
-                                cJSON_IsObject(v) ? "an object" : "a single value");
-    int n = cJSON_GetArraySize(v);
-    if (n > max) return pfsph__json_fail(&p->ctx, kp, "too many entries (%d, at most %d)", n, max);
-    *out = v;
-    return PFSPH_OK;
-}
 
 static int axis_index(const char *path, parser *p, const cJSON *obj, int *axis)
 {
     return json_enum(p, obj, path, "axis", axis_names, axis);
 }
 
-/* ---------------------------------------------------------------------------------------- */
-/* Geometry used by the validation: bounding boxes and overlaps of blocks and solids. */
-
-typedef struct geo {
-    int shape, dim, axis;
-    double min[3], max[3], center[3], radius, height;
-} geo;
-
-static geo geo_of(int dim, int shape, const double *min, const double *max, const double *center, double radius,
-                  double height, int axis)
-{
-    geo g;
-    memset(&g, 0, sizeof g);
-    g.shape = shape;
-    g.dim = dim;
-    g.axis = axis;
-    g.radius = radius;
-    g.height = height;
-    for (int k = 0; k < 3; k++) {
-        g.center[k] = center[k];
-        g.min[k] = min[k];
-        g.max[k] = max[k];
-    }
-    /* A 2D cylinder is a disc: the same thing as a 2D sphere. */
-    if (dim == 2 && shape == PFSPH_SHAPE_CYLINDER) g.shape = PFSPH_SHAPE_SPHERE;
-    if (g.shape == PFSPH_SHAPE_SPHERE) {
-        for (int k = 0; k < dim; k++) {
-            g.min[k] = center[k] - radius;
-            g.max[k] = center[k] + radius;
-        }
-    } else if (g.shape == PFSPH_SHAPE_CYLINDER) {
-        for (int k = 0; k < 3; k++) {
-            double e = k == axis ? 0.5 * height : radius;
-            g.min[k] = center[k] - e;
-            g.max[k] = center[k] + e;
-        }
-    }
-    if (dim == 2) g.min[2] = g.max[2] = 0.0;
-    return g;
-}
-
-/* Is point x inside g shrunk by d on every side? */
-static bool geo_inside(const geo *g, const double *x, double d)
-{
-    if (g->shape == PFSPH_SHAPE_SPHERE) {
-        double r2 = 0;
-        for (int k = 0; k < g->dim; k++) r2 += (x[k] - g->center[k]) * (x[k] - g->center[k]);
-        return g->radius > d && r2 < (g->radius - d) * (g->radius - d);
-    }
-    if (g->shape == PFSPH_SHAPE_CYLINDER) {
-        double r2 = 0;
-        for (int k = 0; k < 3; k++) {
-            double e = x[k] - g->center[k];
-            if (k == g->axis) {
-                if (fabs(e) >= 0.5 * g->height - d) return false;
-            } else {
-                r2 += e * e;
-            }
-        }
-        return g->radius > d && r2 < (g->radius - d) * (g->radius - d);
-    }
-    for (int k = 0; k < g->dim; k++)
-        if (x[k] <= g->min[k] + d || x[k] >= g->max[k] - d) return false;
-    return true;
-}
-
-/* Distance from point c to the box [lo, hi] (0 inside). */
-static double point_box_distance(int dim, const double *c, const double *lo, const double *hi)
-{
-    double d2 = 0;
-    for (int k = 0; k < dim; k++) {
-        double e = c[k] < lo[k] ? lo[k] - c[k] : (c[k] > hi[k] ? c[k] - hi[k] : 0.0);
-        d2 += e * e;
-    }
-    return sqrt(d2);
-}
-
-/* Do a and b overlap by more than half a particle spacing? Both shapes are shrunk by a quarter
- * spacing and tested for intersection: for two boxes this is "overlap > s/2 along every axis",
- * for two spheres "r1 + r2 - distance > s/2". Cylinders (3D) are sampled on a fine lattice over
- * the common bounding box, which is exact to a small fraction of the spacing. */
-static bool geo_overlap(const geo *a, const geo *b, double spacing)
-{
-    const int dim = a->dim;
-    const double d = 0.25 * spacing;
-    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (int k = 0; k < dim; k++) {
-        lo[k] = fmax(a->min[k], b->min[k]) + d;
-        hi[k] = fmin(a->max[k], b->max[k]) - d;
-        if (!(lo[k] < hi[k])) return false;
-    }
-    if (a->shape == PFSPH_SHAPE_BOX && b->shape == PFSPH_SHAPE_BOX) return true;
-    if (a->shape == PFSPH_SHAPE_SPHERE && b->shape == PFSPH_SHAPE_SPHERE) {
-        double r2 = 0;
-        for (int k = 0; k < dim; k++) r2 += (a->center[k] - b->center[k]) * (a->center[k] - b->center[k]);
-        return sqrt(r2) < a->radius + b->radius - 2.0 * d;
-    }
-    if ((a->shape == PFSPH_SHAPE_BOX && b->shape == PFSPH_SHAPE_SPHERE) ||
-        (a->shape == PFSPH_SHAPE_SPHERE && b->shape == PFSPH_SHAPE_BOX)) {
-        const geo *bx = a->shape == PFSPH_SHAPE_BOX ? a : b;
-        const geo *sp = a->shape == PFSPH_SHAPE_BOX ? b : a;
-        double blo[3], bhi[3];
-        for (int k = 0; k < dim; k++) {
-            blo[k] = bx->min[k] + d;
-            bhi[k] = bx->max[k] - d;
-        }
-        return point_box_distance(dim, sp->center, blo, bhi) < sp->radius - d;
-    }
-    /* Sampled test; at most 64 samples per axis of the common box, never coarser than an
-     * eighth of a spacing in practice for blocks that touch. */
-    int n[3] = {1, 1, 1};
-    for (int k = 0; k < dim; k++) {
-        double cells = (hi[k] - lo[k]) / (0.125 * spacing);
-        n[k] = cells < 1 ? 1 : (cells > 64 ? 64 : (int)ceil(cells));
-    }
-    double x[3] = {0, 0, 0};
-    for (int i = 0; i <= n[0]; i++)
-        for (int j = 0; j <= n[1]; j++)
-            for (int l = 0; l <= (dim == 3 ? n[2] : 0); l++) {
-                int idx[3] = {i, j, l};
-                for (int k = 0; k < dim; k++) x[k] = lo[k] + (hi[k] - lo[k]) * (double)idx[k] / (double)n[k];
-                if (geo_inside(a, x, d) && geo_inside(b, x, d)) return true;
-            }
-    return false;
-}
-
-static void fmt_vec(char *out, size_t cap, int dim, const double *v)
-{
-    if (dim == 2) snprintf(out, cap, "[%g, %g]", v[0], v[1]);
-    else snprintf(out, cap, "[%g, %g, %g]", v[0], v[1], v[2]);
-}
+typedef pfsph__geo geo;
 
 /* ---------------------------------------------------------------------------------------- */
 /* Sections. */
@@ -599,13 +368,13 @@ static int parse_solids(parser *p, const cJSON *root)
             so->phase = def;
         }
         /* A solid wholly outside the domain is certainly a mistake. */
-        geo g = geo_of(s->dim, so->shape == PFSPH_SHAPE_CONTAINER ? PFSPH_SHAPE_BOX : so->shape, so->min, so->max,
-                       so->center, so->radius, so->height, so->axis);
+        geo g = pfsph__geo_of(s->dim, so->shape == PFSPH_SHAPE_CONTAINER ? PFSPH_SHAPE_BOX : so->shape, so->min,
+                              so->max, so->center, so->radius, so->height, so->axis);
         for (int k = 0; k < s->dim; k++)
             if (g.max[k] < s->domain_min[k] || g.min[k] > s->domain_max[k]) {
                 char a[96], b[96];
-                fmt_vec(a, sizeof a, s->dim, s->domain_min);
-                fmt_vec(b, sizeof b, s->dim, s->domain_max);
+                pfsph__fmt_vec(a, sizeof a, s->dim, s->domain_min);
+                pfsph__fmt_vec(b, sizeof b, s->dim, s->domain_max);
                 return pfsph__json_fail(&p->ctx, P, "solid lies outside the domain %s .. %s", a, b);
             }
     }
@@ -723,7 +492,7 @@ static int parse_fluid(parser *p, const cJSON *root)
         if (get(e, "bubble")) TRY(parse_bubble(p, e, P, i, b));
         /* Spheres and cylinders also get their bounding box in min/max (used by samplers and
          * the checks below). */
-        geo g = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
+        geo g = pfsph__geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
         if (b->shape != PFSPH_SHAPE_BOX)
             for (int k = 0; k < 3; k++) {
                 b->min[k] = g.min[k];
@@ -735,266 +504,6 @@ static int parse_fluid(parser *p, const cJSON *root)
 }
 
 /* Checks across blocks and solids, once all of them are known. */
-static int check_blocks(parser *p)
-{
-    pfsph_scene *s = p->s;
-    const double sp = 2.0 * s->particle_radius;
-    const double tiny = 1e-9 * sp;
-    for (int i = 0; i < s->nblocks; i++) {
-        const pfsph_block *b = &s->blocks[i];
-        char P[128], kp[160];
-        path_index(P, sizeof P, "$.fluid", i);
-        const geo gb = geo_of(s->dim, b->shape, b->min, b->max, b->center, b->radius, b->height, b->axis);
-        /* Empty: fewer than one particle along some axis. */
-        if (b->shape == PFSPH_SHAPE_BOX) {
-            for (int k = 0; k < s->dim; k++)
-                if (b->max[k] - b->min[k] < sp - tiny) {
-                    path_key(kp, sizeof kp, P, "max");
-                    return pfsph__json_fail(&p->ctx, kp,
-                                            "block is %g m wide along %s, less than one particle "
-                                            "spacing (%g m = 2 x particle_radius): it would hold no "
-                                            "particle",
-                                            b->max[k] - b->min[k], axis_names[k], sp);
-                }
-        } else {
-            if (b->radius < sp - tiny) {
-                path_key(kp, sizeof kp, P, "radius");
-                return pfsph__json_fail(&p->ctx, kp,
-                                        "radius %g m is less than one particle spacing (%g m = 2 x "
-                                        "particle_radius): too small to sample",
-                                        b->radius, sp);
-            }
-            if (b->shape == PFSPH_SHAPE_CYLINDER && s->dim == 3 && b->height < sp - tiny) {
-                path_key(kp, sizeof kp, P, "height");
-                return pfsph__json_fail(&p->ctx, kp, "height %g m is less than one particle spacing (%g m)", b->height,
-                                        sp);
-            }
-        }
-        /* Inside the domain. */
-        for (int k = 0; k < s->dim; k++) {
-            double scale = fmax(1.0, fabs(s->domain_max[k] - s->domain_min[k]));
-            if (gb.min[k] < s->domain_min[k] - 1e-9 * scale || gb.max[k] > s->domain_max[k] + 1e-9 * scale) {
-                char a[96], c[96], lo[96], hi[96];
-                fmt_vec(a, sizeof a, s->dim, s->domain_min);
-                fmt_vec(c, sizeof c, s->dim, s->domain_max);
-                fmt_vec(lo, sizeof lo, s->dim, gb.min);
-                fmt_vec(hi, sizeof hi, s->dim, gb.max);
-                const char *key =
-                    b->shape != PFSPH_SHAPE_BOX ? "center" : (gb.min[k] < s->domain_min[k] ? "min" : "max");
-                path_key(kp, sizeof kp, P, key);
-                return pfsph__json_fail(&p->ctx, kp, "block %s .. %s extends outside the domain %s .. %s along %s", lo,
-                                        hi, a, c, axis_names[k]);
-            }
-        }
-        /* Solids: obstacles must not start inside fluid; container walls must not cut blocks. */
-        for (int j = 0; j < s->nsolids; j++) {
-            const pfsph_solid *so = &s->solids[j];
-            if (so->shape == PFSPH_SHAPE_PLANE) continue;
-            if (so->shape == PFSPH_SHAPE_CONTAINER) {
-                /* Partly inside the container's inner box but not wholly: crosses a wall. */
-                bool touches = true, inside = true;
-                for (int k = 0; k < s->dim; k++) {
-                    double lo = fmax(gb.min[k], so->min[k]), hi = fmin(gb.max[k], so->max[k]);
-                    if (hi - lo <= 0.5 * sp) touches = false;
-                    if (gb.min[k] < so->min[k] - 0.5 * sp) inside = false;
-                    bool top = so->open_top && k == 1;
-                    if (!top && gb.max[k] > so->max[k] + 0.5 * sp) inside = false;
-                }
-                if (touches && !inside)
-                    return pfsph__json_fail(&p->ctx, P, "block crosses the walls of the container $.solids[%d]", j);
-                continue;
-            }
-            geo g = geo_of(s->dim, so->shape, so->min, so->max, so->center, so->radius, so->height, so->axis);
-            if (geo_overlap(&g, &gb, sp))
-                return pfsph__json_fail(&p->ctx, P,
-                                        "overlaps the solid $.solids[%d]; fluid particles would start "
-                                        "inside it",
-                                        j);
-        }
-        /* Overlaps with later blocks are what carving is for (shapes.c); a block they cover
-         * wholly adds nothing, which is an ordering mistake (a tank listed after its bubble). */
-        if (pfsph__scene_block_covered(s, i, sp)) {
-            return pfsph__json_fail(&p->ctx, P,
-                                    "every particle of this block lies inside later blocks, which replace "
-                                    "earlier ones where they overlap: it would add nothing (list it after "
-                                    "the blocks it should replace)");
-        }
-    }
-    return PFSPH_OK;
-}
-
-/* output.surface: true, false or {"formats", "smoothing", "isotropic", "cell"} */
-static int parse_surface(parser *p, const cJSON *v)
-{
-    pfsph_surface_output *o = &p->s->output.surface;
-    if (!v) return PFSPH_OK;
-    const char *P = "$.output.surface";
-    if (cJSON_IsBool(v)) o->on = cJSON_IsTrue(v);
-    else if (cJSON_IsObject(v)) {
-        static const char *const keys[] = {"formats", "smoothing", "isotropic", "cell", NULL};
-        TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
-        o->on = true;
-        TRY(pfsph__json_int(v, P, "smoothing", 0, 100, &o->smoothing, &p->ctx));
-        TRY(pfsph__json_bool(v, P, "isotropic", &o->isotropic, &p->ctx));
-        TRY(pfsph__json_number(v, P, "cell", 0.2, 2.0, &o->cell, &p->ctx));
-        const cJSON *f = get(v, "formats");
-        if (f) {
-            if (!cJSON_IsArray(f) || !cJSON_GetArraySize(f))
-                return pfsph__json_fail(&p->ctx, "$.output.surface.formats",
-                                        "expected a non-empty array of strings (\"ply\", \"obj\", \"vtp\")");
-            o->ply = o->obj = o->vtp = false;
-            int i = 0;
-            for (const cJSON *e = f->child; e; e = e->next, i++) {
-                char ep[64];
-                path_index(ep, sizeof ep, "$.output.surface.formats", i);
-                const char *n = cJSON_IsString(e) ? e->valuestring : "";
-                if (!strcmp(n, "ply")) o->ply = true;
-                else if (!strcmp(n, "obj")) o->obj = true;
-                else if (!strcmp(n, "vtp")) o->vtp = true;
-                else return pfsph__json_fail(&p->ctx, ep, "unknown format (expected \"ply\", \"obj\" or \"vtp\")");
-            }
-        }
-    } else
-        return pfsph__json_fail(&p->ctx, P, "expected true, false or an object (formats, smoothing, isotropic, cell)");
-    /* 2D: the outline as VTP polylines only (docs/surfaces.md#2d-contours) */
-    if (o->on && p->s->dim == 2) {
-        if (get(v, "formats") && (o->ply || o->obj))
-            return pfsph__json_fail(&p->ctx, "$.output.surface.formats",
-                                    "a 2D scene's outline is written as VTP polylines only (formats [\"vtp\"])");
-        o->ply = o->obj = false;
-        o->vtp = true;
-    }
-    return PFSPH_OK;
-}
-
-static int parse_output(parser *p, const cJSON *root)
-{
-    pfsph_output *o = &p->s->output;
-    const cJSON *v = get(root, "output");
-    if (!v) return PFSPH_OK;
-    static const char *const keys[] = {"directory",           "formats", "fields", "boundary", "frame_interval",
-                                       "checkpoint_interval", "surface", NULL};
-    const char *P = "$.output";
-    TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
-    TRY(parse_surface(p, get(v, "surface")));
-    TRY(pfsph__json_string(v, P, "directory", o->dir, sizeof o->dir, &p->ctx));
-    if (get(v, "directory") && !o->dir[0]) return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
-    TRY(pfsph__json_bool(v, P, "boundary", &o->write_boundary, &p->ctx));
-    TRY(pfsph__json_int(v, P, "frame_interval", 1, 1000000, &o->frame_interval, &p->ctx));
-    TRY(pfsph__json_int(v, P, "checkpoint_interval", 0, 1000000, &o->checkpoint_interval, &p->ctx));
-    const cJSON *f = get(v, "formats");
-    if (f) {
-        static const char *const names[] = {"vtp", "ply", NULL};
-        if (!cJSON_IsArray(f))
-            return pfsph__json_fail(&p->ctx, "$.output.formats", "expected an array of strings (\"vtp\", \"ply\")");
-        o->vtp = o->ply = false;
-        int i = 0;
-        for (const cJSON *e = f->child; e; e = e->next, i++) {
-            char ep[64];
-            path_index(ep, sizeof ep, "$.output.formats", i);
-            int idx = -1;
-            for (int k = 0; names[k] && cJSON_IsString(e); k++)
-                if (strcmp(e->valuestring, names[k]) == 0) idx = k;
-            if (idx < 0) return pfsph__json_fail(&p->ctx, ep, "unknown format (expected \"vtp\" or \"ply\")");
-            if (idx == 0) o->vtp = true;
-            else o->ply = true;
-        }
-    }
-    const cJSON *fl = get(v, "fields");
-    if (fl) {
-        static const char *const names[] = {"id", "speed", NULL};
-        static const unsigned bits[] = {PFSPH_OUT_ID, PFSPH_OUT_SPEED};
-        if (!cJSON_IsArray(fl))
-            return pfsph__json_fail(&p->ctx, "$.output.fields", "expected an array of strings (\"id\", \"speed\")");
-        o->fields = 0;
-        int i = 0;
-        for (const cJSON *e = fl->child; e; e = e->next, i++) {
-            char ep[64];
-            path_index(ep, sizeof ep, "$.output.fields", i);
-            int idx = -1;
-            for (int k = 0; names[k] && cJSON_IsString(e); k++)
-                if (strcmp(e->valuestring, names[k]) == 0) idx = k;
-            if (idx < 0) return pfsph__json_fail(&p->ctx, ep, "unknown field (expected \"id\" or \"speed\")");
-            o->fields |= bits[idx];
-        }
-    }
-    return PFSPH_OK;
-}
-
-static int parse_camera(parser *p, const cJSON *root)
-{
-    pfsph_camera *c = &p->s->camera;
-    const cJSON *v = get(root, "camera");
-    if (!v) return PFSPH_OK;
-    static const char *const keys[] = {"eye", "target", "up", "fov", "width", "height", "color_by", NULL};
-    const char *P = "$.camera";
-    TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
-    c->set = true;
-    /* The camera always lives in 3D: a 2D scene lies in the plane z = 0. */
-    TRY(pfsph__json_vec(v, P, "eye", 3, -COORD_MAX, COORD_MAX, c->eye, &p->ctx));
-    TRY(pfsph__json_vec(v, P, "target", 3, -COORD_MAX, COORD_MAX, c->target, &p->ctx));
-    TRY(pfsph__json_vec(v, P, "up", 3, -1e3, 1e3, c->up, &p->ctx));
-    TRY(pfsph__json_number(v, P, "fov", 1.0, 179.0, &c->fov_deg, &p->ctx));
-    TRY(pfsph__json_int(v, P, "width", 16, 16384, &c->width, &p->ctx));
-    TRY(pfsph__json_int(v, P, "height", 16, 16384, &c->height, &p->ctx));
-    int cb = 0;
-    static const char *const colors[] = {"phase", "speed", "density", "pressure", NULL};
-    TRY(json_enum(p, v, P, "color_by", colors, &cb));
-    snprintf(c->color_by, sizeof c->color_by, "%s", colors[cb]);
-    double d[3], u2 = 0, d2 = 0, cr2 = 0;
-    for (int k = 0; k < 3; k++) {
-        d[k] = c->target[k] - c->eye[k];
-        d2 += d[k] * d[k];
-        u2 += c->up[k] * c->up[k];
-    }
-    if (!(d2 > 0)) return pfsph__json_fail(&p->ctx, "$.camera.target", "target equals eye");
-    double cr[3] = {d[1] * c->up[2] - d[2] * c->up[1], d[2] * c->up[0] - d[0] * c->up[2],
-                    d[0] * c->up[1] - d[1] * c->up[0]};
-    for (int k = 0; k < 3; k++) cr2 += cr[k] * cr[k];
-    if (!(u2 > 0) || !(cr2 > 1e-12 * d2 * u2))
-        return pfsph__json_fail(&p->ctx, "$.camera.up", "up must be non-zero and not parallel to the view direction");
-    return PFSPH_OK;
-}
-
-/* A camera framing the domain, used when the scene names none (and as defaults for the keys a
- * "camera" object leaves out). */
-static void auto_camera(pfsph_scene *s)
-{
-    pfsph_camera *c = &s->camera;
-    double ext = 0;
-    for (int k = 0; k < s->dim; k++) {
-        c->target[k] = 0.5 * (s->domain_min[k] + s->domain_max[k]);
-        ext = fmax(ext, s->domain_max[k] - s->domain_min[k]);
-    }
-    if (s->dim == 2) {
-        c->target[2] = 0;
-        c->eye[0] = c->target[0];
-        c->eye[1] = c->target[1];
-        c->eye[2] = 1.6 * ext;
-    } else {
-        c->eye[0] = c->target[0] + 0.35 * ext;
-        c->eye[1] = c->target[1] + 0.45 * ext;
-        c->eye[2] = c->target[2] + 1.4 * ext;
-    }
-}
-
-/* File name without directory and ".json": default scene name and output directory. */
-static void source_stem(const char *source, char *out, size_t cap)
-{
-    const char *b = source ? strrchr(source, '/') : NULL;
-    b = b ? b + 1 : (source ? source : "");
-    size_t n = strlen(b);
-    if (n > 5 && strcmp(b + n - 5, ".json") == 0) n -= 5;
-    size_t m = 0;
-    for (size_t i = 0; i < n && m + 1 < cap; i++) {
-        char ch = b[i];
-        bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' ||
-            ch == '-' || ch == '.';
-        if (ok) out[m++] = ch;
-    }
-    out[m] = 0;
-    if (!m) snprintf(out, cap, "scene");
-}
 
 /* ---------------------------------------------------------------------------------------- */
 
@@ -1109,7 +618,7 @@ static int parse_root(parser *p, const cJSON *root)
     TRY(parse_phases(p, root));
     TRY(parse_solids(p, root));
     TRY(parse_fluid(p, root));
-    TRY(check_blocks(p));
+    TRY(pfsph__scene_check_blocks(p));
     const cJSON *bd = get(root, "bodies");
     if (bd) TRY(pfsph__scene_parse_bodies(bd, "$.bodies", s, &p->ctx));
     TRY(pfsph__scene_parse_emitters(get(root, "emitters"), "$.emitters", s, &p->ctx));
@@ -1124,9 +633,9 @@ static int parse_root(parser *p, const cJSON *root)
         if (!cJSON_IsObject(df)) return pfsph__json_fail(&p->ctx, "$.diffuse", "expected an object");
         TRY(pfsph__scene_parse_diffuse(df, "$.diffuse", s, &p->ctx));
     }
-    auto_camera(s);
-    TRY(parse_output(p, root));
-    TRY(parse_camera(p, root));
+    pfsph__scene_auto_camera(s);
+    TRY(pfsph__scene_parse_output(p, root));
+    TRY(pfsph__scene_parse_camera(p, root));
     return PFSPH_OK;
 }
 
@@ -1154,7 +663,7 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
     pfsph_scene_defaults(s);
     snprintf(s->source, sizeof s->source, "%s", source);
     char stem[PFSPH_NAME_LEN];
-    source_stem(source, stem, sizeof stem);
+    pfsph__scene_source_stem(source, stem, sizeof stem);
     snprintf(s->name, sizeof s->name, "%s", stem);
     snprintf(s->output.dir, sizeof s->output.dir, "runs/%s", stem);
 
