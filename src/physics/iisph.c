@@ -259,13 +259,10 @@ static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, dou
     return dt;
 }
 
-/* IISPH removes the predicted density error within one step, as PCISPH does, so with a tiny dt
- * its pressure speeds grow as 1/dt without harm: a blow-up is above 20 c and half a spacing in
- * the step (PCISPH's rule, issue 15 item 5). */
+/* a blow-up only above 20 c and half a spacing in the step (pfsph__speed_bound_one_step) */
 static double speed_bound(const void *state, const pfsph_ctx *ctx)
 {
-    const double b = 20 * ((const iisph *)state)->c;
-    return ctx->dt > 0 ? fmax(b, 0.5 * (double)ctx->spacing / ctx->dt) : b;
+    return pfsph__speed_bound_one_step(((const iisph *)state)->c, ctx);
 }
 
 static const char *hint(const void *state, const pfsph_ctx *ctx)

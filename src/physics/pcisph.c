@@ -117,13 +117,10 @@ static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, dou
     return dt;
 }
 
-/* PCISPH removes the density error within one step, so with a tiny dt its pressure speeds
- * grow as 1/dt without harm: a speed is a blow-up only above 20 c and once the particle also
- * moves half a spacing in the step (issue 15 item 5). */
+/* a blow-up only above 20 c and half a spacing in the step (pfsph__speed_bound_one_step) */
 static double speed_bound(const void *state, const pfsph_ctx *ctx)
 {
-    const double b = 20 * ((const pcisph *)state)->c;
-    return ctx->dt > 0 ? fmax(b, 0.5 * (double)ctx->spacing / ctx->dt) : b;
+    return pfsph__speed_bound_one_step(((const pcisph *)state)->c, ctx);
 }
 
 /* below the acoustic step a smaller dt_max makes things worse */

@@ -15,6 +15,7 @@
 PFSPH_SOLVERS(PFSPH_SOLVER_DECLARE)
 #define PFSPH_SOLVER_ROW(n) &pfsph_solver_##n,
 static const pfsph_solver_ops *const solvers[] = {PFSPH_SOLVERS(PFSPH_SOLVER_ROW) NULL};
+_Static_assert(sizeof solvers / sizeof *solvers - 1 <= PFSPH_MAX_SOLVERS, "raise PFSPH_MAX_SOLVERS");
 
 const pfsph_solver_ops *pfsph_solver_find(const char *name)
 {
@@ -33,6 +34,12 @@ int pfsph_solver_key_index(const pfsph_solver_ops *ops, const char *key)
     for (int k = 0; ops && key && k < ops->nkeys; k++)
         if (!strcmp(ops->keys[k].name, key)) return k;
     return -1;
+}
+
+double pfsph__speed_bound_one_step(double c, const pfsph_ctx *ctx)
+{
+    const double b = 20 * c;
+    return ctx->dt > 0 ? fmax(b, 0.5 * (double)ctx->spacing / ctx->dt) : b;
 }
 
 double pfsph__dt_force(double spacing, double a) { return a > 0 ? 0.25 * sqrt(spacing / a) : INFINITY; }

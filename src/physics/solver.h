@@ -93,6 +93,14 @@ const pfsph_solver_ops *pfsph_solver_at(int i);
 /* The index of key in the row's keys, or -1. */
 int pfsph_solver_key_index(const pfsph_solver_ops *ops, const char *key);
 
+/* Most solvers the registry holds (solver.c checks it at compile time). */
+#define PFSPH_MAX_SOLVERS 16
+
+/* Shared by the solvers that remove the density error within one step (PCISPH, IISPH): with a
+ * tiny dt their pressure speeds grow as 1/dt without harm, so a speed is a blow-up only above
+ * 20 c and once the particle also moves half a spacing in the step (issue 15 item 5). */
+double pfsph__speed_bound_one_step(double c, const pfsph_ctx *ctx);
+
 /* Shared by the iterative solvers' `check`: min_iterations <= max_iterations. */
 int pfsph__check_iterations(double min_iter, double max_iter, const char **key, char *msg, size_t len);
 

@@ -57,13 +57,13 @@ static int parse_solver(parser *p, const cJSON *root)
     const cJSON *o = get(root, "solver");
     if (!o) return PFSPH_OK;
     static const char *const common[] = {"type", "sound_speed", "gamma", "pressure_scale"};
-    const char *keys[4 + 8 * PFSPH_SOLVER_MAX_KEYS + 1];
-    const char *names[9];
+    const char *keys[4 + PFSPH_MAX_SOLVERS * PFSPH_SOLVER_MAX_KEYS + 1];
+    const char *names[PFSPH_MAX_SOLVERS + 1];
     int nk = 0, nn = 0;
     for (int k = 0; k < 4; k++) keys[nk++] = common[k];
     for (int i = 0; pfsph_solver_at(i); i++) {
         const pfsph_solver_ops *ops = pfsph_solver_at(i);
-        if (nn < 8) names[nn++] = ops->name;
+        names[nn++] = ops->name;
         for (int k = 0; k < ops->nkeys; k++) {
             int seen = 0;
             for (int m = 0; m < nk && !seen; m++) seen = !strcmp(keys[m], ops->keys[k].name);
@@ -92,8 +92,7 @@ static int parse_solver(parser *p, const cJSON *root)
             } else {
                 TRY(pfsph__json_number(o, P, key->name, key->min, key->max, &v, &p->ctx));
             }
-            int own = ops == self ? k : -1;
-            if (own >= 0) s->solver_settings[own] = v;
+            if (ops == self) s->solver_settings[k] = v;
         }
     }
     char msg[256];
