@@ -22,152 +22,36 @@
  * narrow range of 1 / R amplifies that into the slope. The five drops run in parallel, one per
  * thread, each simulation on one thread (independent, so the bits do not depend on the order): 131 s of CPU in all
  * (label validation). Under AddressSanitizer it skips (tu_release_only).
+ * The code: pfm_laplace_run, tests/pf_measure.c.
  * Knobs for studies: PF_SOLVER, PF_TOL (the solver's density tolerance), PF_DTMAX (0.002 s),
  * PF_THETA, PF_SEED (7), PF_T (end [s]), PF_RADII ("8,10,13,16,20" in spacings). */
-#include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
-#include "pfsph/sim.h"
+#include "pf_measure.h"
 #include "testutil.h"
-
-static const double PI = 3.14159265358979323846;
-#define SIGMA 4.0 /* N/m */
-#define NB 10
-
-#define MAXR 8
-
-typedef struct {
-    double Rs;
-    pfsph_sim *sim;
-    double Re, p, se;
-    size_t m;
-    int rc, removed;
-    char msg[256];
-} drop;
-
-static void create_drop(drop *dr)
-{
-    const double d = 0.01;
-    char json[2048], thermo[96] = "", tol[64] = "";
-    if (getenv("PF_TOL")) snprintf(tol, sizeof tol, ", \"tolerance\": %s", getenv("PF_TOL"));
-    if (getenv("PF_THETA"))
-        snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},", getenv("PF_THETA"));
-    snprintf(json, sizeof json,
-             "{\"dimension\": 2, \"seed\": %d, \"particle_radius\": %g, \"gravity\": [0, 0],"
-             " \"domain\": {\"min\": [-1, -1], \"max\": [1, 1]},"
-             " \"solver\": {\"type\": \"%s\"%s}, \"time\": {\"dt_max\": %s},"
-             " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.001}],"
-             " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0], \"radius\": %g}],"
-             " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
-             " \"sigma\": %g}]}}",
-             getenv("PF_SEED") ? atoi(getenv("PF_SEED")) : 7, 0.5 * d,
-             getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", tol,
-             getenv("PF_DTMAX") ? getenv("PF_DTMAX") : "0.002", dr->Rs * d, thermo, SIGMA);
-    dr->sim = tu_sim_from_json(json, "laplace.json");
-    dr->Re = sqrt((double)pfsph_sim_ctx(dr->sim)->fluid->n * d * d / PI);
-}
-
-/* Runs on one thread of the test's parallel loop: no cmocka assertion here (they jump); the
- * outcome goes into dr->rc / dr->msg. */
-static void run_drop(drop *dr, double t0, double t_end)
-{
-    pfsph_sim *sim = dr->sim;
-    const pfsph_particles *f = pfsph_sim_ctx(sim)->fluid;
-    const size_t n = f->n;
-    pfsph_error err = {0};
-    size_t cap = 1 << 14, m = 0;
-    pfsph_real *pm = malloc(n * sizeof *pm);
-    double *smp = malloc(cap * sizeof *smp);
-    dr->rc = !pm || !smp ? PFSPH_ENOMEM : pfsph_sim_advance(sim, t0, &err);
-    while (dr->rc == PFSPH_OK && pfsph_sim_time(sim) < t_end - 1e-9) {
-        /* whole steps (pfsph_sim_advance would shorten the last one to land on a time) */
-        for (int q = 0; q < 2 && dr->rc == PFSPH_OK && pfsph_sim_time(sim) < t_end - 1e-9; q++)
-            dr->rc = pfsph_sim_step(sim, t_end, &err);
-        if (dr->rc == PFSPH_OK) dr->rc = pfsph_sim_mechanical_pressure(sim, pm);
-        if (dr->rc != PFSPH_OK) break;
-        double cx = 0, cy = 0, sum = 0;
-        int cnt = 0;
-        for (size_t i = 0; i < n; i++) cx += f->x[i], cy += f->y[i];
-        cx /= (double)n, cy /= (double)n;
-        for (size_t i = 0; i < n; i++)
-            if (hypot(f->x[i] - cx, f->y[i] - cy) < 0.5 * dr->Re) sum += pm[i], cnt++;
-        if (cnt == 0) {
-            snprintf(err.msg, sizeof err.msg, "no particle within R_e / 2 of the centroid at t = %g s",
-                     pfsph_sim_time(sim));
-            dr->rc = PFSPH_EUNSTABLE;
-            break;
-        }
-        if (m == cap) {
-            double *grown = realloc(smp, 2 * cap * sizeof *smp);
-            if (!grown) {
-                dr->rc = PFSPH_ENOMEM;
-                break;
-            }
-            smp = grown, cap *= 2;
-        }
-        smp[m++] = sum / cnt;
-    }
-    snprintf(dr->msg, sizeof dr->msg, "%s", err.msg);
-    dr->m = m;
-    dr->removed = (int)pfsph_sim_removed(sim);
-    if (dr->rc == PFSPH_OK && m >= NB) tu_block_mean(smp, m, NB, &dr->p, &dr->se, NULL);
-    free(pm);
-    free(smp);
-}
-
-typedef struct {
-    drop *dr;
-    double t0, t_end;
-} drop_job;
-
-static void run_job(void *arg, int i)
-{
-    drop_job *j = arg;
-    run_drop(&j->dr[i], j->t0, j->t_end);
-}
 
 static void test_laplace(void **state)
 {
     (void)state;
-    double radii[MAXR] = {8, 10, 13, 16, 20};
-    int nr = 5;
-    nr = tu_env_list("PF_RADII", radii, MAXR, nr);
-    double t_end = getenv("PF_T") ? atof(getenv("PF_T")) : 6.0;
     tu_release_only();
-    const double t0 = 1.0;
-    drop dr[MAXR];
-    memset(dr, 0, sizeof dr);
-    for (int i = 0; i < nr; i++) {
-        dr[i].Rs = radii[i];
-        create_drop(&dr[i]);
-    }
-    drop_job job = {dr, t0, t_end};
-    tu_parallel_largest_first(nr, radii, run_job, &job);
-    for (int i = 0; i < nr; i++) {
-        if (dr[i].rc != PFSPH_OK) print_message("R = %g d: %s\n", dr[i].Rs, dr[i].msg);
-        assert_int_equal(dr[i].rc, PFSPH_OK);
-        assert_int_equal(dr[i].removed, 0);
-        assert_true(dr[i].m >= NB);
-        const size_t n = pfsph_sim_ctx(dr[i].sim)->fluid->n;
-        print_message("R = %g d (%zu particles, R_e %.4f m): p_in = %.3f +- %.3f Pa over %zu samples; "
-                      "sigma / R_e = %.3f Pa (ratio %.3f +- %.3f); %llu steps\n",
-                      dr[i].Rs, n, dr[i].Re, dr[i].p, dr[i].se, dr[i].m, SIGMA / dr[i].Re, dr[i].p * dr[i].Re / SIGMA,
-                      dr[i].se * dr[i].Re / SIGMA, (unsigned long long)pfsph_sim_steps(dr[i].sim));
-        pfsph_sim_destroy(dr[i].sim);
-    }
-    /* least squares p = a + s x, x = 1 / R_e */
-    double x[MAXR], y[MAXR], Rmax = 0;
-    for (int i = 0; i < nr; i++) x[i] = 1.0 / dr[i].Re, y[i] = dr[i].p, Rmax = fmax(Rmax, dr[i].Re);
-    const tu_line fit = tu_line_fit(nr, x, y);
-    const double slope = fit.slope, icpt = fit.icpt, r2 = fit.r2;
-    print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n", slope, slope / SIGMA,
-                  icpt, 0.25 * SIGMA / Rmax, r2);
-    assert_true(fabs(slope / SIGMA - 1) <= 0.15);
-    assert_true(fabs(icpt) <= 0.25 * SIGMA / Rmax);
-    assert_true(r2 >= 0.9);
+    double radii[PFM_MAXR] = {8, 10, 13, 16, 20};
+    const int nr = tu_env_list("PF_RADII", radii, PFM_MAXR, 5);
+    char tol[64] = "", thermo[96] = "";
+    const char *e;
+    if ((e = getenv("PF_TOL"))) snprintf(tol, sizeof tol, ", \"tolerance\": %s", e);
+    if ((e = getenv("PF_THETA"))) snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},", e);
+    pfm_laplace cfg = {.dim = 2,
+                       .seed = (e = getenv("PF_SEED")) ? atoi(e) : 7,
+                       .solver = (e = getenv("PF_SOLVER")) ? e : "pcisph",
+                       .solver_keys = tol,
+                       .dt_max = (e = getenv("PF_DTMAX")) ? e : "0.002",
+                       .thermo = thermo,
+                       .every = 2,
+                       .t0 = 1.0,
+                       .t_end = (e = getenv("PF_T")) ? atof(e) : 6.0,
+                       .checks = 1};
+    pfm_laplace_run(&cfg, radii, nr);
 }
 
 int main(int argc, char **argv)
