@@ -280,7 +280,10 @@ static void create_drop(const pfm_laplace *cfg, drop *dr)
 {
     const double d = D_SP;
     const int D = cfg->dim;
-    char json[2048], z[32], lo[32], hi[32];
+    char json[2048], z[32], lo[32], hi[32], thermo[96] = "";
+    const char *e = getenv("PF_THETA");
+    if (e) snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},", e);
+    e = getenv("PF_SEED");
     snprintf(json, sizeof json,
              "{\"dimension\": %d, \"seed\": %d, \"particle_radius\": %g, \"gravity\": %s,"
              " \"domain\": {\"min\": %s, \"max\": %s},"
@@ -289,9 +292,8 @@ static void create_drop(const pfm_laplace *cfg, drop *dr)
              " \"fluid\": [{\"shape\": \"sphere\", \"center\": %s, \"radius\": %g}],"
              " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"],"
              " \"sigma\": %g}]}}",
-             D, cfg->seed, 0.5 * d, vec(z, sizeof z, D, 0, 0, 0), vec(lo, sizeof lo, D, -1, -1, -1),
-             vec(hi, sizeof hi, D, 1, 1, 1), cfg->solver, cfg->solver_keys, cfg->dt_max, z, dr->Rs * d, cfg->thermo,
-             SIGMA);
+             D, e ? atoi(e) : 7, 0.5 * d, vec(z, sizeof z, D, 0, 0, 0), vec(lo, sizeof lo, D, -1, -1, -1),
+             vec(hi, sizeof hi, D, 1, 1, 1), cfg->solver, cfg->solver_keys, cfg->dt_max, z, dr->Rs * d, thermo, SIGMA);
     dr->sim = tu_sim_from_json(json, "laplace.json");
     const size_t n = pfsph_sim_ctx(dr->sim)->fluid->n;
     /* the equivalent radius: the disc (ball) of the particles' volume */

@@ -67,14 +67,13 @@ void pfm_contact_angles(int dim, const double *targets, int nd);
  * pressure the frames carry (pfsph_sim_mechanical_pressure) averaged over the particles within
  * R_e / 2 of the centroid, sampled every `every` steps from t0 to t_end; its mean and block
  * error come from 10 block means. The fit p = a + s x, x = (dim - 1) / R_e, must give s within
- * 15 % of sigma, |a| <= 0.25 sigma / R_max and R^2 >= 0.9 (unless checks is 0: code paths only). */
+ * 15 % of sigma, |a| <= 0.25 sigma / R_max and R^2 >= 0.9 (unless checks is 0: code paths only).
+ * Knobs for studies: PF_SEED (7), PF_THETA (the thermostat's reduced temperature). */
 typedef struct pfm_laplace {
     int dim;
-    int seed;
     const char *solver;      /* "type" */
     const char *solver_keys; /* appended to the solver object (", \"tolerance\": ..." or "") */
     const char *dt_max;      /* as written in the scene */
-    const char *thermo;      /* the pairwise "thermostat" member with a trailing comma, or "" */
     int every;
     double t0, t_end;
     int profile; /* 3D: radial profile of the pressure, gyration radius and block means */

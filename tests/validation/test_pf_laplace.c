@@ -37,16 +37,13 @@ static void test_laplace(void **state)
     tu_release_only();
     double radii[PFM_MAXR] = {8, 10, 13, 16, 20};
     const int nr = tu_env_list("PF_RADII", radii, PFM_MAXR, 5);
-    char tol[64] = "", thermo[96] = "";
+    char tol[64] = "";
     const char *e;
     if ((e = getenv("PF_TOL"))) snprintf(tol, sizeof tol, ", \"tolerance\": %s", e);
-    if ((e = getenv("PF_THETA"))) snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},", e);
     pfm_laplace cfg = {.dim = 2,
-                       .seed = (e = getenv("PF_SEED")) ? atoi(e) : 7,
                        .solver = (e = getenv("PF_SOLVER")) ? e : "pcisph",
                        .solver_keys = tol,
                        .dt_max = (e = getenv("PF_DTMAX")) ? e : "0.002",
-                       .thermo = thermo,
                        .every = 2,
                        .t0 = 1.0,
                        .t_end = (e = getenv("PF_T")) ? atof(e) : 6.0,

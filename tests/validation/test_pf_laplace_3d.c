@@ -37,15 +37,11 @@ static void test_laplace(void **state)
     double radii[PFM_MAXR] = {6, 7, 8, 9, 10};
     int nr = 5;
     nr = tu_env_list("PF_RADII", radii, PFM_MAXR, nr);
-    char thermo[96] = "";
     const char *e;
-    if ((e = getenv("PF_THETA"))) snprintf(thermo, sizeof thermo, "\"thermostat\": {\"reduced_temperature\": %s},", e);
     pfm_laplace cfg = {.dim = 3,
-                       .seed = (e = getenv("PF_SEED")) ? atoi(e) : 7,
                        .solver = (e = getenv("PF_SOLVER")) ? e : "dfsph",
                        .solver_keys = (e = getenv("PF_SOLVER_KEYS")) ? e : ", \"tolerance\": 0.0001",
                        .dt_max = "0.002",
-                       .thermo = thermo,
                        .every = (e = getenv("PF_EVERY")) ? atoi(e) : 4,
                        .t0 = (e = getenv("PF_T0")) ? atof(e) : 0.5,
                        .t_end = (e = getenv("PF_T")) ? atof(e) : 5.5,
