@@ -339,6 +339,21 @@ tu_relax tu_shape_relax(int dim, int nl, int ns, int seed, double t_end, double 
 
 /* ---- small numerics shared by the measurement tests ---- */
 
+double tu_shape_relax_seeds(int dim, int nl, int ns, double t_end, double t_win, double dt_s, const char *window)
+{
+    double mean = 0;
+    for (int seed = 1; seed <= 3; seed++) {
+        tu_relax r = tu_shape_relax(dim, nl, ns, seed, t_end, t_win, dt_s);
+        print_message("seed %d: over %.2f - %.2f s (%s) moment ratio %.4f, %.4f %% of "
+                      "pairs closer than d/2; %.1f s CPU\n",
+                      seed, t_end - t_win, t_end, window, r.ratio, 100 * r.close, r.cpu);
+        assert_true(r.ratio >= 0.95);
+        assert_true(r.close <= 0.001);
+        mean += r.ratio / 3;
+    }
+    return mean;
+}
+
 tu_line tu_line_fit(int n, const double *x, const double *y)
 {
     double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;

@@ -104,5 +104,9 @@ typedef struct tu_relax {
     double ratio, close, cpu;
 } tu_relax;
 tu_relax tu_shape_relax(int dim, int nl, int ns, int seed, double t_end, double t_win, double dt_s);
+/* tu_shape_relax for seeds 1, 2 and 3, each of which must end with a moment ratio >= 0.95 and
+ * at most 0.1 % of close pairs (`window` names the averaging window in the report); returns the
+ * mean ratio of the three. */
+double tu_shape_relax_seeds(int dim, int nl, int ns, double t_end, double t_win, double dt_s, const char *window);
 
 #endif

@@ -44,16 +44,7 @@ static void test_box_to_sphere(void **state)
     /* Rayleigh (1879): omega_l^2 = l (l - 1) (l + 2) sigma / (rho R^3), l = 2 */
     const double T = 2 * PI / sqrt(8 * sigma / (rho * R * R * R));
     print_message("R = %.2f d, capillary period T = %.3f s\n", R / d, T);
-    double mean = 0;
-    for (int seed = 1; seed <= 3; seed++) {
-        tu_relax r = tu_shape_relax(3, nl, ns, seed, 6.2, 4 * T, 0.025);
-        print_message("seed %d: over %.2f - %.2f s (four periods) moment ratio %.4f, %.4f %% of "
-                      "pairs closer than d/2; %.1f s CPU\n",
-                      seed, 6.2 - 4 * T, 6.2, r.ratio, 100 * r.close, r.cpu);
-        assert_true(r.ratio >= 0.95);
-        assert_true(r.close <= 0.001);
-        mean += r.ratio / 3;
-    }
+    const double mean = tu_shape_relax_seeds(3, nl, ns, 6.2, 4 * T, 0.025, "four periods");
     print_message("three seeds: moment ratio %.4f (floor 0.971)\n", mean);
 }
 

@@ -43,16 +43,7 @@ static void test_rectangle_to_disc(void **state)
     const double a_mean = sqrt(PI / 4) * sqrt(2 * theta * d / (3 * PI * R));
     const double ratio_floor = (1 - 2 * a_mean) / (1 + 2 * a_mean);
     print_message("R = %.2f d, capillary period T = %.3f s, thermal floor of the ratio %.4f\n", R / d, T, ratio_floor);
-    double mean = 0;
-    for (int seed = 1; seed <= 3; seed++) {
-        tu_relax r = tu_shape_relax(2, nl, ns, seed, 12.65, 2 * T, 0.05);
-        print_message("seed %d: over %.2f - %.2f s (two periods) moment ratio %.4f, %.4f %% of "
-                      "pairs closer than d/2; %.1f s CPU\n",
-                      seed, 12.65 - 2 * T, 12.65, r.ratio, 100 * r.close, r.cpu);
-        assert_true(r.ratio >= 0.95);
-        assert_true(r.close <= 0.001);
-        mean += r.ratio / 3;
-    }
+    const double mean = tu_shape_relax_seeds(2, nl, ns, 12.65, 2 * T, 0.05, "two periods");
     print_message("three seeds: moment ratio %.4f (floor %.4f)\n", mean, ratio_floor);
 }
 
