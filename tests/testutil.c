@@ -103,6 +103,14 @@ int tu_write_file(const char *path, const char *text)
     return (fclose(f) == 0 && ok) ? 0 : -1;
 }
 
+void tu_write_bytes(const char *path, const void *data, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, len, f), len);
+    assert_int_equal(fclose(f), 0);
+}
+
 int tu_run(const char *cmd, char *out, size_t cap)
 {
     char full[4096];
@@ -240,6 +248,14 @@ pfsph_sim *tu_sim_from_json(const char *json, const char *name)
     assert_int_equal(rc, PFSPH_OK);
     free(s); /* the simulation keeps its own copy */
     return sim;
+}
+
+void tu_advance(pfsph_sim *sim, double t)
+{
+    pfsph_error err = {0};
+    int rc = pfsph_sim_advance(sim, t, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
 }
 
 /* ---- shape of a free drop (the shape tests of docs/thermostat.md) ---- */

@@ -41,6 +41,8 @@ const char *tu_pfsph_bin(void);
 const char *tu_tmpdir(void);
 /* Write text to a file; returns 0 on success. */
 int tu_write_file(const char *path, const char *text);
+/* Write len bytes to a file; fails the test if it cannot. */
+void tu_write_bytes(const char *path, const void *data, size_t len);
 /* Run a shell command, capturing stdout+stderr into out (truncated to cap). Returns the exit
  * status (or -1). */
 int tu_run(const char *cmd, char *out, size_t cap);
@@ -87,6 +89,8 @@ void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, doubl
  * message, when the scene does not parse or the simulation cannot start. */
 struct pfsph_sim;
 struct pfsph_sim *tu_sim_from_json(const char *json, const char *name);
+/* pfsph_sim_advance to time t; fails the test, printing the message, on an error. */
+void tu_advance(struct pfsph_sim *sim, double t);
 
 /* Shape of a free drop (docs/thermostat.md, "The shape tests"): ratio is the smallest / largest
  * principal second moment about the centroid, close the fraction of kernel-neighbour pairs

@@ -22,27 +22,10 @@ static const char *SCENE =
 static pfsph_sim *make(const char *bodies)
 {
     static char json[8192];
-    static pfsph_scene s;
     snprintf(json, sizeof json, SCENE, bodies);
-    pfsph_error err = {0};
     char src[1200];
     snprintf(src, sizeof src, "%s/tests/contacts.json", tu_source_dir()); /* meshes resolve from here */
-    int rc = pfsph_scene_parse(&s, json, src, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, &s, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    return sim;
-}
-
-static void advance(pfsph_sim *sim, double t)
-{
-    pfsph_error err = {0};
-    int rc = pfsph_sim_advance(sim, t, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    return tu_sim_from_json(json, src);
 }
 
 /* Boxes 0.1 x 0.05 x 0.1 m released 2 cm apart: resting centres at 0.025, 0.075, 0.125 m above
@@ -55,7 +38,7 @@ static void test_stack(void **st)
         "{\"name\": \"b\", \"shape\": \"box\", \"half_extents\": [0.05, 0.025, 0.05], \"position\": [0.2, 0.17, 0.2], "
         "\"rotation\": [0, 20, 0]},"
         "{\"name\": \"c\", \"shape\": \"box\", \"half_extents\": [0.05, 0.025, 0.05], \"position\": [0.2, 0.24, 0.2]}");
-    advance(sim, 1.2);
+    tu_advance(sim, 1.2);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     for (int i = 0; i < 3; i++) {
         pfsph_body_state s;
@@ -81,7 +64,7 @@ static void test_mesh_on_box(void **st)
              "0.04, 0.2], \"density\": 2000},"
              "{\"name\": \"ball\", \"shape\": \"mesh\", \"file\": \"data/meshes/icosphere.obj\", \"scale\": 0.05,"
              " \"position\": [0.2, 0.25, 0.2], \"density\": 500}");
-    advance(sim, 1.2);
+    tu_advance(sim, 1.2);
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
     pfsph_body_state c, b;
     pfsph_bodies_get_state(B, 0, &c);

@@ -14,28 +14,6 @@
 #include "pfsph/sim.h"
 #include "testutil.h"
 
-static pfsph_sim *make(const char *json, const char *name)
-{
-    static pfsph_scene s;
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&s, json, name, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, &s, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    return sim;
-}
-
-static void advance(pfsph_sim *sim, double t)
-{
-    pfsph_error err = {0};
-    int rc = pfsph_sim_advance(sim, t, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-}
-
 /* Mass of phase `ph` and whether the ids 0..next_id-1 are each held by at most one particle. */
 static double phase_mass(const pfsph_ctx *c, int ph, int *ids_unique)
 {
@@ -68,7 +46,7 @@ static const char *MASS_2D =
 static void test_mass_2d(void **st)
 {
     (void)st;
-    pfsph_sim *sim = make(MASS_2D, "mass-2d");
+    pfsph_sim *sim = tu_sim_from_json(MASS_2D, "mass-2d");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const pfsph_emitters *E = pfsph_sim_emitters(sim);
     pfsph_emitter_info in0, in1;
@@ -77,7 +55,7 @@ static void test_mass_2d(void **st)
     /* the rate given is the rate used; the speed given gives sites V0 v / d */
     assert_true(fabs(in0.rate - 0.1) < 1e-12);
     assert_true(fabs(in1.rate / ((double)in1.sites * 2.0 * c->spacing) - 1) < 1e-6);
-    advance(sim, 0.6);
+    tu_advance(sim, 0.6);
     int uniq;
     double mw = phase_mass(c, 0, &uniq), mo = phase_mass(c, 1, &uniq);
     double ew = 1000 * 0.1 * (0.6 - 0.1), eo = 800 * in1.rate * 0.35;
@@ -112,13 +90,13 @@ static const char *MASS_3D =
 static void test_mass_3d(void **st)
 {
     (void)st;
-    pfsph_sim *sim = make(MASS_3D, "mass-3d");
+    pfsph_sim *sim = tu_sim_from_json(MASS_3D, "mass-3d");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const pfsph_emitters *E = pfsph_sim_emitters(sim);
     pfsph_emitter_info in0, in1;
     pfsph_emitters_info(E, 0, &in0);
     pfsph_emitters_info(E, 1, &in1);
-    advance(sim, 0.5);
+    tu_advance(sim, 0.5);
     pfsph_emitter_state s0, s1;
     pfsph_emitters_get_state(E, 0, &s0);
     pfsph_emitters_get_state(E, 1, &s1);
@@ -158,7 +136,7 @@ static const char *POOL_2D =
 static void test_entry_spacing(void **st)
 {
     (void)st;
-    pfsph_sim *sim = make(POOL_2D, "pool-2d");
+    pfsph_sim *sim = tu_sim_from_json(POOL_2D, "pool-2d");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const pfsph_particles *f = c->fluid;
     const double d = c->spacing;
@@ -216,9 +194,9 @@ static const char *BLOW_2D =
 static void test_blow_gas(void **st)
 {
     (void)st;
-    pfsph_sim *sim = make(BLOW_2D, "blow-2d");
+    pfsph_sim *sim = tu_sim_from_json(BLOW_2D, "blow-2d");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
-    advance(sim, 0.4);
+    tu_advance(sim, 0.4);
     pfsph_emitter_state es;
     pfsph_emitter_info in;
     pfsph_emitters_get_state(pfsph_sim_emitters(sim), 0, &es);
@@ -248,11 +226,11 @@ static void test_threads_identical(void **st)
     (void)st;
     pfsph_sim *a, *b;
     omp_set_num_threads(1);
-    a = make(POOL_2D, "pool-2d");
-    advance(a, 0.2);
+    a = tu_sim_from_json(POOL_2D, "pool-2d");
+    tu_advance(a, 0.2);
     omp_set_num_threads(2);
-    b = make(POOL_2D, "pool-2d");
-    advance(b, 0.2);
+    b = tu_sim_from_json(POOL_2D, "pool-2d");
+    tu_advance(b, 0.2);
     const pfsph_particles *fa = pfsph_sim_ctx(a)->fluid, *fb = pfsph_sim_ctx(b)->fluid;
     printf("threads: %zu particles after %llu steps, 1 and 2 threads compared\n", fa->n,
            (unsigned long long)pfsph_sim_steps(a));

@@ -48,15 +48,7 @@ static void run_ratio(double rho_gas, double t_end)
 {
     char json[4096];
     snprintf(json, sizeof json, SCENE, rho_gas);
-    static pfsph_scene s;
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&s, json, "density ratio", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim;
-    rc = pfsph_sim_create(&sim, &s, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = tu_sim_from_json(json, "density ratio");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const size_t n0 = c->fluid->n;
     int ngas = 0;
@@ -70,9 +62,7 @@ static void run_ratio(double rho_gas, double t_end)
     double worst_r = 0;
     for (int k = 1; k <= ns; k++) {
         double t = 0.025 * k;
-        rc = pfsph_sim_advance(sim, t, &err);
-        if (rc) fprintf(stderr, "%s\n", err.msg);
-        assert_int_equal(rc, PFSPH_OK);
+        tu_advance(sim, t);
         assert_int_equal(c->fluid->n, n0);
         tu_bubble b;
         tu_bubble_measure(c, GAS, rho_gas, R, &b);

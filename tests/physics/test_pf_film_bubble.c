@@ -140,17 +140,7 @@ static bubble_m measure(const pfsph_ctx *c, int k, ang *A)
 
 static pfsph_sim *make(const char *json, const char *name)
 {
-    pfsph_scene *s = malloc(sizeof *s);
-    assert_non_null(s);
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(s, json, name, &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, s, &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    free(s);
+    pfsph_sim *sim = tu_sim_from_json(json, name);
     return sim;
 }
 
@@ -189,10 +179,7 @@ static void test_bubble_at_rest(void **state)
     const int ns = (int)lround(T / dt);
     bubble_m m = m0;
     for (int k = 1; k <= ns; k++) {
-        pfsph_error err = {0};
-        int rc = pfsph_sim_advance(sim, k * dt, &err);
-        if (rc) print_message("%s\n", err.msg);
-        assert_int_equal(rc, PFSPH_OK);
+        tu_advance(sim, k * dt);
         m = measure(c, 0, A);
         max_dl = fmax(max_dl, fabs(m.liquid / VL - 1));
         max_dg = fmax(max_dg, fabs(m.gas / m0.gas - 1));
@@ -290,10 +277,7 @@ static void test_two_bubbles(void **state)
     const double dt = 0.05, T = 1.5;
     const int ns = (int)lround(T / dt);
     for (int k = 1; k <= ns; k++) {
-        pfsph_error err = {0};
-        int rc = pfsph_sim_advance(sim, k * dt, &err);
-        if (rc) print_message("%s\n", err.msg);
-        assert_int_equal(rc, PFSPH_OK);
+        tu_advance(sim, k * dt);
         const pfsph_particles *f = c->fluid;
         double dmin2 = 1e30;
         for (size_t i = 0; i < n; i++)

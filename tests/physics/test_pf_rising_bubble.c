@@ -64,15 +64,7 @@ static void run_bubble(const char *solver)
 {
     char json[4096];
     snprintf(json, sizeof json, SCENE, solver);
-    static pfsph_scene s;
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&s, json, "rising bubble", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim;
-    rc = pfsph_sim_create(&sim, &s, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = tu_sim_from_json(json, "rising bubble");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const size_t n0 = c->fluid->n;
     int ngas = 0;
@@ -87,9 +79,7 @@ static void run_bubble(const char *solver)
     double worst_r = 0, worst_gas = 0;
     for (int k = 1; k <= 16; k++) {
         double t = 0.05 * k;
-        rc = pfsph_sim_advance(sim, t, &err);
-        if (rc) fprintf(stderr, "%s\n", err.msg);
-        assert_int_equal(rc, PFSPH_OK);
+        tu_advance(sim, t);
         assert_int_equal(c->fluid->n, n0);
         tu_bubble b;
         tu_bubble_measure(c, GAS, 100.0, R, &b);

@@ -116,16 +116,7 @@ static void relax(int dim, int N, const char *k, double t_end, double ratio_min)
                  " \"fluid\": [{\"shape\": \"box\", \"min\": [%g, %g, %g], \"max\": [%g, %g, %g]}],"
                  " \"pairwise\": {\"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}}",
                  -a, -a, -a, a, a, a, k);
-    pfsph_scene *s = malloc(sizeof *s);
-    assert_non_null(s);
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(s, json, dim == 2 ? "square.json" : "cube.json", &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, s, &err);
-    if (rc) print_message("%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = tu_sim_from_json(json, dim == 2 ? "square.json" : "cube.json");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     shape st = measure(c);
     const double spread0 = st.spread;
@@ -137,9 +128,7 @@ static void relax(int dim, int N, const char *k, double t_end, double ratio_min)
     int navg = 0;
     const int ns = (int)lround(t_end / 0.025);
     for (int i = 1; i <= ns; i++) {
-        rc = pfsph_sim_advance(sim, 0.025 * i, &err);
-        if (rc) print_message("%s\n", err.msg);
-        assert_int_equal(rc, PFSPH_OK);
+        tu_advance(sim, 0.025 * i);
         st = measure(c);
         if (st.dmin < dmin) dmin = st.dmin, tmin = 0.025 * i;
         if (2 * i > ns) { /* the second half: a liquid at temperature fluctuates about round */
@@ -165,7 +154,6 @@ static void relax(int dim, int N, const char *k, double t_end, double ratio_min)
     assert_true(avg_ratio >= ratio_min);
     assert_true(avg_close <= 0.01);
     pfsph_sim_destroy(sim);
-    free(s);
 }
 
 /* 20 x 20 square, 400 particles. Outline spread 0.42-0.49 d from 0.9 s on (0.54-0.66 d at 1-3 s

@@ -69,15 +69,7 @@ static void run_case(const char *name, const double cf[6], const int want[3])
 {
     char json[4096];
     snprintf(json, sizeof json, SCENE, cf[0], cf[1], cf[2], cf[3], cf[4], cf[5]);
-    static pfsph_scene s;
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&s, json, name, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim;
-    rc = pfsph_sim_create(&sim, &s, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = tu_sim_from_json(json, name);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const size_t n0 = c->fluid->n;
     assert_int_equal(n0, 600);
@@ -90,9 +82,7 @@ static void run_case(const char *name, const double cf[6], const int want[3])
     int ok = 1;
     for (int k = 0; k < 3; k++) {
         double t = 2.5 + 0.25 * k;
-        rc = pfsph_sim_advance(sim, t, &err);
-        if (rc) fprintf(stderr, "%s\n", err.msg);
-        assert_int_equal(rc, PFSPH_OK);
+        tu_advance(sim, t);
         assert_int_equal(c->fluid->n, n0);
         contacts(c, n);
         printf("%s t=%.2f s:", name, t);

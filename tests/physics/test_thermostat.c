@@ -27,27 +27,7 @@
 #include "physics/viscosity.h"
 #include "testutil.h"
 
-static pfsph_sim *make(const char *json)
-{
-    static pfsph_scene s; /* the sim copies it */
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&s, json, "thermostat-test", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, &s, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    return sim;
-}
-
-static void advance(pfsph_sim *sim, double t)
-{
-    pfsph_error err = {0};
-    int rc = pfsph_sim_advance(sim, t, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-}
+static pfsph_sim *make(const char *json) { return tu_sim_from_json(json, "thermostat-test"); }
 
 /* A 2D drop at rest without gravity: a lattice disc of radius 8 d, sigma 4 N/m, nu 1e-3. */
 static void drop_scene(char *json, size_t cap, const char *solver, const char *thermo)
@@ -95,7 +75,7 @@ static void test_noise(void **st)
         " \"pairwise\": {\"k\": 1.7, \"coefficients\": [{\"phases\": [\"a\", \"a\"], \"sigma\": 4},"
         "   {\"phases\": [\"b\", \"b\"], \"sigma\": 2}, {\"phases\": [\"a\", \"b\"], \"sigma\": 1}]}}";
     pfsph_sim *sim = make(json);
-    advance(sim, 1e-4);
+    tu_advance(sim, 1e-4);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     assert_true(pfsph_thermostat_kT(c) > 0);
     const size_t n = c->fluid->n;
@@ -135,7 +115,7 @@ static double drop_temperature(const char *solver)
     double sum = 0;
     int cnt = 0;
     for (int k = 50; k <= 200; k++) {
-        advance(sim, 0.01 * k);
+        tu_advance(sim, 0.01 * k);
         sum += pfsph_thermostat_measure(c->fluid, c->mass, c->dim);
         cnt++;
     }
@@ -162,7 +142,7 @@ static double broken_bonds(const char *thermo)
     pfsph_sim *sim = make(json);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const double d = c->spacing;
-    advance(sim, 0.5);
+    tu_advance(sim, 0.5);
     const pfsph_particles *f = c->fluid;
     size_t n = f->n, nb = 0;
     uint32_t(*bond)[2] = malloc(sizeof(*bond) * n * 8);
@@ -175,7 +155,7 @@ static double broken_bonds(const char *thermo)
                 nb++;
             }
         }
-    advance(sim, 2.5);
+    tu_advance(sim, 2.5);
     assert_int_equal(f->n, n);
     size_t *where = malloc(sizeof(size_t) * (f->next_id + 1));
     for (size_t i = 0; i < n; i++) where[f->id[i]] = i;

@@ -32,15 +32,7 @@ static pfsph_sim *make_sim(const char *gravity, const char *solver)
 {
     char json[4096];
     snprintf(json, sizeof json, SCENE, gravity, solver);
-    static pfsph_scene s;
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&s, json, "ckpt-scene", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim = NULL;
-    rc = pfsph_sim_create(&sim, &s, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = tu_sim_from_json(json, "ckpt-scene");
     return sim;
 }
 
@@ -126,28 +118,6 @@ static void test_roundtrip_dfsph(void **st)
     roundtrip("dfsph");
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc((size_t)n + 1);
-    assert_int_equal(fread(b, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *len = (size_t)n;
-    return b;
-}
-
-static void spit(const char *path, const unsigned char *b, size_t len)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(b, 1, len, f), len);
-    fclose(f);
-}
-
 /* Load must fail with PFSPH_EINPUT, a message naming the file and containing `what`, and leave
  * the simulation as it was. */
 static void expect_reject(const char *path, const char *what)
@@ -176,7 +146,7 @@ static void test_corrupt_and_truncated(void **st)
     size_t bytes = 0;
     assert_int_equal(pfsph_checkpoint_save(path, a, 2, &bytes, &err), PFSPH_OK);
     size_t len;
-    unsigned char *b = slurp(path, &len);
+    unsigned char *b = tu_slurp(path, &len);
     assert_int_equal(len, bytes);
     /* the file is written from the arrays through a staging buffer, the buffer in one piece:
      * the same bytes, and a stash (no fsync) too */
@@ -190,7 +160,7 @@ static void test_corrupt_and_truncated(void **st)
     snprintf(stash, sizeof stash, "%s/stash.bin", tu_tmpdir());
     assert_int_equal(pfsph_checkpoint_stash(stash, a, 2, &err), PFSPH_OK);
     size_t slen;
-    unsigned char *sb = slurp(stash, &slen);
+    unsigned char *sb = tu_slurp(stash, &slen);
     assert_int_equal(slen, len);
     assert_memory_equal(sb, b, len);
     free(sb);
@@ -198,26 +168,26 @@ static void test_corrupt_and_truncated(void **st)
     /* payload byte flipped (in the middle of the particle arrays) */
     snprintf(bad, sizeof bad, "%s/flipped.bin", tu_tmpdir());
     b[len / 2] ^= 0x10;
-    spit(bad, b, len);
+    tu_write_bytes(bad, b, len);
     expect_reject(bad, "checksum");
     b[len / 2] ^= 0x10;
     /* header byte flipped (the step count's neighbour: the payload length) */
     snprintf(bad, sizeof bad, "%s/flipped_header.bin", tu_tmpdir());
     b[26] ^= 0x01;
-    spit(bad, b, len);
+    tu_write_bytes(bad, b, len);
     expect_reject(bad, "checksum");
     b[26] ^= 0x01;
     /* last byte flipped */
     snprintf(bad, sizeof bad, "%s/flipped_last.bin", tu_tmpdir());
     b[len - 1] ^= 0x80;
-    spit(bad, b, len);
+    tu_write_bytes(bad, b, len);
     expect_reject(bad, "checksum");
     b[len - 1] ^= 0x80;
     /* truncated: by one byte, in the middle, inside the header, empty */
     snprintf(bad, sizeof bad, "%s/truncated.bin", tu_tmpdir());
     const size_t cuts[] = {len - 1, len / 3, 20, 0};
     for (size_t k = 0; k < sizeof cuts / sizeof cuts[0]; k++) {
-        spit(bad, b, cuts[k]);
+        tu_write_bytes(bad, b, cuts[k]);
         expect_reject(bad, "truncated");
     }
     /* the intact file still loads */
@@ -329,8 +299,8 @@ static void test_keep_and_fallback(void **st)
 
     /* newest truncated: reported, the previous one used */
     size_t len;
-    unsigned char *buf = slurp(p3, &len);
-    spit(p3, buf, len - 7);
+    unsigned char *buf = tu_slurp(p3, &len);
+    tu_write_bytes(p3, buf, len - 7);
     free(buf);
     b = make_sim("-9.81", "pcisph");
     nwarn = 0;
@@ -342,9 +312,9 @@ static void test_keep_and_fallback(void **st)
     pfsph_sim_destroy(b);
 
     /* both bad: an error naming the folder */
-    buf = slurp(p2, &len);
+    buf = tu_slurp(p2, &len);
     buf[len / 2] ^= 1;
-    spit(p2, buf, len);
+    tu_write_bytes(p2, buf, len);
     free(buf);
     b = make_sim("-9.81", "pcisph");
     nwarn = 0;
@@ -454,10 +424,10 @@ static void test_crafted_clock(void **st)
     /* a file named for frame 7 that holds frame 2 */
     char path[600];
     snprintf(path, sizeof path, "%s/ckpt_00007.bin", tu_tmpdir());
-    spit(path, b, len);
+    tu_write_bytes(path, b, len);
     expect_reject(path, "its name says 7");
     snprintf(path, sizeof path, "%s/ckpt_00002.bin", tu_tmpdir());
-    spit(path, b, len);
+    tu_write_bytes(path, b, len);
     pfsph_sim *s = make_sim("-9.81", "pcisph");
     pfsph_error err = {0};
     assert_int_equal(pfsph_checkpoint_load(path, s, NULL, &err), PFSPH_OK);

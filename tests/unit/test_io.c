@@ -264,28 +264,6 @@ static void test_atomic_keeps_old_file(void **state)
     assert_int_equal(count_tmp_files(sub), 0);
 }
 
-static unsigned char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long l = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc((size_t)l + 1);
-    assert_int_equal(fread(b, 1, (size_t)l, f), (size_t)l);
-    fclose(f);
-    *n = (size_t)l;
-    return b;
-}
-
-static void dump(const char *path, const void *d, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(d, 1, n, f), n);
-    fclose(f);
-}
-
 /* Replace the first occurrence of `from` by `to` (same length or not) and write to out. */
 static void patched(const unsigned char *b, size_t n, const char *from, const char *to, const char *out)
 {
@@ -296,7 +274,7 @@ static void patched(const unsigned char *b, size_t n, const char *from, const ch
             memcpy(c, b, i);
             memcpy(c + i, to, tl);
             memcpy(c + i + tl, b + i + fl, n - i - fl);
-            dump(out, c, n - fl + tl);
+            tu_write_bytes(out, c, n - fl + tl);
             free(c);
             return;
         }
@@ -325,10 +303,10 @@ static void corrupt_common(writer_fn w, reader_fn r, const char *ext)
     pfsph_error err;
     assert_int_equal(w(path, &ps, &o, &err), PFSPH_OK);
     size_t n;
-    unsigned char *b = slurp(path, &n);
+    unsigned char *b = tu_slurp(path, &n);
     /* Every truncation must be refused (and must not read past the end: ASan checks). */
     for (size_t cut = 0; cut + 1 < n; cut += (cut < 2000 ? 1 : 97)) {
-        dump(bad, b, cut);
+        tu_write_bytes(bad, b, cut);
         expect_reject(r, bad);
     }
     /* Random byte flips in the header may be accepted or refused, but never crash. */
@@ -339,7 +317,7 @@ static void corrupt_common(writer_fn w, reader_fn r, const char *ext)
         memcpy(c, b, n);
         c[rnd32() % hdr] = (unsigned char)rnd32();
         c[rnd32() % hdr] = (unsigned char)("0123456789\"<>/= \n"[rnd32() % 17]);
-        dump(bad, c, n);
+        tu_write_bytes(bad, c, n);
         pfsph_particles q;
         if (r(bad, &q, NULL, &err) == PFSPH_OK) pfsph_particles_free(&q);
         free(c);
@@ -358,7 +336,7 @@ static void test_vtp_corrupt(void **state)
     snprintf(path, sizeof path, "%s/good.vtp", dir);
     snprintf(bad, sizeof bad, "%s/bad.vtp", dir);
     size_t n;
-    unsigned char *b = slurp(path, &n);
+    unsigned char *b = tu_slurp(path, &n);
     /* Header lies about the number of points, offsets or types. */
     patched(b, n, "NumberOfPoints=\"100\"", "NumberOfPoints=\"101\"", bad);
     expect_reject(pfsph_read_vtp, bad);
@@ -388,7 +366,7 @@ static void test_vtp_corrupt(void **state)
     unsigned char *u = memchr(c, '_', n);
     assert_non_null(u);
     memset(u + 1, 0xff, 8);
-    dump(bad, c, n);
+    tu_write_bytes(bad, c, n);
     expect_reject(pfsph_read_vtp, bad);
     free(c);
     free(b);
@@ -403,7 +381,7 @@ static void test_ply_corrupt(void **state)
     snprintf(path, sizeof path, "%s/good.ply", dir);
     snprintf(bad, sizeof bad, "%s/bad.ply", dir);
     size_t n;
-    unsigned char *b = slurp(path, &n);
+    unsigned char *b = tu_slurp(path, &n);
     patched(b, n, "element vertex 100", "element vertex 101", bad);
     expect_reject(pfsph_read_ply, bad);
     patched(b, n, "element vertex 100", "element vertex 18446744073709551615", bad);
@@ -495,9 +473,9 @@ static void test_surface_ply_roundtrip(void **state)
 
     /* malformed: short data, a quad, an index out of range, a bad list, particles */
     size_t n;
-    unsigned char *d = slurp(path, &n);
+    unsigned char *d = tu_slurp(path, &n);
     snprintf(bad, sizeof bad, "%s/bad.ply", dir);
-    dump(bad, d, n - 1);
+    tu_write_bytes(bad, d, n - 1);
     surface_reject(bad, "bytes of data");
     const unsigned char *hdr = (const unsigned char *)strstr((const char *)d, "end_header\n");
     size_t nv = b[0].nverts + b[1].nverts;
@@ -505,12 +483,12 @@ static void test_surface_ply_roundtrip(void **state)
     unsigned char *c = malloc(n);
     memcpy(c, d, n);
     c[f0] = 4;
-    dump(bad, c, n);
+    tu_write_bytes(bad, c, n);
     surface_reject(bad, "triangles only");
     memcpy(c, d, n);
     uint32_t big = (uint32_t)nv;
     memcpy(c + f0 + 5, &big, 4);
-    dump(bad, c, n);
+    tu_write_bytes(bad, c, n);
     surface_reject(bad, "out of range");
     free(c);
     patched(d, n, "list uchar uint", "list uint uint", bad);
