@@ -4,6 +4,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <png.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -157,6 +158,43 @@ void tu_assert_same_file(const char *dir_a, const char *dir_b, const char *name)
     assert_memory_equal(a, b, la);
     free(a);
     free(b);
+}
+
+tu_img tu_read_png(const char *path)
+{
+    tu_img m = {0, 0, NULL};
+    FILE *f = fopen(path, "rb");
+    if (!f) fail_msg("cannot open %s", path);
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
+    png_infop info = png_create_info_struct(png);
+    if (setjmp(png_jmpbuf(png))) fail_msg("libpng failed on %s", path);
+    png_init_io(png, f);
+    png_read_info(png, info);
+    assert_int_equal(png_get_color_type(png, info), PNG_COLOR_TYPE_RGB);
+    assert_int_equal(png_get_bit_depth(png, info), 8);
+    m.w = (int)png_get_image_width(png, info);
+    m.h = (int)png_get_image_height(png, info);
+    m.rgb = malloc((size_t)m.w * m.h * 3);
+    assert_non_null(m.rgb);
+    for (int y = 0; y < m.h; y++) png_read_row(png, m.rgb + (size_t)y * m.w * 3, NULL);
+    png_destroy_read_struct(&png, &info, NULL);
+    fclose(f);
+    return m;
+}
+
+size_t tu_nearest(const pfsph_particles *ps, double x, double y, double z)
+{
+    size_t best = 0;
+    double bd = 1e300;
+    for (size_t i = 0; i < ps->n; i++) {
+        double dx = ps->x[i] - x, dy = ps->y[i] - y, dz = ps->z[i] - z;
+        double r2 = dx * dx + dy * dy + dz * dz;
+        if (r2 < bd) {
+            bd = r2;
+            best = i;
+        }
+    }
+    return best;
 }
 
 static int uf_find(int *p, int i)

@@ -72,6 +72,18 @@ int tu_env_list(const char *env, double *v, int max, int n_default);
  * then do not depend on the order. fn must not use cmocka's assertions (they jump). */
 void tu_parallel_largest_first(int n, const double *size, void (*fn)(void *arg, int i), void *arg);
 
+/* An 8-bit RGB PNG, rows top to bottom (fails the test if the file is anything else); free rgb
+ * with free(). */
+typedef struct tu_img {
+    int w, h;
+    unsigned char *rgb;
+} tu_img;
+tu_img tu_read_png(const char *path);
+
+/* Index of the particle of ps nearest to (x, y, z). */
+struct pfsph_particles;
+size_t tu_nearest(const struct pfsph_particles *ps, double x, double y, double z);
+
 /* A gas bubble in a liquid (test_pf_rising_bubble, test_pf_density_ratio), measured over the
  * fluid particles of ctx: particles of phase `gas` are the bubble, R is its equivalent radius. */
 struct pfsph_ctx;

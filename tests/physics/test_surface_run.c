@@ -2,7 +2,6 @@
  * the same bytes afterwards with another thread count, the meshes are closed, the .pvd
  * collections list every frame, frame 0 carries densities, a 2D run gets closed VTP outlines
  * (the same bytes again from `pfsph mesh`), PLY for 2D and bad keys are refused with the JSON path, diffuse frames name their class "type" and carry no density or pressure. */
-#include <png.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -210,24 +209,10 @@ static void test_houdini_roundtrip(void **state)
 /* pixels of the water shading (blue, dark red channel): none in the viridis or grey palettes */
 static long water_pixels(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
-    png_infop info = png_create_info_struct(png);
-    if (setjmp(png_jmpbuf(png))) fail_msg("libpng failed on %s", path);
-    png_init_io(png, f);
-    png_read_info(png, info);
-    assert_int_equal(png_get_color_type(png, info), PNG_COLOR_TYPE_RGB);
-    int w = (int)png_get_image_width(png, info), h = (int)png_get_image_height(png, info);
-    unsigned char *row = malloc((size_t)w * 3);
+    tu_img m = tu_read_png(path);
     long n = 0;
-    for (int y = 0; y < h; y++) {
-        png_read_row(png, row, NULL);
-        for (int x = 0; x < w; x++) n += row[3 * x] < 80 && row[3 * x + 2] > 150;
-    }
-    free(row);
-    png_destroy_read_struct(&png, &info, NULL);
-    fclose(f);
+    for (size_t k = 0; k < (size_t)m.w * m.h; k++) n += m.rgb[3 * k] < 80 && m.rgb[3 * k + 2] > 150;
+    free(m.rgb);
     return n;
 }
 

@@ -134,22 +134,6 @@ static void world_free(world *w)
     free(w->scene);
 }
 
-/* Index of the particle nearest to (x, y, z). */
-static size_t find(const pfsph_particles *ps, double x, double y, double z)
-{
-    size_t best = 0;
-    double bd = 1e300;
-    for (size_t i = 0; i < ps->n; i++) {
-        double dx = ps->x[i] - x, dy = ps->y[i] - y, dz = ps->z[i] - z;
-        double r2 = dx * dx + dy * dy + dz * dz;
-        if (r2 < bd) {
-            bd = r2;
-            best = i;
-        }
-    }
-    return best;
-}
-
 static void test_shape(void **state)
 {
     (void)state;
@@ -190,7 +174,7 @@ static void test_two_particles(void **state)
             add(&w.fluid, r * e[0], r * e[1], r * e[2], 1);
             world_finish(&w);
             apply(&w);
-            size_t i = find(&w.fluid, 0, 0, 0), j = 1 - i;
+            size_t i = tu_nearest(&w.fluid, 0, 0, 0), j = 1 - i;
             double m0 = w.ctx.mass[0], m1 = w.ctx.mass[1];
             double a0[3] = {w.ctx.ax[i], w.ctx.ay[i], w.ctx.az[i]};
             double a1[3] = {w.ctx.ax[j], w.ctx.ay[j], w.ctx.az[j]};
@@ -316,7 +300,7 @@ static void test_lattice_isotropic(void **state)
                     else add(&w.fluid, i * d, j * d, k * d, 0);
                 }
         world_finish(&w);
-        size_t c = find(&w.fluid, 0, 0, 0);
+        size_t c = tu_nearest(&w.fluid, 0, 0, 0);
         double *T = calloc(9 * w.fluid.n, sizeof(double));
         pfsph_pairwise_diagnose(NULL, &w.ctx, NULL, T);
         for (int a = 0; a < 3; a++)
@@ -352,7 +336,7 @@ static void test_half_space(void **state)
         pfsph_kernel kk;
         pfsph_kernel_init(&kk, 2, (pfsph_real)R);
         for (int depth = 0; depth <= 1; depth++) {
-            size_t c = find(&w.fluid, 0, -depth * d, 0);
+            size_t c = tu_nearest(&w.fluid, 0, -depth * d, 0);
             /* independent covariance in double over the lattice (Eq. 7, self included) */
             double sw = kk.sigma, sx = 0, sy = 0, sxx = 0, syy = 0;
             for (int i = -10; i <= 10; i++)
@@ -387,7 +371,7 @@ static void test_half_space(void **state)
         }
         /* the surface is pulled into the liquid: net force on an edge particle points down */
         apply(&w);
-        size_t c = find(&w.fluid, 0, 0, 0);
+        size_t c = tu_nearest(&w.fluid, 0, 0, 0);
         assert_true(w.ctx.ay[c] < 0);
         assert_true(fabs(w.ctx.ax[c]) < 1e-4 * fabs(w.ctx.ay[c]));
         free(T);
@@ -582,7 +566,7 @@ static void test_film_eq24(void **state)
                     if (other == 2) add(&w.boundary, r * e[0] / en, r * e[1] / en, r * e[2] / en, 2);
                     else add(&w.fluid, r * e[0] / en, r * e[1] / en, r * e[2] / en, other == 1 ? 0 : 1);
                     world_finish(&w);
-                    const size_t i = find(&w.fluid, 0, 0, 0), j = 1 - i;
+                    const size_t i = tu_nearest(&w.fluid, 0, 0, 0), j = 1 - i;
                     const double a = fr[p], b = fr[q];
                     w.fluid.film[i] = (pfsph_real)a;
                     if (other == 0) w.fluid.film[j] = (pfsph_real)b;

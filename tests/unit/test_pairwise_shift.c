@@ -80,21 +80,6 @@ static void world_free(world *w)
     free(w->scene);
 }
 
-static size_t find(const pfsph_particles *ps, double x, double y, double z)
-{
-    size_t best = 0;
-    double bd = 1e300;
-    for (size_t i = 0; i < ps->n; i++) {
-        double dx = ps->x[i] - x, dy = ps->y[i] - y, dz = ps->z[i] - z;
-        double r2 = dx * dx + dy * dy + dz * dz;
-        if (r2 < bd) {
-            bd = r2;
-            best = i;
-        }
-    }
-    return best;
-}
-
 /* One shifting step; the shifts in s[3][n] (caller frees), returns the largest. */
 static double shift(world *w, const pfsph_shift_params *p, double dt, pfsph_real **s)
 {
@@ -131,7 +116,7 @@ static void test_lattice(void **state)
             pfsph_shift_defaults(&p);
             p.D = 1e-3;
             p.max_frac = 0.25;
-            size_t c = find(&w.fluid, pass ? 0.2 * d : 0, 0, 0);
+            size_t c = tu_nearest(&w.fluid, pass ? 0.2 * d : 0, 0, 0);
             double g[3];
             double C = pfsph_shift_concentration(&w.ctx, c, g);
             pfsph_real *s[3];
@@ -149,7 +134,7 @@ static void test_lattice(void **state)
                 /* the shift is -D dt grad C */
                 assert_true(fabs(s[0][c] + p.D * dt * g[0]) < 1e-5 * fabs(s[0][c]) + 1e-12);
                 /* far particles are untouched */
-                size_t far = find(&w.fluid, -5 * d, -5 * d, 0);
+                size_t far = tu_nearest(&w.fluid, -5 * d, -5 * d, 0);
                 assert_true(fabs(s[0][far]) + fabs(s[1][far]) < 1e-4 * fabs(s[0][c]));
             }
             free3(s);
@@ -170,7 +155,7 @@ static void test_free_surface(void **state)
     for (int i = -12; i <= 12; i++)
         for (int j = -10; j <= 0; j++) add(&w.fluid, i * d + (j == 0 && i == 0 ? 0.2 * d : 0), j * d, 0);
     world_finish(&w);
-    size_t c = find(&w.fluid, 0.2 * d, 0, 0);
+    size_t c = tu_nearest(&w.fluid, 0.2 * d, 0, 0);
     double g[3];
     double C = pfsph_shift_concentration(&w.ctx, c, g);
     print_message("surface particle: C = %.3f, grad C = (%.3g, %.3g) 1/m\n", C, g[0], g[1]);
@@ -186,7 +171,7 @@ static void test_free_surface(void **state)
     assert_true(s[0][c] < -1e-4 * d);
     assert_true(s[1][c] <= 0 && fabs(s[1][c]) < 0.2 * fabs(s[0][c])); /* never outwards */
     /* a surface particle on the lattice does not move at all */
-    size_t e = find(&w.fluid, 5 * d, 0, 0);
+    size_t e = tu_nearest(&w.fluid, 5 * d, 0, 0);
     print_message("lattice surface particle: shift (%.3g, %.3g) d\n", s[0][e] / d, s[1][e] / d);
     assert_true(fabs(s[0][e]) + fabs(s[1][e]) < 1e-4 * fabs(s[0][c]));
     free3(s);
@@ -198,7 +183,7 @@ static void test_free_surface(void **state)
     world_finish(&w);
     p.surface = 0;
     shift(&w, &p, 1e-3, s);
-    e = find(&w.fluid, 0, 0, 0);
+    e = tu_nearest(&w.fluid, 0, 0, 0);
     assert_true(s[1][e] > 1e-4 * d);
     free3(s);
     world_free(&w);
@@ -219,7 +204,7 @@ static void test_cap_wall_velocity(void **state)
         for (int j = -2; j <= 0; j++) add(&w.boundary, i * d, j * d, 0);
     for (size_t i = 0; i < w.fluid.n; i++) w.fluid.vx[i] = (pfsph_real)(0.1 * (double)i);
     world_finish(&w);
-    size_t c = find(&w.fluid, 0, 0.5 * d, 0);
+    size_t c = tu_nearest(&w.fluid, 0, 0.5 * d, 0);
     pfsph_shift_params p;
     pfsph_shift_defaults(&p);
     p.D = 1.0; /* huge: the cap decides */

@@ -1,7 +1,6 @@
 /* PNG previews: a hand-made run directory (scene.json + frames written with the frame writers)
  * is rendered; the images must have the requested size, show particles where they project and
  * leave the corners as background. */
-#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,31 +11,7 @@
 #include "pfsph/render.h"
 #include "testutil.h"
 
-typedef struct img {
-    int w, h;
-    unsigned char *rgb;
-} img;
-
-static img load_png(const char *path)
-{
-    img m = {0};
-    FILE *f = fopen(path, "rb");
-    if (!f) fail_msg("cannot open %s", path);
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
-    png_infop info = png_create_info_struct(png);
-    if (setjmp(png_jmpbuf(png))) fail_msg("libpng failed on %s", path);
-    png_init_io(png, f);
-    png_read_info(png, info);
-    assert_int_equal(png_get_color_type(png, info), PNG_COLOR_TYPE_RGB);
-    assert_int_equal(png_get_bit_depth(png, info), 8);
-    m.w = (int)png_get_image_width(png, info);
-    m.h = (int)png_get_image_height(png, info);
-    m.rgb = malloc((size_t)m.w * m.h * 3);
-    for (int y = 0; y < m.h; y++) png_read_row(png, m.rgb + (size_t)y * m.w * 3, NULL);
-    png_destroy_read_struct(&png, &info, NULL);
-    fclose(f);
-    return m;
-}
+typedef tu_img img;
 
 static const unsigned char *px(const img *m, int x, int y)
 {
@@ -150,7 +125,7 @@ static void test_render_2d(void **state)
     assert_int_equal(count, 2);
     for (int f = 0; f < 2; f++) {
         snprintf(p, sizeof p, "%s/png/frame_%05d.png", run, f);
-        img m = load_png(p);
+        img m = tu_read_png(p);
         assert_int_equal(m.w, 320);
         assert_int_equal(m.h, 180);
         int ix, iy;
@@ -214,7 +189,7 @@ static void run_3d(const char *name, const char *camera, int use_ply)
     if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
     assert_int_equal(count, 1);
     snprintf(p, sizeof p, "%s/png/frame_00000.png", run);
-    img m = load_png(p);
+    img m = tu_read_png(p);
     assert_int_equal(m.w, 200);
     assert_int_equal(m.h, 150);
     /* Both cameras look at the centre of the cube of particles. */
@@ -266,7 +241,7 @@ static void test_render_wall_color(void **state)
     int count = -1;
     if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
     snprintf(p, sizeof p, "%s/png/frame_00000.png", run);
-    img m = load_png(p);
+    img m = tu_read_png(p);
     int ix, iy;
     to_px(m.w, m.h, 0.8, 0.02, &ix, &iy);
     const unsigned char *c = px(&m, ix, iy);

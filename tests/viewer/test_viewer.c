@@ -4,7 +4,6 @@
  * body and liquid meshes drawn as meshes, and the mesh toggle); bad input. Skipped in builds without the
  * viewer or without a display. */
 #include <math.h>
-#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -59,31 +58,7 @@ static const char *SCENE3D_MESH =
     " \"output\": {\"formats\": [\"vtp\", \"ply\"], \"boundary\": true, \"surface\": true},"
     " \"camera\": {\"width\": 320, \"height\": 240}}";
 
-typedef struct img {
-    int w, h;
-    unsigned char *rgb;
-} img;
-
-static img read_png(const char *path)
-{
-    img m = {0, 0, NULL};
-    FILE *f = fopen(path, "rb");
-    if (!f) fail_msg("cannot open %s", path);
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL);
-    png_infop info = png_create_info_struct(png);
-    if (setjmp(png_jmpbuf(png))) fail_msg("libpng failed on %s", path);
-    png_init_io(png, f);
-    png_read_info(png, info);
-    assert_int_equal(png_get_color_type(png, info), PNG_COLOR_TYPE_RGB);
-    assert_int_equal(png_get_bit_depth(png, info), 8);
-    m.w = (int)png_get_image_width(png, info);
-    m.h = (int)png_get_image_height(png, info);
-    m.rgb = malloc((size_t)m.w * m.h * 3);
-    for (int y = 0; y < m.h; y++) png_read_row(png, m.rgb + (size_t)y * m.w * 3, NULL);
-    png_destroy_read_struct(&png, &info, NULL);
-    fclose(f);
-    return m;
-}
+typedef tu_img img;
 
 /* Both front ends draw the same background: light grey, darker towards the bottom. A pixel
  * more than 14/255 away from it in some channel shows a particle. */
@@ -157,7 +132,7 @@ static void test_live_2d(void **state)
     int st = tu_run(cmd, out, sizeof out);
     print_message("%s", out);
     assert_int_equal(st, 0);
-    img m = read_png(shot);
+    img m = tu_read_png(shot);
     assert_int_equal(m.w, 320);
     assert_int_equal(m.h, 240);
 
@@ -286,7 +261,7 @@ static void compare_replay(const char *scene_text, const char *name, int frame, 
     snprintf(shot, sizeof shot, "%s/replay.png", run);
     view_shot(run, frame, vargs, shot);
     snprintf(ref, sizeof ref, "%s/png/frame_%05d.png", run, frame);
-    img a = read_png(ref), b = read_png(shot);
+    img a = tu_read_png(ref), b = tu_read_png(shot);
     assert_int_equal(a.w, b.w);
     assert_int_equal(a.h, b.h);
     unsigned char *ca = block_mask(&a), *cb = block_mask(&b);
@@ -338,7 +313,7 @@ static void test_replay_meshes(void **state)
     snprintf(s2, sizeof s2, "%s/particles.png", run);
     view_shot(run, 2, "", s1);
     view_shot(run, 2, "--particles", s2);
-    img a = read_png(s1), b = read_png(s2);
+    img a = tu_read_png(s1), b = tu_read_png(s2);
     unsigned char *ma = mask_of(&a), *mb = mask_of(&b);
     size_t scene_px = 0, changed = 0;
     for (size_t o = 0; o < (size_t)a.w * a.h; o++) {
