@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "pfsph/eigen.h"
+#include "pfsph/run.h"
 #include "pfsph/sim.h"
 
 static const char *g_src = ".";
@@ -127,6 +128,19 @@ int tu_run(const char *cmd, char *out, size_t cap)
     while (fread(sink, 1, sizeof sink, p) > 0) {}
     int st = pclose(p);
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+int tu_pfsph(const char *env, char *out, size_t cap, const char *fmt, ...)
+{
+    char args[2048], cmd[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    snprintf(cmd, sizeof cmd, "%s%s'%s' %s", env, env[0] ? " " : "", tu_pfsph_bin(), args);
+    int st = tu_run(cmd, out, cap);
+    printf("$ pfsph %s\n-> %d %s", args, st, out);
+    return st;
 }
 
 unsigned char *tu_slurp(const char *path, size_t *len)
@@ -286,6 +300,15 @@ pfsph_sim *tu_sim_from_json(const char *json, const char *name)
     assert_int_equal(rc, PFSPH_OK);
     free(s); /* the simulation keeps its own copy */
     return sim;
+}
+
+void tu_pfsph_run(const pfsph_scene *s, const char *dir, double end, int resume)
+{
+    pfsph_run_opts o = {.out_dir = dir, .end_time = end, .resume = resume};
+    pfsph_error err = {0};
+    int rc = pfsph_run(s, &o, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
 }
 
 void tu_advance(pfsph_sim *sim, double t)

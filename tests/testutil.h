@@ -46,6 +46,14 @@ void tu_write_bytes(const char *path, const void *data, size_t len);
 /* Run a shell command, capturing stdout+stderr into out (truncated to cap). Returns the exit
  * status (or -1). */
 int tu_run(const char *cmd, char *out, size_t cap);
+/* The pfsph program with the printf-style arguments fmt, after the environment assignments env
+ * ("" for none; "OMP_NUM_THREADS=1"); prints the command line, status and output. Returns the
+ * exit status, the output (stdout+stderr) in out[cap]. */
+int tu_pfsph(const char *env, char *out, size_t cap, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
 /* A whole file, NUL-terminated (len excludes the NUL); fails the test if it cannot be read.
  * Free with free(). */
 unsigned char *tu_slurp(const char *path, size_t *len);
@@ -101,6 +109,10 @@ void tu_bubble_measure(const struct pfsph_ctx *c, int gas, double rho_gas, doubl
  * message, when the scene does not parse or the simulation cannot start. */
 struct pfsph_sim;
 struct pfsph_sim *tu_sim_from_json(const char *json, const char *name);
+/* pfsph_run of scene s into dir to time end (a resume when resume is set); fails the test,
+ * printing the message, on an error. */
+struct pfsph_scene;
+void tu_pfsph_run(const struct pfsph_scene *s, const char *dir, double end, int resume);
 /* pfsph_sim_advance to time t; fails the test, printing the message, on an error. */
 void tu_advance(struct pfsph_sim *sim, double t);
 

@@ -263,15 +263,6 @@ static const char *RESUME_2D =
     "               \"lifetime_min\": 0.5, \"lifetime_max\": 2},"
     " \"output\": {\"formats\": [\"vtp\"], \"fields\": [\"id\", \"speed\"], \"checkpoint_interval\": 5}}";
 
-static void run_dir(const pfsph_scene *s, const char *dir, double end, bool resume)
-{
-    pfsph_run_opts o = {.out_dir = dir, .end_time = end, .resume = resume};
-    pfsph_error err = {0};
-    int rc = pfsph_run(s, &o, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-}
-
 static void test_resume(void **st)
 {
     (void)st;
@@ -281,9 +272,9 @@ static void test_resume(void **st)
     char full[1024], part[1024];
     snprintf(full, sizeof full, "%s/full", tu_tmpdir());
     snprintf(part, sizeof part, "%s/part", tu_tmpdir());
-    run_dir(&s, full, -1, false);
-    run_dir(&s, part, 0.2, false);
-    run_dir(&s, part, 0.4, true);
+    tu_pfsph_run(&s, full, -1, false);
+    tu_pfsph_run(&s, part, 0.2, false);
+    tu_pfsph_run(&s, part, 0.4, true);
     tu_assert_same_file(full, part, "frames/fluid_00006.vtp");
     tu_assert_same_file(full, part, "frames/fluid_00008.vtp");
     tu_assert_same_file(full, part, "frames/fluid_00010.vtp");

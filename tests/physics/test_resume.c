@@ -43,15 +43,6 @@ static void parse(pfsph_scene *s, int ckpt_interval)
     assert_int_equal(rc, PFSPH_OK);
 }
 
-static void run(const pfsph_scene *s, const char *dir, double end, bool resume)
-{
-    pfsph_run_opts o = {.out_dir = dir, .end_time = end, .resume = resume};
-    pfsph_error err = {0};
-    int rc = pfsph_run(s, &o, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-}
-
 static void compare_runs(const char *a, const char *b)
 {
     tu_assert_same_file(a, b, "frames/fluid_00010.vtp");
@@ -72,11 +63,11 @@ static void test_resume_library(void **st)
     static pfsph_scene s;
     parse(&s, 5);
     snprintf(full_dir, sizeof full_dir, "%s/full", tu_tmpdir());
-    run(&s, full_dir, -1, false);
+    tu_pfsph_run(&s, full_dir, -1, false);
     char part[1024];
     snprintf(part, sizeof part, "%s/part", tu_tmpdir());
-    run(&s, part, 0.2, false); /* frames 0..5, checkpoint at 5 */
-    run(&s, part, 0.4, true);  /* 6..10 (without an end time it would keep its own, 0.2) */
+    tu_pfsph_run(&s, part, 0.2, false); /* frames 0..5, checkpoint at 5 */
+    tu_pfsph_run(&s, part, 0.4, true);  /* 6..10 (without an end time it would keep its own, 0.2) */
     compare_runs(full_dir, part);
     /* the diffuse set is not empty at frame 10 (so its restore was exercised) */
     size_t len;
@@ -112,9 +103,9 @@ static void test_resume_film(void **st)
     char a[1024], b[1024];
     snprintf(a, sizeof a, "%s/film_full", tu_tmpdir());
     snprintf(b, sizeof b, "%s/film_part", tu_tmpdir());
-    run(&s, a, -1, false);
-    run(&s, b, 0.2, false);
-    run(&s, b, 0.4, true);
+    tu_pfsph_run(&s, a, -1, false);
+    tu_pfsph_run(&s, b, 0.2, false);
+    tu_pfsph_run(&s, b, 0.4, true);
     tu_assert_same_file(a, b, "frames/fluid_00007.vtp");
     tu_assert_same_file(a, b, "frames/fluid_00010.vtp");
     tu_assert_same_file(a, b, "stats.csv");

@@ -38,20 +38,6 @@ static int setup(void **state)
     return tu_write_file(g_scene, SCENE);
 }
 
-/* pfsph ARGS, one thread; returns the exit status, output in out. */
-static int pf(char *out, size_t cap, const char *fmt, ...)
-{
-    char args[2048], cmd[4096];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args, sizeof args, fmt, ap);
-    va_end(ap);
-    snprintf(cmd, sizeof cmd, "OMP_NUM_THREADS=1 '%s' %s", tu_pfsph_bin(), args);
-    int st = tu_run(cmd, out, cap);
-    printf("$ pfsph %s\n-> %d %s", args, st, out);
-    return st;
-}
-
 static int exists(const char *dir, const char *name)
 {
     char p[1400];
@@ -126,11 +112,12 @@ static void test_lock(void **state)
     }
     char want[64];
     snprintf(want, sizeof want, "(pid %ld,", pid);
-    int st = pf(out, sizeof out, "run '%s' -o '%s' --quiet --force --end 0.08", g_scene, dir);
+    int st =
+        tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --force --end 0.08", g_scene, dir);
     assert_int_equal(st, 2);
     assert_non_null(strstr(out, "in use by another pfsph run"));
     assert_non_null(strstr(out, want));
-    st = pf(out, sizeof out, "run --resume '%s' --quiet", dir);
+    st = tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet", dir);
     assert_int_equal(st, 2);
     assert_non_null(strstr(out, "in use by another pfsph run"));
     snprintf(cmd, sizeof cmd, "while kill -0 %ld 2>/dev/null; do sleep 0.05; done; tail -c 300 '%s.log'", pid, dir);
@@ -141,7 +128,7 @@ static void test_lock(void **state)
     assert_int_equal(rows, 151);
     assert_int_equal(last_frame(dir), 150);
     /* released: the directory can be resumed now (nothing left to do) */
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet", dir), 0);
 }
 
 /* Item 9: a fresh run into an old run directory. */
@@ -150,20 +137,23 @@ static void test_fresh_into_old(void **state)
     (void)state;
     char dir[700], out[8192];
     snprintf(dir, sizeof dir, "%s/old", tu_tmpdir());
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.2", g_scene, dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --end 0.2", g_scene, dir),
+                     0);
     assert_int_equal(last_frame(dir), 5);
     /* what a kill leaves, and a file of the user's */
     touch(dir, "frames/fluid_00009.vtp.tmp.12345");
     touch(dir, "summary.json.tmp.77");
     touch(dir, "notes.txt");
     /* refused, nothing changed */
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.08", g_scene, dir), 2);
+    assert_int_equal(
+        tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --end 0.08", g_scene, dir), 2);
     assert_non_null(strstr(out, "not empty"));
     assert_non_null(strstr(out, "--force"));
     assert_int_equal(last_frame(dir), 5);
     assert_true(exists(dir, "frames/fluid_00009.vtp.tmp.12345"));
     /* --force: pfsph's files go, the user's stay; the new run alone is on disk */
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.08 --force", g_scene, dir), 0);
+    assert_int_equal(
+        tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --end 0.08 --force", g_scene, dir), 0);
     assert_int_equal(last_frame(dir), 2);
     int rows;
     assert_int_equal(last_row(dir, &rows), 2);
@@ -178,7 +168,7 @@ static void test_fresh_into_old(void **state)
     touch(dir, "frames/fluid_00001.vtp.tmp.999");
     touch(dir, "checkpoints/ckpt_00004.bin.tmp.999");
     touch(dir, "stats.csv.tmp.999");
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.16", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.16", dir), 0);
     assert_false(exists(dir, "frames/fluid_00001.vtp.tmp.999"));
     assert_false(exists(dir, "checkpoints/ckpt_00004.bin.tmp.999"));
     assert_false(exists(dir, "stats.csv.tmp.999"));
@@ -186,7 +176,8 @@ static void test_fresh_into_old(void **state)
     /* an empty existing directory is fine without --force */
     snprintf(dir, sizeof dir, "%s/empty", tu_tmpdir());
     assert_int_equal(mkdir(dir, 0755), 0);
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.04", g_scene, dir), 0);
+    assert_int_equal(
+        tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --end 0.04", g_scene, dir), 0);
 }
 
 /* Item 10: resume and the end time. */
@@ -197,35 +188,36 @@ static void test_resume_end(void **state)
     int rows;
     snprintf(dir, sizeof dir, "%s/ends", tu_tmpdir());
     /* given --end 0.2 (frame 5; checkpoints at 4 and 5, the last frame); the scene's end is 0.4 */
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.2", g_scene, dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --end 0.2", g_scene, dir),
+                     0);
     /* a resume without --end runs to the run's own end, not the scene's */
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet", dir), 0);
     assert_int_equal(last_row(dir, &rows), 5);
     assert_int_equal(rows, 6);
     assert_int_equal(last_frame(dir), 5);
     /* extend to 0.32 (frame 8; checkpoints 6 and 8), then lose checkpoint 8, as if killed
      * just before it: a resume to a shorter end (0.28, frame 7) starts at 6 and must not
      * leave frame 8 without its row (and checkpoints frame 7, its last) */
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.32", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.32", dir), 0);
     assert_int_equal(last_frame(dir), 8);
     snprintf(p, sizeof p, "%s/checkpoints/ckpt_00008.bin", dir);
     assert_int_equal(unlink(p), 0);
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.28", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.28", dir), 0);
     assert_int_equal(last_row(dir, &rows), 7);
     assert_int_equal(rows, 8);
     assert_int_equal(last_frame(dir), 7);
     /* and that shorter end is now the run's own */
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet", dir), 0);
     assert_int_equal(last_row(dir, &rows), 7);
     /* an end before the newest checkpoint: refused, nothing changed */
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.1", dir), 2);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.1", dir), 2);
     assert_non_null(strstr(out, "before the newest checkpoint"));
     assert_int_equal(last_frame(dir), 7);
     assert_int_equal(last_row(dir, &rows), 7);
     /* a deleted stats.csv is reported */
     snprintf(p, sizeof p, "%s/stats.csv", dir);
     assert_int_equal(unlink(p), 0);
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.32", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.32", dir), 0);
     assert_non_null(strstr(out, "warning"));
     assert_non_null(strstr(out, "stats.csv: the rows of frames 0..7 are missing"));
 }
@@ -241,7 +233,8 @@ static void test_frame_int_max(void **state)
     (void)state;
     char dir[700], out[8192], p[1400];
     snprintf(dir, sizeof dir, "%s/intmax", tu_tmpdir());
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.16", g_scene, dir), 0);
+    assert_int_equal(
+        tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --end 0.16", g_scene, dir), 0);
     for (int k = 2; k <= 4; k += 2) {
         snprintf(p, sizeof p, "%s/checkpoints/ckpt_%05d.bin", dir, k);
         FILE *f = fopen(p, "r+b");
@@ -259,7 +252,7 @@ static void test_frame_int_max(void **state)
         fclose(f);
         free(b);
     }
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.4", dir), 2);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.4", dir), 2);
     assert_non_null(strstr(out, "frame 2147483647 is outside"));
     assert_non_null(strstr(out, "no valid checkpoint"));
     assert_int_equal(last_frame(dir), 4);
@@ -273,12 +266,13 @@ static void test_checkpoint_at_last_frame(void **state)
     char dir[700], out[8192];
     snprintf(dir, sizeof dir, "%s/lastckpt", tu_tmpdir());
     /* checkpoint_interval 2, end at frame 3 */
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --quiet --end 0.12", g_scene, dir), 0);
+    assert_int_equal(
+        tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run '%s' -o '%s' --quiet --end 0.12", g_scene, dir), 0);
     assert_true(exists(dir, "checkpoints/ckpt_00002.bin"));
     assert_true(exists(dir, "checkpoints/ckpt_00003.bin"));
     /* the stash of the last good frame (kept on disk for a blow-up) goes when the run ends well */
     assert_false(exists(dir, ".last_good.bin"));
-    assert_int_equal(pf(out, sizeof out, "run --resume '%s' --quiet --end 0.16", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.16", dir), 0);
     assert_false(exists(dir, ".last_good.bin"));
     char p[1400], sum[4096];
     snprintf(p, sizeof p, "%s/summary.json", dir);
@@ -346,7 +340,7 @@ static void test_progress(void **state)
     assert_true(l.min_gap >= 0.24);
     /* render without a terminal: one summary line, no carriage returns */
     char out[8192];
-    assert_int_equal(pf(out, sizeof out, "render '%s' --size 64x48", dir), 0);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "render '%s' --size 64x48", dir), 0);
     assert_null(strchr(out, '\r'));
     assert_null(strchr(strchr(out, '\n') + 1, '\n'));
     assert_non_null(strstr(out, "rendered 2 frames"));

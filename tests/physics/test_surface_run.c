@@ -21,33 +21,6 @@ static const char *SCENE3 =
     "             \"phase\": \"wall\"}],\n"
     " \"output\": {\"formats\": [\"vtp\"], \"surface\": {\"formats\": [\"ply\", \"obj\", \"vtp\"]}}}\n";
 
-static int pf(char *out, size_t cap, const char *fmt, ...)
-{
-    char args[2048], cmd[4096];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args, sizeof args, fmt, ap);
-    va_end(ap);
-    snprintf(cmd, sizeof cmd, "'%s' %s", tu_pfsph_bin(), args);
-    int st = tu_run(cmd, out, cap);
-    printf("$ pfsph %s\n-> %d %s", args, st, out);
-    return st;
-}
-
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc((size_t)n + 1);
-    *len = fread(b, 1, (size_t)n, f);
-    b[*len] = 0;
-    fclose(f);
-    return b;
-}
-
 static size_t count(const char *hay, const char *needle)
 {
     size_t c = 0;
@@ -65,7 +38,7 @@ static int u64cmp(const void *a, const void *b)
 static void check_ply_closed(const char *path, size_t *faces)
 {
     size_t len;
-    unsigned char *b = slurp(path, &len);
+    unsigned char *b = tu_slurp(path, &len);
     assert_non_null(b);
     size_t nv = 0, nf = 0;
     const char *h = (const char *)b;
@@ -102,17 +75,17 @@ static void test_run_and_mesh(void **state)
     snprintf(scene, sizeof scene, "%s/s3.json", tu_tmpdir());
     snprintf(run, sizeof run, "%s/run3", tu_tmpdir());
     assert_int_equal(tu_write_file(scene, SCENE3), 0);
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --threads 2 --quiet", scene, run), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s' -o '%s' --threads 2 --quiet", scene, run), 0);
     /* the collections list every frame, in order */
     size_t len;
     snprintf(path, sizeof path, "%s/liquid.pvd", run);
-    char *pvd = (char *)slurp(path, &len);
+    char *pvd = (char *)tu_slurp(path, &len);
     assert_non_null(pvd);
     assert_int_equal(count(pvd, "<DataSet "), 3);
     assert_non_null(strstr(pvd, "timestep=\"0.05\" group=\"\" part=\"0\" file=\"frames/liquid_00001.vtp\""));
     free(pvd);
     snprintf(path, sizeof path, "%s/fluid.pvd", run);
-    pvd = (char *)slurp(path, &len);
+    pvd = (char *)tu_slurp(path, &len);
     assert_int_equal(count(pvd, "<DataSet "), 3);
     free(pvd);
     /* frame 0: densities of the summation, not zeros */
@@ -134,27 +107,27 @@ static void test_run_and_mesh(void **state)
     size_t blen[3];
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/frames/liquid_00001.%s", run, ext[k]);
-        before[k] = slurp(path, &blen[k]);
+        before[k] = tu_slurp(path, &blen[k]);
         assert_non_null(before[k]);
         remove(path);
     }
-    assert_int_equal(pf(out, sizeof out, "mesh '%s' --threads 1 --formats ply,obj,vtp", run), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "mesh '%s' --threads 1 --formats ply,obj,vtp", run), 0);
     assert_non_null(strstr(out, "meshed 3 frames"));
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/frames/liquid_00001.%s", run, ext[k]);
         size_t l;
-        unsigned char *after = slurp(path, &l);
+        unsigned char *after = tu_slurp(path, &l);
         assert_non_null(after);
         assert_int_equal(l, blen[k]);
         assert_memory_equal(after, before[k], l);
         free(after);
         free(before[k]);
     }
-    assert_int_equal(pf(out, sizeof out, "mesh '%s' --formats ply,stl", run), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "mesh '%s' --formats ply,stl", run), 2);
     assert_non_null(strstr(out, "stl"));
-    assert_int_equal(pf(out, sizeof out, "mesh '%s/none'", run), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "mesh '%s/none'", run), 2);
     /* Houdini: every frame, read back equal to the VTP frame */
-    assert_int_equal(pf(out, sizeof out, "export '%s' --houdini", run), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "export '%s' --houdini", run), 0);
     assert_non_null(strstr(out, "exported 3 frames"));
     pfsph_particles a, b;
     snprintf(path, sizeof path, "%s/frames/fluid_00002.vtp", run);
@@ -193,7 +166,7 @@ static void test_houdini_roundtrip(void **state)
     assert_memory_equal(ps.id, back.id, 5 * sizeof(uint32_t));
     pfsph_particles_free(&back);
     size_t len;
-    char *t = (char *)slurp(path, &len);
+    char *t = (char *)tu_slurp(path, &len);
     assert_non_null(strstr(t, "PGEOMETRY V5\nNPoints 5 NPrims 0\n"));
     assert_non_null(strstr(t, "PointAttrib\nv 3 vector 0 0 0\ndensity 1 float 0\n"));
     char *open = strstr(t, " 1 (");
@@ -223,9 +196,9 @@ static void test_render_meshes(void **state)
     char out[8192], path[1400], run[1200];
     snprintf(run, sizeof run, "%s/run3", tu_tmpdir());
     snprintf(path, sizeof path, "%s/png/frame_00002.png", run);
-    assert_int_equal(pf(out, sizeof out, "render '%s' --size 240x135 --color-by speed", run), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "render '%s' --size 240x135 --color-by speed", run), 0);
     long mesh = water_pixels(path);
-    assert_int_equal(pf(out, sizeof out, "render '%s' --size 240x135 --color-by speed --particles", run), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "render '%s' --size 240x135 --color-by speed --particles", run), 0);
     long parts = water_pixels(path);
     printf("water-coloured pixels: %ld with meshes, %ld with particles\n", mesh, parts);
     assert_true(mesh > 200);
@@ -251,12 +224,12 @@ static void test_contour_run(void **state)
     snprintf(scene, sizeof scene, "%s/s2run.json", tu_tmpdir());
     snprintf(run, sizeof run, "%s/run2", tu_tmpdir());
     assert_int_equal(tu_write_file(scene, SCENE2), 0);
-    assert_int_equal(pf(out, sizeof out, "run '%s' -o '%s' --threads 2 --quiet", scene, run), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s' -o '%s' --threads 2 --quiet", scene, run), 0);
     size_t len, len2;
     unsigned char *first[3];
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/frames/liquid_%05d.vtp", run, k);
-        first[k] = slurp(path, &len);
+        first[k] = tu_slurp(path, &len);
         assert_non_null(first[k]);
         const char *t = (const char *)first[k];
         size_t np = 0, nl = 0;
@@ -285,21 +258,21 @@ static void test_contour_run(void **state)
         free(seen_to);
     }
     snprintf(path, sizeof path, "%s/liquid.pvd", run);
-    char *pvd = (char *)slurp(path, &len);
+    char *pvd = (char *)tu_slurp(path, &len);
     assert_non_null(pvd);
     assert_int_equal(count(pvd, "<DataSet "), 3);
     free(pvd);
-    assert_int_equal(pf(out, sizeof out, "mesh '%s' --threads 1", run), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "mesh '%s' --threads 1", run), 0);
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/frames/liquid_%05d.vtp", run, k);
-        unsigned char *again = slurp(path, &len2);
+        unsigned char *again = tu_slurp(path, &len2);
         assert_non_null(again);
         assert_int_equal(strlen((const char *)first[k]), len2);
         assert_memory_equal(first[k], again, len2);
         free(again);
         free(first[k]);
     }
-    assert_int_equal(pf(out, sizeof out, "mesh '%s' --formats ply", run), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "mesh '%s' --formats ply", run), 2);
     assert_non_null(strstr(out, "VTP"));
 }
 
@@ -316,7 +289,7 @@ static void test_refusals(void **state)
                       "\"max\": [0.1, 0.1]}],\n"
                       " \"output\": {\"surface\": {\"formats\": [\"ply\"]}}}\n"),
         0);
-    assert_int_equal(pf(out, sizeof out, "check '%s'", path), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "check '%s'", path), 2);
     assert_non_null(strstr(out, "$.output.surface.formats"));
     assert_non_null(strstr(out, "VTP"));
     snprintf(path, sizeof path, "%s/s3bad.json", tu_tmpdir());
@@ -325,7 +298,7 @@ static void test_refusals(void **state)
     char *f = strstr(text, "\"obj\"");
     memcpy(f, "\"stl\"", 5);
     assert_int_equal(tu_write_file(path, text), 0);
-    assert_int_equal(pf(out, sizeof out, "check '%s'", path), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "check '%s'", path), 2);
     assert_non_null(strstr(out, "$.output.surface.formats[1]"));
 }
 
@@ -346,7 +319,7 @@ static void test_diffuse_type(void **state)
         snprintf(path, sizeof path, "%s/d.%s", tu_tmpdir(), fmt ? "ply" : "vtp");
         assert_int_equal((fmt ? pfsph_write_ply : pfsph_write_vtp)(path, &ps, &o, &err), 0);
         size_t len;
-        char *t = (char *)slurp(path, &len);
+        char *t = (char *)tu_slurp(path, &len);
         assert_non_null(strstr(t, fmt ? "uchar type" : "Name=\"type\""));
         assert_null(strstr(t, "density"));
         assert_null(strstr(t, "pressure"));

@@ -227,15 +227,6 @@ static void test_threads(void **st)
     free(x[1]);
 }
 
-static void run(const pfsph_scene *s, const char *dir, double end, bool resume)
-{
-    pfsph_run_opts o = {.out_dir = dir, .end_time = end, .resume = resume};
-    pfsph_error err = {0};
-    int rc = pfsph_run(s, &o, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-}
-
 static void test_resume(void **st)
 {
     (void)st;
@@ -247,9 +238,9 @@ static void test_resume(void **st)
     char full[1024], part[1024];
     snprintf(full, sizeof full, "%s/full", tu_tmpdir());
     snprintf(part, sizeof part, "%s/part", tu_tmpdir());
-    run(&s, full, -1, false);
-    run(&s, part, 0.06, false); /* frames 0..3, checkpoint at 2 */
-    run(&s, part, 0.1, true);
+    tu_pfsph_run(&s, full, -1, false);
+    tu_pfsph_run(&s, part, 0.06, false); /* frames 0..3, checkpoint at 2 */
+    tu_pfsph_run(&s, part, 0.1, true);
     tu_assert_same_file(full, part, "frames/fluid_00005.vtp");
     tu_assert_same_file(full, part, "frames/fluid_00004.vtp");
     tu_assert_same_file(full, part, "bodies.csv");

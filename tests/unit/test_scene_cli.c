@@ -192,22 +192,13 @@ static void test_check_good(void **state)
     "\"shape\":\"box\",\"half_extents\":[0.05,0.05,0.05],\"position\":[0.8,0.8,0.8],\"phase\":\"s\"},"   \
     "{\"name\":\"m\",\"shape\":\"mesh\",\"file\":\"%s\",\"phase\":\"s\",\"position\":[0.5,0.5,0.5]}]"
 
-static int cli(const char *args, char *out, size_t cap)
-{
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "'%s' %s", tu_pfsph_bin(), args);
-    int st = tu_run(cmd, out, cap);
-    printf("$ pfsph %s\n-> %d: %s", args, st, out);
-    return st;
-}
-
 static void expect(const char *name, const char *json, const char *cmd, int status, const char *want)
 {
     char path[600], args[2048], out[8192];
     snprintf(path, sizeof path, "%s/%s", tu_tmpdir(), name);
     assert_int_equal(tu_write_file(path, json), 0);
     snprintf(args, sizeof args, cmd, path);
-    int st = cli(args, out, sizeof out);
+    int st = tu_pfsph("", out, sizeof out, "%s", args);
     if (st != status) fail_msg("%s: exit status %d, expected %d: %s", name, st, status, out);
     if (!strstr(out, want)) fail_msg("%s: output lacks \"%s\": %s", name, want, out);
     if (status && strstr(out, ": valid ")) fail_msg("%s: \"valid\" printed before the failure: %s", name, out);
@@ -224,7 +215,7 @@ static void test_messages(void **state)
     expect("mesh_dir.json", json, "check '%s'", 2, "is a directory, not an OBJ file");
     /* a directory as the scene */
     snprintf(args, sizeof args, "check '%s'", tu_tmpdir());
-    assert_int_equal(cli(args, out, sizeof out), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 2);
     assert_non_null(strstr(out, "is a directory, not a scene file"));
     /* nested past cJSON's limit */
     static char deep[3000];
@@ -234,7 +225,7 @@ static void test_messages(void **state)
     /* bytes that would drive the terminal come back escaped */
     expect("bytes.json", "{\"\x1b[31mred\xff\xfe\": 1}", "check '%s'", 2, "\\x1b[31mred\\xff\\xfe");
     snprintf(args, sizeof args, "check '%s/bytes.json'", tu_tmpdir());
-    cli(args, out, sizeof out);
+    tu_pfsph("", out, sizeof out, "%s", args);
     for (const char *c = out; *c; c++)
         if ((unsigned char)*c == 0x1b || (unsigned char)*c >= 0x80)
             fail_msg("raw byte 0x%02x in: %s", (unsigned char)*c, out);
@@ -249,12 +240,12 @@ static void test_messages(void **state)
     snprintf(args, sizeof args, "%s/plain.json", tu_tmpdir());
     assert_int_equal(tu_write_file(args, json), 0);
     snprintf(args, sizeof args, "run '%s/plain.json' -o '%s' --quiet", tu_tmpdir(), file);
-    assert_int_equal(cli(args, out, sizeof out), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 2);
     assert_non_null(strstr(out, "output directory"));
     assert_non_null(strstr(out, "exists and is not a directory"));
     /* the verdict last */
     snprintf(args, sizeof args, "check '%s/scenes/dam_break_2d.json'", tu_source_dir());
-    assert_int_equal(cli(args, out, sizeof out), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
     size_t n = strlen(out);
     while (n && out[n - 1] == '\n') out[--n] = 0;
     const char *last = strrchr(out, '\n');
@@ -280,7 +271,7 @@ static void test_no_boundary(void **state)
         assert_int_equal(tu_write_file(path, text), 0);
         snprintf(dir, sizeof dir, "%s/boundary_run_%d", tu_tmpdir(), on);
         snprintf(args, sizeof args, "run '%s' -o '%s' --quiet", path, dir);
-        assert_int_equal(cli(args, out, sizeof out), 0);
+        assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
         snprintf(b, sizeof b, "%s/frames/boundary_00000.vtp", dir);
         assert_int_equal(stat(b, &sb) == 0, on);
         snprintf(b, sizeof b, "%s/frames/fluid_00001.vtp", dir);
@@ -310,9 +301,9 @@ static void test_no_boundary_bodies(void **state)
         assert_int_equal(tu_write_file(path, text), 0);
         snprintf(dir, sizeof dir, "%s/boundary_bodies_run_%d", tu_tmpdir(), on);
         snprintf(args, sizeof args, "run '%s' -o '%s' --quiet", path, dir);
-        assert_int_equal(cli(args, out, sizeof out), 0);
+        assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
         snprintf(args, sizeof args, "run --resume '%s' --end 0.16 --quiet", dir);
-        assert_int_equal(cli(args, out, sizeof out), 0);
+        assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
         for (int f = 0; f <= 4; f++)
             for (int ply = 0; ply < 2; ply++) {
                 const char *ext = ply ? "ply" : "vtp";
@@ -347,12 +338,12 @@ static void test_help(void **state)
     };
     char out[8192];
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        int st = cli(cases[i].args, out, sizeof out);
+        int st = tu_pfsph("", out, sizeof out, "%s", cases[i].args);
         if (st != 0) fail_msg("pfsph %s: exit status %d", cases[i].args, st);
         for (int k = 0; cases[i].want[k]; k++)
             if (!strstr(out, cases[i].want[k])) fail_msg("pfsph %s: lacks \"%s\"", cases[i].args, cases[i].want[k]);
     }
-    assert_int_equal(cli("help nosuch", out, sizeof out), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", "help nosuch"), 2);
     char path[600], args[2048];
     snprintf(path, sizeof path, "%s/threads0.json", tu_tmpdir());
     assert_int_equal(tu_write_file(path,
@@ -361,9 +352,9 @@ static void test_help(void **state)
                                    "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"),
                      0);
     snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads 0", path, tu_tmpdir());
-    assert_int_equal(cli(args, out, sizeof out), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
     snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads -1", path, tu_tmpdir());
-    assert_int_equal(cli(args, out, sizeof out), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 2);
 }
 
 int main(int argc, char **argv)
