@@ -214,8 +214,7 @@ static void test_messages(void **state)
     snprintf(json, sizeof json, "{" BASE3 "," BODY "}", tu_tmpdir());
     expect("mesh_dir.json", json, "check '%s'", 2, "is a directory, not an OBJ file");
     /* a directory as the scene */
-    snprintf(args, sizeof args, "check '%s'", tu_tmpdir());
-    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "check '%s'", tu_tmpdir()), 2);
     assert_non_null(strstr(out, "is a directory, not a scene file"));
     /* nested past cJSON's limit */
     static char deep[3000];
@@ -224,8 +223,7 @@ static void test_messages(void **state)
     expect("deep.json", deep, "check '%s'", 2, "$: JSON nested too deep: more than 1000");
     /* bytes that would drive the terminal come back escaped */
     expect("bytes.json", "{\"\x1b[31mred\xff\xfe\": 1}", "check '%s'", 2, "\\x1b[31mred\\xff\\xfe");
-    snprintf(args, sizeof args, "check '%s/bytes.json'", tu_tmpdir());
-    tu_pfsph("", out, sizeof out, "%s", args);
+    tu_pfsph("", out, sizeof out, "check '%s/bytes.json'", tu_tmpdir());
     for (const char *c = out; *c; c++)
         if ((unsigned char)*c == 0x1b || (unsigned char)*c >= 0x80)
             fail_msg("raw byte 0x%02x in: %s", (unsigned char)*c, out);
@@ -239,13 +237,11 @@ static void test_messages(void **state)
     snprintf(json, sizeof json, "{" BASE3 "}");
     snprintf(args, sizeof args, "%s/plain.json", tu_tmpdir());
     assert_int_equal(tu_write_file(args, json), 0);
-    snprintf(args, sizeof args, "run '%s/plain.json' -o '%s' --quiet", tu_tmpdir(), file);
-    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s/plain.json' -o '%s' --quiet", tu_tmpdir(), file), 2);
     assert_non_null(strstr(out, "output directory"));
     assert_non_null(strstr(out, "exists and is not a directory"));
     /* the verdict last */
-    snprintf(args, sizeof args, "check '%s/scenes/dam_break_2d.json'", tu_source_dir());
-    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "check '%s/scenes/dam_break_2d.json'", tu_source_dir()), 0);
     size_t n = strlen(out);
     while (n && out[n - 1] == '\n') out[--n] = 0;
     const char *last = strrchr(out, '\n');
@@ -257,7 +253,7 @@ static void test_messages(void **state)
 static void test_no_boundary(void **state)
 {
     (void)state;
-    char path[600], args[2048], out[8192], dir[700], b[800];
+    char path[600], out[8192], dir[700], b[800];
     struct stat sb;
     const char *json = "{\"dimension\":2,\"particle_radius\":0.02,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
                        "\"time\":{\"end\":0.04},\"phases\":[{\"name\":\"w\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
@@ -270,8 +266,7 @@ static void test_no_boundary(void **state)
         snprintf(path, sizeof path, "%s/boundary_%d.json", tu_tmpdir(), on);
         assert_int_equal(tu_write_file(path, text), 0);
         snprintf(dir, sizeof dir, "%s/boundary_run_%d", tu_tmpdir(), on);
-        snprintf(args, sizeof args, "run '%s' -o '%s' --quiet", path, dir);
-        assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
+        assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s' -o '%s' --quiet", path, dir), 0);
         snprintf(b, sizeof b, "%s/frames/boundary_00000.vtp", dir);
         assert_int_equal(stat(b, &sb) == 0, on);
         snprintf(b, sizeof b, "%s/frames/fluid_00001.vtp", dir);
@@ -285,7 +280,7 @@ static void test_no_boundary(void **state)
 static void test_no_boundary_bodies(void **state)
 {
     (void)state;
-    char path[600], args[2048], out[8192], dir[700], b[800];
+    char path[600], out[8192], dir[700], b[800];
     struct stat sb;
     const char *json = "{\"dimension\":2,\"particle_radius\":0.02,\"domain\":{\"min\":[-0.1,-0.1],\"max\":[1,1]},"
                        "\"time\":{\"end\":0.08},\"phases\":[{\"name\":\"w\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
@@ -300,10 +295,8 @@ static void test_no_boundary_bodies(void **state)
         snprintf(path, sizeof path, "%s/boundary_bodies_%d.json", tu_tmpdir(), on);
         assert_int_equal(tu_write_file(path, text), 0);
         snprintf(dir, sizeof dir, "%s/boundary_bodies_run_%d", tu_tmpdir(), on);
-        snprintf(args, sizeof args, "run '%s' -o '%s' --quiet", path, dir);
-        assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
-        snprintf(args, sizeof args, "run --resume '%s' --end 0.16 --quiet", dir);
-        assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
+        assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s' -o '%s' --quiet", path, dir), 0);
+        assert_int_equal(tu_pfsph("", out, sizeof out, "run --resume '%s' --end 0.16 --quiet", dir), 0);
         for (int f = 0; f <= 4; f++)
             for (int ply = 0; ply < 2; ply++) {
                 const char *ext = ply ? "ply" : "vtp";
@@ -344,17 +337,17 @@ static void test_help(void **state)
             if (!strstr(out, cases[i].want[k])) fail_msg("pfsph %s: lacks \"%s\"", cases[i].args, cases[i].want[k]);
     }
     assert_int_equal(tu_pfsph("", out, sizeof out, "%s", "help nosuch"), 2);
-    char path[600], args[2048];
+    char path[600];
     snprintf(path, sizeof path, "%s/threads0.json", tu_tmpdir());
     assert_int_equal(tu_write_file(path,
                                    "{\"dimension\":2,\"particle_radius\":0.02,\"time\":{\"end\":0.04},"
                                    "\"domain\":{\"min\":[0,0],\"max\":[1,1]},\"fluid\":[{\"shape\":"
                                    "\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}"),
                      0);
-    snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads 0", path, tu_tmpdir());
-    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 0);
-    snprintf(args, sizeof args, "run '%s' -o '%s/threads0' --quiet --threads -1", path, tu_tmpdir());
-    assert_int_equal(tu_pfsph("", out, sizeof out, "%s", args), 2);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s' -o '%s/threads0' --quiet --threads 0", path, tu_tmpdir()),
+                     0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s' -o '%s/threads0' --quiet --threads -1", path, tu_tmpdir()),
+                     2);
 }
 
 int main(int argc, char **argv)
