@@ -226,20 +226,17 @@ void pfm_contact_angles(int dim, const double *targets, int nd)
     double target[PFM_MAXDROP], ratio[PFM_MAXDROP];
     memcpy(target, targets, (size_t)nd * sizeof *target);
     nd = pfm_contact_knobs(target, ratio, nd);
-    const char *e;
     pfm_contact cfg = {.dim = dim,
                        .pitch = dim == 2 ? 0.7 : 0.26,
-                       .half = (e = getenv("PF_HALF")) ? atof(e)
-                           : dim == 2                  ? 0.08
-                                                       : 0.03,
+                       .half = tu_env_num("PF_HALF", dim == 2 ? 0.08 : 0.03),
                        .top = dim == 2 ? 0.4 : 0.3,
-                       .k = (e = getenv("PF_K")) ? atof(e) : 1.7,
-                       .seed = (e = getenv("PF_SEED")) ? atoi(e) : 11,
-                       .nu = (e = getenv("PF_NU")) ? e : "0.001",
-                       .pw = (e = getenv("PF_PW")) ? e : "",
+                       .k = tu_env_num("PF_K", 1.7),
+                       .seed = (int)tu_env_num("PF_SEED", 11),
+                       .nu = tu_env("PF_NU", "0.001"),
+                       .pw = tu_env("PF_PW", ""),
                        .dt_s = dim == 2 ? 0.05 : 0.02,
                        .tol = dim == 3 && getenv("PF_RATIO") ? 180 : 10};
-    double t_end = (e = getenv("PF_T")) ? atof(e) : dim == 2 ? 6.0 : 2.0;
+    double t_end = tu_env_num("PF_T", dim == 2 ? 6.0 : 2.0);
 #ifdef __SANITIZE_ADDRESS__
     /* 1 s: the 60-degree drop is still spreading. Averaged over 0.5-1 s, seeds 11 and 1-5
      * (Release, PF_T=1) read 72.9-76.2, 93.3-103.3 and 110.4-117.7 degrees: 16 degrees from
@@ -254,7 +251,7 @@ void pfm_contact_angles(int dim, const double *targets, int nd)
         cfg.avg_after = cfg.nsamples / 2;
         cfg.t_avg0 = 0.5 * t_end;
     } else { /* those after PF_TAVG */
-        cfg.t_avg0 = (e = getenv("PF_TAVG")) ? atof(e) : 0.5 * t_end;
+        cfg.t_avg0 = tu_env_num("PF_TAVG", 0.5 * t_end);
         while (cfg.dt_s * (cfg.avg_after + 1) <= cfg.t_avg0 + 1e-9) cfg.avg_after++;
     }
     pfm_contact_run(&cfg, target, getenv("PF_RATIO") ? ratio : NULL, nd);

@@ -464,6 +464,18 @@ void tu_block_mean(const double *s, size_t m, int nb, double *mean, double *se, 
     if (bm) memcpy(bm, b_, (size_t)nb * sizeof *bm);
 }
 
+const char *tu_env(const char *env, const char *def)
+{
+    const char *e = getenv(env);
+    return e ? e : def;
+}
+
+double tu_env_num(const char *env, double def)
+{
+    const char *e = getenv(env);
+    return e ? atof(e) : def;
+}
+
 int tu_env_list(const char *env, double *v, int max, int n_default)
 {
     const char *e = getenv(env);

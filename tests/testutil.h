@@ -71,6 +71,9 @@ tu_line tu_line_fit(int n, const double *x, const double *y);
  * m >= nb, 2 <= nb <= 64 (else NaN); bm, if not NULL, receives the nb block means. Safe in
  * parallel jobs (no assertion). */
 void tu_block_mean(const double *s, size_t m, int nb, double *mean, double *se, double *bm);
+/* A study knob: the environment variable env, or def when it is not set; as a number. */
+const char *tu_env(const char *env, const char *def);
+double tu_env_num(const char *env, double def);
 /* Up to max comma-separated numbers from the environment variable env into v (a study knob);
  * returns how many, or n_default with v untouched when env is not set. */
 int tu_env_list(const char *env, double *v, int max, int n_default);

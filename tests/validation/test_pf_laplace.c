@@ -38,15 +38,14 @@ static void test_laplace(void **state)
     double radii[PFM_MAXR] = {8, 10, 13, 16, 20};
     const int nr = tu_env_list("PF_RADII", radii, PFM_MAXR, 5);
     char tol[64] = "";
-    const char *e;
-    if ((e = getenv("PF_TOL"))) snprintf(tol, sizeof tol, ", \"tolerance\": %s", e);
+    if (getenv("PF_TOL")) snprintf(tol, sizeof tol, ", \"tolerance\": %s", getenv("PF_TOL"));
     pfm_laplace cfg = {.dim = 2,
-                       .solver = (e = getenv("PF_SOLVER")) ? e : "pcisph",
+                       .solver = tu_env("PF_SOLVER", "pcisph"),
                        .solver_keys = tol,
-                       .dt_max = (e = getenv("PF_DTMAX")) ? e : "0.002",
+                       .dt_max = tu_env("PF_DTMAX", "0.002"),
                        .every = 2,
                        .t0 = 1.0,
-                       .t_end = (e = getenv("PF_T")) ? atof(e) : 6.0,
+                       .t_end = tu_env_num("PF_T", 6.0),
                        .checks = 1};
     pfm_laplace_run(&cfg, radii, nr);
 }

@@ -37,14 +37,13 @@ static void test_laplace(void **state)
     double radii[PFM_MAXR] = {6, 7, 8, 9, 10};
     int nr = 5;
     nr = tu_env_list("PF_RADII", radii, PFM_MAXR, nr);
-    const char *e;
     pfm_laplace cfg = {.dim = 3,
-                       .solver = (e = getenv("PF_SOLVER")) ? e : "dfsph",
-                       .solver_keys = (e = getenv("PF_SOLVER_KEYS")) ? e : ", \"tolerance\": 0.0001",
+                       .solver = tu_env("PF_SOLVER", "dfsph"),
+                       .solver_keys = tu_env("PF_SOLVER_KEYS", ", \"tolerance\": 0.0001"),
                        .dt_max = "0.002",
-                       .every = (e = getenv("PF_EVERY")) ? atoi(e) : 4,
-                       .t0 = (e = getenv("PF_T0")) ? atof(e) : 0.5,
-                       .t_end = (e = getenv("PF_T")) ? atof(e) : 5.5,
+                       .every = (int)tu_env_num("PF_EVERY", 4),
+                       .t0 = tu_env_num("PF_T0", 0.5),
+                       .t_end = tu_env_num("PF_T", 5.5),
                        .profile = getenv("PF_PROFILE") != NULL,
                        .checks = 1};
     pfm_laplace_run(&cfg, radii, nr);
