@@ -1,7 +1,7 @@
 /* Checkpoint files and a run's checkpoints folder (docs/checkpoints.md, "Policy"): atomic
  * saves, loads that check the file name's frame, rotation of the newest few, and resume from
  * the newest valid one. The format is written by checkpoint_encode.c, read by
- * checkpoint_decode.c; the scene hash is checkpoint_hash.c. */
+ * checkpoint_decode.c; the scene hash is src/scene/scene_hash.c. */
 #include "pfsph/checkpoint.h"
 
 #include <dirent.h>

@@ -196,9 +196,15 @@ int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const c
     uint32_t hcrc = r_u32(&r);
     if ((uint32_t)crc32(crc32(0L, Z_NULL, 0), b, 36) != hcrc)
         return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: header checksum mismatch", name);
+    if (version < PFSPH_CHECKPOINT_VERSION)
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: checkpoint format version %u, written by an older pfsph (this one reads version %u "
+                          "only): resume it with the pfsph that wrote it, or run the scene afresh",
+                          name, version, PFSPH_CHECKPOINT_VERSION);
     if (version != PFSPH_CHECKPOINT_VERSION)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint format version %u, this pfsph reads version %u", name,
-                          version, PFSPH_CHECKPOINT_VERSION);
+        return pfsph_fail(err, PFSPH_EINPUT,
+                          "%s: checkpoint format version %u, written by a newer pfsph (this one reads version %u)",
+                          name, version, PFSPH_CHECKPOINT_VERSION);
     if (real_size != sizeof(pfsph_real))
         return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint written in %s precision, this pfsph is built for %s", name,
                           real_size == 8 ? "double" : "float", PFSPH_REAL_NAME);

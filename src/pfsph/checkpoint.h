@@ -8,14 +8,17 @@
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 
-#define PFSPH_CHECKPOINT_VERSION 3u
+/* 4: the scene hash of src/scene/scene_hash.c (the payload is version 3's) */
+#define PFSPH_CHECKPOINT_VERSION 4u
 /* Checkpoints kept in RUN/checkpoints (older ones are deleted after a new one is written). */
 #define PFSPH_CHECKPOINT_KEEP 2
 
-/* 64-bit FNV-1a hash of every scene value that shapes the simulated state (geometry, physics,
- * solver, time stepping, seed, pairwise and diffuse parameters). Output settings, the end time,
- * the thread count, the camera, the scene's name and source are left out: a run may be resumed
- * with another end time or output directory. */
+/* 64-bit hash of every scene value that shapes the simulated state: every member of the scene
+ * (src/scene/scene_hash.c's tables, which the build checks against the structs) except output
+ * settings, the end time, the thread count, the camera, the scene's name and source, phase
+ * colours and the values the simulation derives (resolved pair coefficients): a run may be
+ * resumed with another end time or output directory. The same for a scene as parsed and as
+ * pfsph_sim_scene holds it. */
 uint64_t pfsph_scene_hash(const pfsph_scene *s);
 
 /* What a checkpoint says about itself. */

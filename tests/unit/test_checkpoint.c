@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <glob.h>
 #include <limits.h>
 #include <sys/stat.h>
 #include <zlib.h>
@@ -435,6 +436,66 @@ static void test_crafted_clock(void **st)
     free(b);
 }
 
+/* A checkpoint of an older format version is refused as such, not as another scene's. */
+static void test_older_version(void **st)
+{
+    (void)st;
+    size_t len;
+    unsigned char *b = good_checkpoint(2, &len);
+    put_u32(b + 8, PFSPH_CHECKPOINT_VERSION - 1);
+    reseal(b, len);
+    expect_reject_mem(b, len, "written by an older pfsph");
+    put_u32(b + 8, PFSPH_CHECKPOINT_VERSION + 1);
+    reseal(b, len);
+    expect_reject_mem(b, len, "written by a newer pfsph");
+    free(b);
+}
+
+/* The scene hash (src/scene/scene_hash.c): every shipped scene hashes the same as parsed and as
+ * its simulation holds it (pair coefficients resolved, film volumes filled in), and no two
+ * alike; colours and the run's own settings do not count, the scene's values do. */
+static void test_hash_of_scenes(void **st)
+{
+    (void)st;
+    char pattern[1024];
+    snprintf(pattern, sizeof pattern, "%s/scenes/*.json", tu_source_dir());
+    glob_t g;
+    assert_int_equal(glob(pattern, 0, NULL, &g), 0);
+    assert_true(g.gl_pathc >= 5);
+    uint64_t *h = calloc(g.gl_pathc, sizeof *h);
+    assert_non_null(h);
+    static pfsph_scene s, t;
+    for (size_t i = 0; i < g.gl_pathc; i++) {
+        pfsph_error err = {0};
+        if (pfsph_scene_load(&s, g.gl_pathv[i], &err)) fail_msg("%s", err.msg);
+        h[i] = pfsph_scene_hash(&s);
+        for (size_t j = 0; j < i; j++)
+            if (h[j] == h[i]) fail_msg("%s and %s hash alike", g.gl_pathv[j], g.gl_pathv[i]);
+        t = s;
+        t.phases[0].color[0] += 0.5f;
+        t.phases[0].color_set = !t.phases[0].color_set;
+        t.end_time += 1;
+        t.threads += 3;
+        t.output.frame_interval += 1;
+        t.camera.fov_deg += 1;
+        snprintf(t.source, sizeof t.source, "elsewhere.json");
+        assert_true(pfsph_scene_hash(&t) == h[i]);
+        t = s;
+        t.blocks[0].jitter += 0.1; /* a block in use counts, one beyond nblocks not */
+        assert_true((pfsph_scene_hash(&t) != h[i]) == (s.nblocks > 0));
+        t = s;
+        t.pairwise.shift.D += 1e-3;
+        assert_true(pfsph_scene_hash(&t) != h[i]);
+        pfsph_sim *sim = NULL;
+        if (pfsph_sim_create(&sim, &s, &err)) fail_msg("%s", err.msg);
+        if (pfsph_scene_hash(pfsph_sim_scene(sim)) != h[i])
+            fail_msg("%s: the simulation's scene hashes otherwise", g.gl_pathv[i]);
+        pfsph_sim_destroy(sim);
+    }
+    free(h);
+    globfree(&g);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -443,7 +504,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_roundtrip_dfsph),  cmocka_unit_test(test_corrupt_and_truncated),
         cmocka_unit_test(test_other_scene),      cmocka_unit_test(test_keep_and_fallback),
         cmocka_unit_test(test_scene_key),        cmocka_unit_test(test_crafted_ids),
-        cmocka_unit_test(test_crafted_clock),
+        cmocka_unit_test(test_crafted_clock),    cmocka_unit_test(test_older_version),
+        cmocka_unit_test(test_hash_of_scenes),
     };
     return tu_run_group(tests, NULL, NULL);
 }
