@@ -1,5 +1,5 @@
 /* Free-surface particles layer by layer (Barecasco, Terissa & Naa 2013; PF Fig. 9). See
- * include/pfsph/surface_detect.h and docs/film.md. */
+ * src/pfsph/surface_detect.h and docs/film.md. */
 #include "pfsph/surface_detect.h"
 
 #include <math.h>

@@ -40,7 +40,7 @@ void pfsph_pairwise_apply_density(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsp
 /* The largest pair-force acceleration |F_i^int / m_i| of the last apply [m/s^2] (0 for NULL). */
 double pfsph_pairwise_amax(const pfsph_pairwise *pw);
 
-/* Particle shifting (include/pfsph/shifting.h) with the scene's "shifting" parameters, for a
+/* Particle shifting (src/pfsph/shifting.h) with the scene's "shifting" parameters, for a
  * step of ctx->dt: called right after the grid sort, before the density. No-op when off. The
  * shift per step is capped at min(max_frac d, cell - h) so that neighbour searches stay exact. */
 void pfsph_pairwise_shift(pfsph_pairwise *pw, const pfsph_ctx *ctx);

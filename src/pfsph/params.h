@@ -23,7 +23,7 @@ typedef struct pfsph_phase {
     bool color_set;      /* "color" given in the scene (walls are drawn grey otherwise) */
 } pfsph_phase;
 
-/* ---- particle shifting (physics/shifting.c, include/pfsph/shifting.h) ---- */
+/* ---- particle shifting (physics/shifting.c, src/pfsph/shifting.h) ---- */
 
 typedef struct pfsph_shift_params {
     double D;        /* shifting diffusivity [m^2/s]; the shift of one step is
@@ -37,7 +37,7 @@ typedef struct pfsph_shift_params {
 /* Default: off (D = 0, A = 0), surface 0.9, max_frac 0.05. */
 void pfsph_shift_defaults(pfsph_shift_params *p);
 
-/* ---- pair forces (physics/pairwise.c, include/pfsph/pairwise.h) ---- */
+/* ---- pair forces (physics/pairwise.c, src/pfsph/pairwise.h) ---- */
 
 /* Where the covariance of Eq. 7 is centred. */
 enum pfsph_pw_center {
@@ -149,7 +149,7 @@ double pfsph_pairwise_visc_struct(int dim, double theta);
  * the unit the kinetic temperature already reads 0.89 of its value at 0.16 (docs/thermostat.md). */
 #define PFSPH_VISC_FLOOR 0.05
 
-/* ---- bubbles in air: two-phase film particles (physics/film.c, include/pfsph/film.h) ---- */
+/* ---- bubbles in air: two-phase film particles (physics/film.c, src/pfsph/film.h) ---- */
 
 #define PFSPH_MAX_BUBBLES 250 /* bubble k is stored as k + 1 in the uint8 particle field */
 
@@ -169,7 +169,7 @@ typedef struct pfsph_film_params {
 /* No bubbles; film[] = -1. */
 void pfsph_film_defaults(pfsph_film_params *p);
 
-/* ---- diffuse material (physics/diffuse.c, include/pfsph/diffuse.h) ---- */
+/* ---- diffuse material (physics/diffuse.c, src/pfsph/diffuse.h) ---- */
 
 /* Diffuse particle types, stored in pfsph_particles.phase. */
 enum pfsph_diffuse_type {
@@ -212,7 +212,7 @@ void pfsph_diffuse_defaults(pfsph_diffuse_params *p);
 void pfsph_diffuse_thresholds(const pfsph_diffuse_params *p, int dim, double h, double spacing, int *foam_min,
                               int *foam_max);
 
-/* ---- emitters (physics/emitter.c, include/pfsph/emitter.h; docs/emitters.md) ---- */
+/* ---- emitters (physics/emitter.c, src/pfsph/emitter.h; docs/emitters.md) ---- */
 
 #define PFSPH_MAX_EMITTERS 16
 

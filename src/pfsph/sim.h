@@ -21,7 +21,7 @@ int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err);
  * pressures, so frame 0 carries real values. */
 void pfsph_sim_prime_output(pfsph_sim *sim);
 
-/* Surface layers of the fluid as it is now (include/pfsph/surface_detect.h): out[i] in 0
+/* Surface layers of the fluid as it is now (src/pfsph/surface_detect.h): out[i] in 0
  * (interior) .. layers, fluid order; boundary particles cover; with bubbles each bubble on its
  * own. For the frames' `surface_layer` field. Returns PFSPH_OK or PFSPH_ENOMEM. */
 int pfsph_sim_surface_layers(const pfsph_sim *sim, int layers, uint8_t *out);

@@ -1,5 +1,5 @@
 /* Bubbles in air: the film stage of PF Section 4.2.2 (surface detection per bubble, the even
- * film's volume fraction). include/pfsph/film.h, docs/film.md. */
+ * film's volume fraction). src/pfsph/film.h, docs/film.md. */
 #include "pfsph/film.h"
 
 #include <math.h>

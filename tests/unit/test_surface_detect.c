@@ -1,4 +1,4 @@
-/* Surface particle detection (include/pfsph/surface_detect.h; Barecasco, Terissa & Naa 2013,
+/* Surface particle detection (src/pfsph/surface_detect.h; Barecasco, Terissa & Naa 2013,
  * PF Fig. 9) against shapes whose surface is known: lattice disc, box and annulus (2D), sphere,
  * box and spherical shell (3D). The geometric outer layer of a lattice shape is the set of
  * particles with one of their 2 dim axis neighbours missing; its second layer is the outer
