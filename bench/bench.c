@@ -15,11 +15,12 @@
 #include "pfsph/grid.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
+#include "physics/solver.h"
 
 static void usage(void)
 {
     fprintf(stderr,
-            "usage: bench [--particles N] [--steps N] [--warmup N] [--solver wcsph|pcisph]\n"
+            "usage: bench [--particles N] [--steps N] [--warmup N] [--solver wcsph|pcisph|dfsph|iisph]\n"
             "             [--pairwise [--no-thermostat]] [--threads N] [--diffuse N] [--diffuse-emit-all]\n"
             "Runs a 3D dam break of about N fluid particles (default 50000) for --steps steps\n"
             "(default 20) after --warmup steps (default 3) and prints throughput figures.\n"
@@ -121,7 +122,8 @@ int main(int argc, char **argv)
 {
     pfsph_omp_wait_default(argv); /* as pfsph does */
     long target = 50000, steps = 20, warmup = 3;
-    int pcisph = 0, pairwise = 0, threads = 0, emit_all = 0, no_thermo = 0;
+    const char *solver = "wcsph";
+    int pairwise = 0, threads = 0, emit_all = 0, no_thermo = 0;
     long ndiffuse = -1;
     double wall_nu = -1;
     for (int i = 1; i < argc; i++) {
@@ -140,12 +142,11 @@ int main(int argc, char **argv)
             threads = atoi(v);
             i++;
         } else if (!strcmp(a, "--solver") && v) {
-            if (!strcmp(v, "wcsph")) pcisph = 0;
-            else if (!strcmp(v, "pcisph")) pcisph = 1;
-            else {
+            if (!pfsph_solver_find(v)) {
                 usage();
                 return 2;
             }
+            solver = v;
             i++;
         } else if (!strcmp(a, "--pairwise")) pairwise = 1;
         else if (!strcmp(a, "--no-thermostat")) no_thermo = 1;
@@ -217,8 +218,7 @@ int main(int argc, char **argv)
              "\"phase\": \"wall\"%s}],\n"
              "\"output\": {\"directory\": \"bench_run\", \"formats\": [], \"boundary\": false}"
              "%s%s}\n",
-             r, threads, -m, -m, -m, tx + m, ty + m, tz + m, pcisph ? "pcisph" : "wcsph", bx, by, bz, tx, ty, tz,
-             wallkey, pair, dif);
+             r, threads, -m, -m, -m, tx + m, ty + m, tz + m, solver, bx, by, bz, tx, ty, tz, wallkey, pair, dif);
 
     static pfsph_scene scene;
     pfsph_error err = {0};
@@ -244,7 +244,7 @@ int main(int argc, char **argv)
     const pfsph_ctx *ctx = pfsph_sim_ctx(sim);
     const size_t n_fluid0 = ctx->fluid->n, n_bnd = ctx->boundary ? ctx->boundary->n : 0;
 
-    printf("pfsph bench: 3D dam break, solver %s%s, %d threads (OMP_WAIT_POLICY=%s)\n", pcisph ? "pcisph" : "wcsph",
+    printf("pfsph bench: 3D dam break, solver %s%s, %d threads (OMP_WAIT_POLICY=%s)\n", solver,
            pairwise ? " + pairwise" : "", threads > 0 ? threads : omp_get_max_threads(),
            getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
     printf("  block %ld x %ld x %ld, particle radius %.4g m, h %.4g m, tank %.3f x %.3f x %.3f m\n", nx, ny, nz, r,
@@ -290,7 +290,7 @@ int main(int argc, char **argv)
     printf("  grid candidates     %.1f fluid particles tested per fluid particle (cell %.4g m)\n", ncand,
            (double)ctx->grid->cell);
     const double avg_it = done ? (double)iters / (double)done : 0;
-    if (pcisph) printf("  PCISPH iterations   %.2f per step (average)\n", avg_it);
+    if (strcmp(solver, "wcsph")) printf("  solver iterations   %.2f per step (average)\n", avg_it);
 
     const double *st1 = pfsph_sim_stage_seconds(sim);
     const double *sc1 = pfsph_sim_stage_cpu_seconds(sim);
@@ -331,9 +331,9 @@ int main(int argc, char **argv)
     printf("BENCH solver=%s pairwise=%d threads=%d fluid=%zu boundary=%zu steps=%ld wall_s=%.3f "
            "psteps_per_s=%.4g iters=%.2f nb_fluid=%.1f nb_bnd=%.1f cand=%.1f bytes_per_particle=%.0f "
            "diffuse=%zu diffuse_s=%.4f fluid_s=%.4f diffuse_pct=%.1f cpu_s=%.4f status=%s\n",
-           pcisph ? "pcisph" : "wcsph", pairwise, threads > 0 ? threads : omp_get_max_threads(), n_fluid0, n_bnd, done,
-           wall, rate, avg_it, nbf, nbb, ncand, bpp, dc[0] + dc[1] + dc[2], dif_s, fluid_s,
-           fluid_s > 0 ? 100 * dif_s / fluid_s : 0, cpu_tot, rc == PFSPH_OK ? "ok" : "failed");
+           solver, pairwise, threads > 0 ? threads : omp_get_max_threads(), n_fluid0, n_bnd, done, wall, rate, avg_it,
+           nbf, nbb, ncand, bpp, dc[0] + dc[1] + dc[2], dif_s, fluid_s, fluid_s > 0 ? 100 * dif_s / fluid_s : 0,
+           cpu_tot, rc == PFSPH_OK ? "ok" : "failed");
     pfsph_sim_destroy(sim);
     return rc == PFSPH_OK ? 0 : 3;
 }

@@ -157,6 +157,14 @@ static int reserve_fluid(pfsph_step *st, size_t n, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* The fluid sorted outside the step (set-up), in the accelerations' arrays as the grid stage
+ * sorts it. */
+static int sort_fluid(pfsph_sim *sim)
+{
+    pfsph_ctx *c = &sim->ctx;
+    return pfsph_grid_sort_in(&sim->grid, &sim->fluid, &sim->st.removed, (uint32_t *)c->ax, (uint32_t *)c->ay, c->az);
+}
+
 static void auto_sound_speed(pfsph_sim *sim)
 {
     const pfsph_scene *s = &sim->scene;
@@ -310,6 +318,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     c->grid = &sim->grid;
     c->bgrid = &sim->bgrid;
     if ((rc = pfsph_grid_sort(&sim->bgrid, &sim->boundary, NULL))) goto nomem;
+    if (!s->nbodies) pfsph_grid_release_scratch(&sim->bgrid); /* static walls: sorted once */
     pfsph__boundary_volumes(&sim->boundary, &sim->bgrid, &c->kern);
     for (size_t i = 0; i < sim->boundary.n; i++)
         sim->boundary.rho[i] = (pfsph_real)s->phases[sim->boundary.phase[i]].rest_density;
@@ -343,7 +352,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     sim->st.vbound = sim->st.solver->speed_bound(sim->st.solver_state, c);
 
     if (s->film.nbubbles > 0 && sim->fluid.n) {
-        if (pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->st.removed)) goto nomem;
+        if (sort_fluid(sim)) goto nomem;
         if ((rc = pfsph_film_create(&sim->st.film, c, &s->film, s->source, err))) goto fail;
         if (pfsph_film_update(sim->st.film, c) < 0) goto nomem; /* frame 0 carries the film */
     }
@@ -352,7 +361,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     /* The first step's force criterion needs the accelerations the pair forces give: from |g|
      * alone (0 without gravity) PCISPH took dt_max and blew up at step 0 (issue 11). */
     if (sim->st.pw && sim->fluid.n) {
-        if (pfsph_grid_sort(&sim->grid, &sim->fluid, &sim->st.removed)) goto nomem;
+        if (sort_fluid(sim)) goto nomem;
         pfsph__number_density(c, sim->fluid.x, sim->fluid.y, sim->fluid.z, c->nd);
         pfsph__nonpressure(c);
         pfsph_pairwise_apply(sim->st.pw, c);
@@ -471,8 +480,12 @@ static int plan_buffers(pfsph_sim *sim)
         if (o->writes & PFSPH_D_PAIR_ACC) from = k;
     }
     const int thermo = s->pairwise.enabled && s->pairwise.thermo.enabled;
+    const pfsph_solver_ops *so = sim->st.solver;
+    const int shared = so->scratch_per_call && !so->nscratch4; /* in the stages' scratch */
+    if (shared && so->nscratch > nstage) nstage = so->nscratch;
     int stage0 = SCR_COMMON, noise0 = stage0 + nstage, pair0 = noise0 + (thermo ? 3 : 0),
-        solver0 = pair0 + (pair_own ? 3 : 0), total = solver0 + sim->st.solver->nscratch;
+        solver0 = shared ? stage0 : pair0 + (pair_own ? 3 : 0),
+        total = shared ? pair0 + (pair_own ? 3 : 0) : solver0 + so->nscratch;
     if (total > SCR_MAX) return PFSPH_ENOMEM;
     const int same = sim->nscr == total && sim->scr_stage == stage0 && sim->nscr_stage == nstage &&
         sim->scr_noise == (thermo ? noise0 : -1) && sim->scr_pair == (pair_own ? pair0 : -1) &&

@@ -153,14 +153,18 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     double cell = pfsph__grid_cell(s, h, &r1, &r2);
     double cells = 1;
     for (int a = 0; a < s->dim; a++) cells *= ceil((s->domain_max[a] - s->domain_min[a]) / cell + 8);
-    /* Per particle: its set at up to twice its size (the arrays grow by doubling), the grid's
-     * sort scratch (key, perm, tmp; 1.25x), and for fluid the step scratch (checkpoints and the
-     * last good frame go to disk through a small buffer, docs/checkpoints.md). Measured:
-     * tests/unit/test_estimate.c. In double: the estimate may exceed size_t, so it saturates. */
+    /* Per particle: its set (room reserved by doubling or for emitters is mapped, not resident:
+     * src/core/particles.c), and for fluid the step's scratch (the grid sorts in its acceleration
+     * arrays, src/core/grid.c); the boundary keeps the sort's scratch (key, perm, tmp; 1.25x)
+     * only when bodies move it (checkpoints and the last good frame go to disk through a small
+     * buffer, docs/checkpoints.md). Measured: tests/unit/test_estimate.c, docs/benchmarks.md.
+     * In double: the estimate may exceed size_t, so it saturates. */
     const double P = (double)pfsph_particles_bytes_per_particle();
     const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
-    const int nstage = 1; /* the stages' shared scratch: the integrator's kinetic energies */
+    const int shared = ops && ops->scratch_per_call && !ops->nscratch4;
+    int nstage = 1; /* the stages' shared scratch: the integrator's energies */
+    if (shared && ops->nscratch > nstage) nstage = ops->nscratch;
     const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
     /* neighbour lists: a full neighbourhood within h (pi q^2 in 2D, 4/3 pi q^3 in 3D, q = h / d)
      * and a quarter more for compression near walls and in splashes; boundary lists: half a
@@ -170,10 +174,17 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
         ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) + pfsph_nlist_bytes_per_particle(0.5 * full, 1)
         : 0;
     const int nscr =
-        SCR_COMMON + nstage + (ops ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
-    const double per_fluid = 2 * P + nscr * sizeof(pfsph_real) + sort + nlist;
-    const double per_boundary = 2 * P + sort;
-    const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t); /* fluid and boundary grids */
+        SCR_COMMON + nstage + (ops && !shared ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
+    /* output: the surface layers of a frame (a byte each) and, with pair forces, the
+     * mechanical pressure (src/sim.c, pfsph_sim_output); frames stream through a 1 MiB buffer */
+    const double out = 1 + (s->pairwise.enabled ? sizeof(pfsph_real) : 0);
+    /* and 5 % for the allocator's and the pages' rounding: a 2D run of 160,000 particles held
+     * 116 B per particle against 112 counted here (tests/unit/test_estimate.c) */
+    const double per_fluid = 1.05 * (P + nscr * sizeof(pfsph_real) + nlist + out);
+    const double per_boundary = P + (s->nbodies ? sort : 0);
+    /* fluid and boundary grids: a start per cell, and the boundary's byte per cell of cells
+     * near it (pfsph_grid_near) */
+    const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t) + cells;
     const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary;
     if (n_fluid) *n_fluid = (size_t)nf;
     if (n_boundary) *n_boundary = (size_t)nb;

@@ -86,6 +86,7 @@ int pfsph_sim_restore_bodies(pfsph_sim *sim, int nbodies, const pfsph_body_state
     if (rc) return rc;
     for (int i = 0; i < nbodies; i++) pfsph_bodies_set_state(sim->st.bodies, i, &st[i], b);
     if (pfsph_grid_sort(&sim->bgrid, b, NULL)) return pfsph_fail(err, PFSPH_ENOMEM, "restore: out of memory");
+    if (!sim->scene.nbodies) pfsph_grid_release_scratch(&sim->bgrid); /* static walls */
     return PFSPH_OK;
 }
 void pfsph_sim_add_stage_time(pfsph_sim *sim, int stage, double seconds)

@@ -97,11 +97,26 @@ static int ensure(pfsph_grid *g, size_t n)
     return PFSPH_OK;
 }
 
+void pfsph_grid_release_scratch(pfsph_grid *g)
+{
+    free(g->key);
+    free(g->perm);
+    free(g->tmp);
+    g->key = g->perm = NULL;
+    g->tmp = NULL;
+    g->cap = 0;
+}
+
 int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
 {
-    size_t n = ps->n;
-    int rc = ensure(g, n);
+    int rc = ensure(g, ps->n);
     if (rc) return rc;
+    return pfsph_grid_sort_in(g, ps, removed, g->key, g->perm, g->tmp);
+}
+
+int pfsph_grid_sort_in(pfsph_grid *g, pfsph_particles *ps, size_t *removed, uint32_t *gkey, uint32_t *gperm, void *tmp)
+{
+    size_t n = ps->n;
     const uint32_t outside = UINT32_MAX;
     const pfsph_real *pos[3] = {ps->x, ps->y, ps->z};
     const int dim = g->dim;
@@ -123,22 +138,22 @@ int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
             stride *= (size_t)g->nc[a];
         }
         if (key != outside) key = (uint32_t)lin;
-        g->key[i] = key;
+        gkey[i] = key;
     }
 
     /* Counting sort, stable: the same order for any thread count. */
     memset(g->start, 0, (g->ncells + 1) * sizeof(uint32_t));
     size_t kept = 0;
     for (size_t i = 0; i < n; i++)
-        if (g->key[i] != outside) {
-            g->start[g->key[i] + 1]++;
+        if (gkey[i] != outside) {
+            g->start[gkey[i] + 1]++;
             kept++;
         }
     for (size_t c = 0; c < g->ncells; c++) g->start[c + 1] += g->start[c];
     /* use start[c] as the running insertion cursor, then restore */
     for (size_t i = 0; i < n; i++) {
-        uint32_t k = g->key[i];
-        if (k != outside) g->perm[g->start[k]++] = (uint32_t)i;
+        uint32_t k = gkey[i];
+        if (k != outside) gperm[g->start[k]++] = (uint32_t)i;
     }
     for (size_t c = g->ncells; c > 0; c--) g->start[c] = g->start[c - 1];
     g->start[0] = 0;
@@ -148,7 +163,7 @@ int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed)
         mark_near(g, g->reach, &g->near);
         if (g->reach_far > g->reach) mark_near(g, g->reach_far, &g->near_far);
     }
-    return pfsph_particles_permute(ps, g->perm, kept, g->tmp);
+    return pfsph_particles_permute(ps, gperm, kept, tmp);
 }
 
 size_t pfsph_neighbors_brute(const pfsph_particles *ps, size_t i, pfsph_real radius, uint32_t *out, size_t max)
@@ -173,10 +188,17 @@ static int grid_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error 
     (void)state;
     (void)bad;
     st->removed_before = st->removed;
-    if (pfsph_grid_sort(st->ctx->grid, st->ctx->fluid, &st->removed))
+    /* the sort's keys, permutation and buffer in the accelerations' arrays: per-particle arrays
+     * of the step hold nothing across the sort (it reorders the particles under them), and the
+     * accelerations are written afresh after it (docs/benchmarks.md, issue 28: 12 B per particle) */
+    pfsph_ctx *c = st->ctx;
+    if (pfsph_grid_sort_in(c->grid, c->fluid, &st->removed, (uint32_t *)c->ax, (uint32_t *)c->ay, c->az))
         return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sorting the fluid into the grid");
     return PFSPH_OK;
 }
 
-const pfsph_stage_ops pfsph_stage_grid = {
-    .name = "grid", .slot = PFSPH_STAGE_GRID, .reads = PFSPH_D_POS, .writes = PFSPH_D_ORDER, .run = grid_run};
+const pfsph_stage_ops pfsph_stage_grid = {.name = "grid",
+                                          .slot = PFSPH_STAGE_GRID,
+                                          .reads = PFSPH_D_POS,
+                                          .writes = PFSPH_D_ORDER | PFSPH_D_ACC, /* ACC: lent to the sort */
+                                          .run = grid_run};

@@ -45,6 +45,12 @@ void pfsph_grid_free(pfsph_grid *g);
 /* Remove particles outside the domain (or with non-finite positions; count added to *removed
  * if not NULL), sort the rest by cell and fill g->start. Deterministic for any thread count. */
 int pfsph_grid_sort(pfsph_grid *g, pfsph_particles *ps, size_t *removed);
+/* The same with the caller's scratch (each at least ps->n elements of 4 bytes, tmp ps->n reals):
+ * the simulation lends the step's arrays, which hold nothing while the grid sorts, instead of
+ * keeping three more arrays per particle alive (docs/benchmarks.md, issue 28). */
+int pfsph_grid_sort_in(pfsph_grid *g, pfsph_particles *ps, size_t *removed, uint32_t *key, uint32_t *perm, void *tmp);
+/* Free the grid's own sort scratch (a set sorted once, such as static walls, needs it no more). */
+void pfsph_grid_release_scratch(pfsph_grid *g);
 
 /* Index ranges (into the sorted set) of the cells around a point; the union covers every
  * particle within distance R * g->cell of (x, y, z) (R <= 3). The point may lie outside the

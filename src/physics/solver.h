@@ -46,6 +46,10 @@ typedef struct pfsph_solver_ops {
     const char *(*ratio_advice)(double ratio, int common_scale, char *buf, size_t len);
     int nscratch;  /* per-fluid-particle scratch arrays the solver needs */
     int nscratch4; /* the last nscratch4 of them hold 4 values per particle (packed x, y, z, w) */
+    /* Non-zero: the solver's scratch holds nothing from one call to the next (each call writes
+     * what it reads), so it lies in the stages' shared scratch instead of arrays of its own
+     * (nscratch4 must be 0). */
+    int scratch_per_call;
     /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
      * solver that walks the neighbours many times per step (memory: src/core/nlist.h). */
     int neighbour_lists;

@@ -104,6 +104,7 @@ const pfsph_solver_ops pfsph_solver_wcsph = {
     .name = "wcsph",
     .ratio_advice = ratio_advice,
     .nscratch = 1,
+    .scratch_per_call = 1, /* report's per-particle errors, summed at once */
     .eos = eos,
     .report = report,
     .create = create,
