@@ -8,20 +8,20 @@ library's memory, run directories read back. Guide: docs/python.md.
     x = sim.fluid.positions          # (n, 3), read-only view
     run = pfsph.read_run("runs/dam_break_2d")
 """
-from ._ffi import ffi as _ffi, lib as _lib, library_path
+from ._ffi import ffi as _cffi, lib as _clib, library_path
 from .errors import (Error, InputError, SceneError, UnstableError, PfsphIOError, PfsphMemoryError)
 from .simulation import Simulation, ParticleSet, Body, set_threads, threads
 from .rundir import Run, Frame, read_run, read_frame
 
-__version__ = _ffi.string(_lib.pfsph_version()).decode()
+__version__ = _cffi.string(_clib.pfsph_version()).decode()
 #: numpy dtype of the library's real-valued fields (float32, or float64 in a PFSPH_DOUBLE build)
-real_dtype = "float64" if _lib.pfsph_real_type() == _lib.PFSPH_FLOAT64 else "float32"
+real_dtype = "float64" if _clib.pfsph_real_type() == _clib.PFSPH_FLOAT64 else "float32"
 
 
 def default_scene():
     """The built-in default scene (a small 3D dam break) as a dict."""
     import json
-    return json.loads(_ffi.string(_lib.pfsph_scene_default_json()).decode())
+    return json.loads(_cffi.string(_clib.pfsph_scene_default_json()).decode())
 
 
 __all__ = ["Simulation", "ParticleSet", "Body", "Run", "Frame", "read_run", "read_frame", "set_threads", "threads",

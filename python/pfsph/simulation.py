@@ -15,7 +15,7 @@ _DTYPES = {lib.PFSPH_FLOAT32: np.dtype("<f4"), lib.PFSPH_FLOAT64: np.dtype("<f8"
            lib.PFSPH_UINT8: np.dtype("u1"), lib.PFSPH_UINT32: np.dtype("<u4")}
 
 _default_threads = None
-_lock = threading.Lock()
+_initial_threads = lib.pfsph_threads(0)  # OpenMP's own count, for set_threads(None)
 
 
 def set_threads(n):
@@ -24,7 +24,9 @@ def set_threads(n):
     None: OpenMP's own choice ($OMP_NUM_THREADS, else every core). Returns the count."""
     global _default_threads
     _default_threads = None if n is None else int(n)
-    return lib.pfsph_threads(_default_threads or 0)
+    if _default_threads is not None and _default_threads < 1:
+        raise errors.InputError("threads: %d; at least 1, or None for OpenMP's own" % _default_threads)
+    return lib.pfsph_threads(_default_threads or _initial_threads)
 
 
 def threads():
@@ -88,10 +90,10 @@ class ParticleSet:
     diffuse set, and the fluid of a scene with emitters, grow during steps (their memory moves):
     they are given as copies (``zero_copy`` is False), so no array ever views freed memory.
     An array taken before a step still views the set's memory after it: the same slots, now in
-    the new order (take it again). ``positions`` and ``velocities`` are (n, 3) arrays: views
-    when the library's three component arrays lie equally spaced in memory (numpy then strides
-    between them), copies otherwise; ``x``, ``y``, ``z``, ``vx``, ``vy``, ``vz`` are always
-    views (where the set is zero-copy)."""
+    the new order, and its length is the count when it was taken (take it again). The library
+    stores the three components of a vector in three arrays: ``positions`` and ``velocities``
+    are (n, 3) copies (12 bytes a particle in single precision); ``x``, ``y``, ``z``, ``vx``,
+    ``vy``, ``vz`` and ``components(name)`` are the views."""
 
     def __init__(self, sim, name):
         self._sim = sim
@@ -135,7 +137,8 @@ class ParticleSet:
         return a
 
     def field(self, name):
-        """Field ``name`` (one of ``field_names``): 1 component as an (n,) array, 3 as (n, 3)."""
+        """Field ``name`` (one of ``field_names``): 1 component as an (n,) array (a view where the
+        set is zero-copy), 3 as an (n, 3) copy."""
         f = self._field(name)
         if f.components == 1:
             return self._component(f, 0)
@@ -148,23 +151,19 @@ class ParticleSet:
         return tuple(self._component(f, k) for k in range(f.components))
 
     def _vector(self, f):
-        dtype = _DTYPES[f.type]
-        n = int(f.count)
-        if n == 0:
-            a = np.empty((0, 3), dtype)
-            a.flags.writeable = False
-            return a
-        a0, a1, a2 = (_addr(f.data[k]) for k in range(3))
-        if self.zero_copy and a1 - a0 == a2 - a1 and a1 != a0:
-            # one strided view over the three arrays: row i is (x[i], y[i], z[i])
-            return np.asarray(_View(self._sim._handle, a0, dtype, (n, 3), (int(f.stride), a1 - a0), True))
-        a = np.stack([self._component(f, k) for k in range(3)], axis=1)
+        # the library keeps x, y and z in three separate arrays (structure of arrays): an (n, 3)
+        # array of them is a copy, always (a view only when the three happened to lie equally
+        # spaced would make a snapshot sometimes and a live view other times)
+        a = np.empty((int(f.count), 3), _DTYPES[f.type])
+        for k in range(3):
+            if f.count:
+                a[:, k] = self._component(f, k)
         a.flags.writeable = False
         return a
 
     # the fields by their Python names (docs/python.md lists them per set)
-    positions = property(lambda self: self.field("position"), doc="(n, 3) positions [m] (z = 0 in 2D)")
-    velocities = property(lambda self: self.field("velocity"), doc="(n, 3) velocities [m/s]")
+    positions = property(lambda self: self.field("position"), doc="(n, 3) positions [m] (z = 0 in 2D), a copy")
+    velocities = property(lambda self: self.field("velocity"), doc="(n, 3) velocities [m/s], a copy")
     ids = property(lambda self: self.field("id"), doc="(n,) uint32 particle ids, stable across steps")
     phase = property(lambda self: self.field("phase" if self.name != "diffuse" else "type"),
                      doc="(n,) uint8 phase index in the scene's phases (diffuse: type 0 spray, 1 foam, 2 bubble)")
@@ -278,7 +277,7 @@ class Simulation:
         _check(rc, err, scene=True)
         self._handle = _Handle(simp[0])
         self._threads = threads
-        self._busy = threading.Lock()
+        self._busy = threading.RLock()  # one stepping thread; a callback may step
         scene_c = lib.pfsph_sim_scene(simp[0])
         self.fps = lib.pfsph_scene_fps(scene_c)
         self.end_time = lib.pfsph_scene_end_time(scene_c)
@@ -355,7 +354,7 @@ class Simulation:
 
     def _guard(self):
         if not self._busy.acquire(blocking=False):
-            raise errors.Error("the simulation is being stepped by another thread")
+            raise errors.Error("the simulation is being stepped by another thread (one stepper at a time)")
 
     def step(self, t_limit=None):
         """One time step, never past ``t_limit`` [s] (default: the next frame time, so that
@@ -389,11 +388,7 @@ class Simulation:
                     self._land(ptr, tf, err)
                     self._next_frame += 1
                     if callback is not None:
-                        self._busy.release()
-                        try:
-                            callback(self, self._next_frame - 1)
-                        finally:
-                            self._guard()
+                        callback(self, self._next_frame - 1)
             if lib.pfsph_sim_time(ptr) < t_end - _tol(t_end):
                 self._land(ptr, t_end, err)
             self._next_frame = max(self._next_frame, int(math.floor(self.time * self.fps + 1e-9)) + 1)
