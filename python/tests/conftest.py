@@ -31,7 +31,7 @@ def column():
     return copy.deepcopy(COLUMN)
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def pfsph_bin():
     b = os.environ.get("PFSPH_BIN") or os.path.join(ROOT, "build", "pfsph")
     if not (os.path.isfile(b) and os.access(b, os.X_OK)):

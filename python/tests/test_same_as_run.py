@@ -9,13 +9,16 @@ import numpy as np
 import pytest
 
 import pfsph
+from conftest import COLUMN
 
 
-@pytest.fixture
-def program_run(column, pfsph_bin, tmp_path):
-    path = tmp_path / "column.json"
-    path.write_text(json.dumps(column))
-    out = tmp_path / "run"
+@pytest.fixture(scope="module")
+def program_run(pfsph_bin, tmp_path_factory):
+    """The column run by the program once for this module's tests: (scene file, run dir)."""
+    tmp = tmp_path_factory.mktemp("program")
+    path = tmp / "column.json"
+    path.write_text(json.dumps(COLUMN))
+    out = tmp / "run"
     subprocess.run([pfsph_bin, "run", str(path), "-o", str(out), "--quiet"], check=True)
     return path, out
 
