@@ -115,9 +115,9 @@ def main():
     ax.set(xlabel="t [s]", ylabel="contact angle [deg]", ylim=(0, 180), title="each drop over time (averaged: grey)")
     ax.legend(fontsize=8, loc="lower right")
     ax = fig.add_subplot(gs[1, :])
-    span = 0.28  # shown half width around each plate's middle [m]
+    span = PLATE / 2  # the whole plate
     for k, (target, mean, _, _, _, p) in enumerate(results):
-        off = k * (2 * span + 0.08) - PLATE / 2 + span
+        off = k * (PLATE + 0.06)
         ax.scatter(p[:, 0] + off, p[:, 1], s=1)
         ax.plot([PLATE / 2 - span + off, PLATE / 2 + span + off], [-0.003, -0.003], "k-", lw=2)
         ax.text(PLATE / 2 + off, -0.02, "%g -> %.0f deg" % (target, mean), ha="center", va="top")
