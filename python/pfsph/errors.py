@@ -55,8 +55,8 @@ def _split(msg):
 def _last_key(path):
     if not path or path == "$":
         return None
-    tail = path.rsplit(".", 1)[-1]
-    return None if tail.endswith("]") and "[" == tail[:1] else tail.split("[", 1)[0] or None
+    # "$.phases[0].viscosity" -> "viscosity", "$.fluid[2]" -> "fluid"
+    return path.rsplit(".", 1)[-1].split("[", 1)[0] or None
 
 
 _CODES = {-2: InputError, -3: UnstableError, -5: PfsphIOError, -12: PfsphMemoryError}
