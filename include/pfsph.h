@@ -169,6 +169,17 @@ int pfsph_sim_field_write(pfsph_sim *sim, const char *set, const char *name, pfs
  * a non-zero z in 2D; the values stay as written, to be corrected before stepping. */
 int pfsph_sim_fields_written(pfsph_sim *sim, pfsph_error *err);
 
+/* ---- output ---- */
+
+/* Write the particles as they are now as frame `frame` of the run directory dir, with the
+ * frame writer of `pfsph run` (so the files equal the program's for the same state):
+ * dir/frames/<set>_NNNNN.{vtp,ply} in the scene's "output" formats and fields (boundary
+ * particles at frame 0 only, as the program does; diffuse, bodies and liquid surfaces when the
+ * scene has them) and the .pvd collections; dir and dir/frames are made if missing. frame < 0:
+ * the frame of the simulated time, floor(t * fps) / output.frame_interval. Does not change the
+ * particles; writes no stats.csv or summary.json. PFSPH_EINPUT for a path too long, PFSPH_EIO. */
+int pfsph_sim_write_frame(pfsph_sim *sim, const char *dir, int frame, pfsph_error *err);
+
 /* ---- rigid bodies ---- */
 
 int pfsph_sim_body_count(const pfsph_sim *sim);

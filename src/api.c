@@ -1,10 +1,15 @@
 /* The embedding API (include/pfsph.h): status texts, version, scenes, the simulation's life and
  * clock, bodies. A thin layer over the library's own modules; particle fields: api_fields.c. */
+#include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "pfsph.h"
 #include "pfsph/bodies.h"
+#include "pfsph/io.h"
+#include "pfsph/run.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 
@@ -107,6 +112,26 @@ void pfsph_sim_stats_get(const pfsph_sim *sim, pfsph_stats *out)
                          .ekin = st->ekin,
                          .iterations = st->iterations,
                          .div_iterations = st->div_iterations};
+}
+
+/* ---- output: the run's own frame writer (run.c) ---- */
+
+int pfsph_sim_write_frame(pfsph_sim *sim, const char *dir, int frame, pfsph_error *err)
+{
+    if (!sim || !dir || !dir[0]) return pfsph_fail(err, PFSPH_EINPUT, "write frame: no simulation or directory");
+    /* the writer's paths are dir/frames/<set>_NNNNN.ext in PFSPH_PATH_LEN + 64 bytes */
+    if (strlen(dir) >= PFSPH_PATH_LEN)
+        return pfsph_fail(err, PFSPH_EINPUT, "write frame: directory name longer than %d bytes", PFSPH_PATH_LEN - 1);
+    const pfsph_scene *s = pfsph_sim_scene(sim);
+    if (frame < 0) {
+        double k = floor(pfsph_sim_time(sim) * s->fps + 1e-9);
+        if (!(k <= PFSPH_MAX_FRAMES)) return pfsph_fail(err, PFSPH_EINPUT, "write frame: t * fps = %g frames", k);
+        frame = (int)k / s->output.frame_interval;
+    }
+    char path[PFSPH_PATH_LEN + 16];
+    snprintf(path, sizeof path, "%s/frames", dir);
+    int rc = pfsph_mkdirs(path, err);
+    return rc ? rc : pfsph__run_write_frame(sim, dir, frame, err);
 }
 
 /* ---- rigid bodies ---- */

@@ -795,3 +795,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     }
     return rc;
 }
+
+int pfsph__run_write_frame(pfsph_sim *sim, const char *dir, int frame, pfsph_error *err)
+{
+    return write_frame(pfsph_sim_scene(sim), dir, frame, sim, err);
+}

@@ -48,4 +48,8 @@ typedef struct pfsph_run_opts {
  * output), PFSPH_EUNSTABLE (blow-up; frames written so far are kept) or PFSPH_ENOMEM. */
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err);
 
+/* One frame as pfsph_run writes it (its own writer), into dir/frames, which must exist: for the
+ * embedding API's pfsph_sim_write_frame. */
+int pfsph__run_write_frame(pfsph_sim *sim, const char *dir, int frame, pfsph_error *err);
+
 #endif

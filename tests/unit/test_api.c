@@ -1,6 +1,6 @@
 /* The embedding API (include/pfsph.h): status texts, scene errors as the loader words them, and
  * the field accessors against the simulation's own arrays (count, stride, type, the very
- * pointers), bad names, writing fluid velocities between steps. */
+ * pointers), bad names, writing fluid velocities between steps, frames as the program writes them. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -257,12 +257,50 @@ static void test_write(void **state)
     pfsph_sim_free(sim);
 }
 
+/* pfsph_sim_write_frame: the program's frame writer, so frames written by an embedder that
+ * advances frame by frame are the program's files byte for byte (frame < 0: the current one). */
+static void test_write_frame(void **state)
+{
+    (void)state;
+    char scene[512], prog[512], mine[512], cmd[2048], out[4096];
+    snprintf(scene, sizeof scene, "%s/frames.json", tu_tmpdir());
+    snprintf(prog, sizeof prog, "%s/program_run", tu_tmpdir());
+    snprintf(mine, sizeof mine, "%s/api_run/sub", tu_tmpdir());
+    assert_int_equal(tu_write_file(scene, SCENE), 0);
+    snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet", tu_pfsph_bin(), scene, prog);
+    if (tu_run(cmd, out, sizeof out) != 0) fail_msg("%s: %s", cmd, out);
+    pfsph_error err = {0};
+    pfsph_scene *s = NULL;
+    if (pfsph_scene_new_file(&s, scene, &err)) fail_msg("%s", err.msg);
+    pfsph_sim *sim = NULL;
+    if (pfsph_sim_new(&sim, s, &err)) fail_msg("%s", err.msg);
+    pfsph_scene_free(s);
+    /* frame 0 by number, then the frames of t = 0.01 and 0.02 s by the clock (dir made) */
+    assert_int_equal(pfsph_sim_write_frame(sim, mine, 0, &err), PFSPH_OK);
+    for (int k = 1; k <= 2; k++) {
+        if (pfsph_sim_advance(sim, k / 100.0, &err)) fail_msg("%s", err.msg);
+        if (pfsph_sim_write_frame(sim, mine, -1, &err)) fail_msg("%s", err.msg);
+    }
+    char a[600], b[600];
+    snprintf(a, sizeof a, "%s/frames", prog);
+    snprintf(b, sizeof b, "%s/frames", mine);
+    tu_assert_same_file(a, b, "fluid_00000.vtp");
+    tu_assert_same_file(a, b, "boundary_00000.vtp");
+    tu_assert_same_file(a, b, "fluid_00001.vtp");
+    tu_assert_same_file(a, b, "fluid_00002.vtp");
+    tu_assert_same_file(prog, mine, "fluid.pvd");
+    /* a directory that cannot be made: the writer's error */
+    assert_int_equal(pfsph_sim_write_frame(sim, "/proc/no/such", 0, &err) != PFSPH_OK, 1);
+    assert_int_equal(pfsph_sim_write_frame(sim, NULL, 0, &err), PFSPH_EINPUT);
+    pfsph_sim_free(sim);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_strerror),  cmocka_unit_test(test_scene_errors), cmocka_unit_test(test_fields),
-        cmocka_unit_test(test_bad_names), cmocka_unit_test(test_write),
+        cmocka_unit_test(test_bad_names), cmocka_unit_test(test_write),        cmocka_unit_test(test_write_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
