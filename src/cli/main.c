@@ -30,7 +30,8 @@ static const char *USAGE =
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH] [--particles] [--all-walls] [--no-legend]\n"
-    "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
+    "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--droplet R]\n"
+    "                  [--threads N]\n"
     "       pfsph export RUN_DIR --houdini\n"
     "       pfsph view [SCENE | RUN_DIR] [--screenshot FILE --frames N] [...]\n"
     "       pfsph --version\n"
@@ -106,7 +107,8 @@ static const char *HELP_RENDER =
     "  -h, --help              this text\n";
 
 static const char *HELP_MESH =
-    "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
+    "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--droplet R]\n"
+    "                  [--threads N]\n"
     "\n"
     "Reconstruct the liquid surface of every fluid frame of RUN_DIR (a finished or stopped\n"
     "run) into RUN_DIR/frames/liquid_NNNNN.{ply,obj,vtp}, one closed mesh per fluid phase with\n"
@@ -116,6 +118,8 @@ static const char *HELP_MESH =
     "  --formats LIST  comma-separated: ply, obj, vtp (default: the scene's, else ply,vtp)\n"
     "  --smooth N      Taubin smoothing passes of the mesh, 0..100 (default 0)\n"
     "  --isotropic     spherical kernels instead of anisotropic ones\n"
+    "  --droplet R     blob radius of isolated particles in spacings (default 0.62: their own\n"
+    "                  volume; -1: unbounded, the meshes before issue 33)\n"
     "  --threads N     OpenMP threads (the meshes are the same bytes for any count)\n"
     "  -h, --help      this text\n"
     "\n"
@@ -664,6 +668,14 @@ static int cmd_mesh(int argc, char **argv)
             if (i + 1 >= argc || *end || v < 0 || v > 100)
                 return usage_error("--smooth: '%s' is not 0..100", i + 1 < argc ? argv[i + 1] : "");
             so.smoothing = (int)v;
+            i++;
+            set = true;
+        } else if (!strcmp(a, "--droplet")) {
+            char *end = NULL;
+            double v = i + 1 < argc ? strtod(argv[i + 1], &end) : -2;
+            if (i + 1 >= argc || *end || !(v == -1 || (v >= 0 && v <= 2)))
+                return usage_error("--droplet: '%s' is not -1 or 0..2", i + 1 < argc ? argv[i + 1] : "");
+            so.droplet = v;
             i++;
             set = true;
         } else if (!strcmp(a, "--isotropic")) so.isotropic = set = true;

@@ -223,6 +223,7 @@ static int mesh_particles(const pfsph_surface_output *so, int dim, double spacin
     o.isotropic = so->isotropic;
     o.smooth_iters = so->smoothing;
     o.cell = so->cell;
+    o.droplet = so->droplet;
     char path[PFSPH_PATH_LEN + 64];
     if (dim == 2) { /* the outline as polylines, VTP only (docs/surfaces.md#2d-contours) */
         pfsph_surface_contour c;

@@ -25,6 +25,10 @@ typedef struct pfsph_surface_opts {
                           * flat lattice surface lies half a spacing beyond its last layer */
     bool isotropic;    /* plain spherical kernels, no PCA (for comparison) */
     int smooth_iters;  /* Taubin mesh smoothing passes (0: none) */
+    double droplet;    /* blob radius of an isolated particle (fewer than 5 particles within the
+                          * PCA radius, itself included) / d: its kernel shrinks until a lone one
+                          * meshes as a ball of this radius (0: (3 / 4 pi)^(1/3) = 0.62, the ball of
+                          * the particle's own volume d^3; < 0: no bound, kn kernels as before) */
 } pfsph_surface_opts;
 
 /* A welded triangle mesh, counter-clockwise seen from outside (the liquid). */
