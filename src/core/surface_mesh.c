@@ -408,5 +408,6 @@ void pfsph_surface_mesh_free(pfsph_surface_mesh *m)
     free(m->n);
     free(m->tri);
     free(m->phase);
+    free(m->vel);
     memset(m, 0, sizeof *m);
 }

@@ -127,6 +127,15 @@ def read_mesh(path):
     return pts, polys, cd
 
 
+def read_mesh_velocity(path):
+    """The liquid's velocity at the vertices of a surface file, (n, 3) or None (older runs, OBJ)."""
+    if path.endswith(".ply"):
+        v, _, _, _ = read_ply(path)
+        return np.stack([v["vx"], v["vy"], v["vz"]], axis=1) if "vx" in v else None
+    _, pd, _, _, _ = read_vtp(path)
+    return pd.get("velocity")
+
+
 def y_up_to_z_up(p):
     """pfsph is y-up, Blender z-up: (x, y, z) -> (x, -z, y), a rotation (faces keep their side)."""
     p = np.asarray(p, dtype=np.float64)
