@@ -99,11 +99,11 @@ def _material(name, color, kind):
     m.use_nodes = True
     bsdf = m.node_tree.nodes.get("Principled BSDF")
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.05 if kind == "water" else 0.6
-    if kind == "water":
+    bsdf.inputs["Roughness"].default_value = 0.05 if kind == "water" else 0.02 if kind == "glass" else 0.6
+    if kind in ("water", "glass"):
         key = "Transmission" if "Transmission" in bsdf.inputs else "Transmission Weight"
         bsdf.inputs[key].default_value = 1.0
-        bsdf.inputs["IOR"].default_value = 1.33
+        bsdf.inputs["IOR"].default_value = 1.33 if kind == "water" else 1.0  # thin glass: no lensing
     m.diffuse_color = (*color, 1.0)
     return m
 
@@ -313,8 +313,11 @@ def load_run(run_dir, max_frames=None):
             for p in ob.data.polygons:
                 p.use_smooth = shape in ("sphere", "cylinder")
             col = next((ph.get("color") for ph in phases if ph.get("name") == phase and ph.get("color")), None)
-            ob.data.materials.append(_material(f"pfsph solid {phase}", tuple(col) if col else (0.5, 0.45, 0.4),
-                                               "solid"))
+            if shape == "container":  # a tank is glass: the water inside shows from any side
+                ob.data.materials.append(_material("pfsph glass", tuple(col) if col else (0.9, 0.95, 1.0), "glass"))
+            else:
+                ob.data.materials.append(_material(f"pfsph solid {phase}", tuple(col) if col else (0.5, 0.45, 0.4),
+                                                   "solid"))
             report["solids"][ob.name] = len(ob.data.polygons)
         report["sets"]["solids"] = len(coll.objects)
 
