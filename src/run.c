@@ -23,6 +23,7 @@
 #include "pfsph/checkpoint.h"
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
+#include "pfsph/solid_mesh.h"
 #include "pfsph/thermostat.h"
 
 /* ---- the run directory: lock, what is pfsph's, temporaries, the run's own end ---- */
@@ -84,7 +85,7 @@ static int frame_file(const char *name, long *num)
         while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
         if (!digits) return 0;
         if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj") ||
-            !strcmp(p, ".geo")) {
+            !strcmp(p, ".geo") || !strcmp(p, ".bgeo")) {
             *num = v;
             return 1;
         }
@@ -108,7 +109,8 @@ static int is_temporary(const char *name)
 static int is_run_file(const char *name)
 {
     static const char *const names[] = {"scene.json", "summary.json",       "stats.csv",  "bodies.csv",
-                                        RUN_JSON,     "diffuse_counts.png", "frames.mp4", NULL};
+                                        RUN_JSON,     "diffuse_counts.png", "frames.mp4", "solids.ply",
+                                        "solids.obj", "solids.bgeo",        "solids.geo", NULL};
     for (int k = 0; names[k]; k++)
         if (!strcmp(name, names[k])) return 1;
     size_t len = strlen(name); /* the .pvd collections (io/meshing.c) */
@@ -376,6 +378,10 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, pfsph_s
         if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
         else /* the static part; body particles go to bodies_NNNNN every frame */
             rc = write_boundary_part(s, dir, "boundary", frame, c->boundary, pfsph_bodies_first_id(B), false, t, err);
+    }
+    if (!rc && frame == 0) { /* the static solids as meshes, once (docs/artists.md#static-solids) */
+        int nsolid;
+        rc = pfsph_write_solids(s, dir, &nsolid, err);
     }
     const pfsph_particles *d = pfsph_sim_diffuse(sim);
     if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);

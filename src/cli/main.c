@@ -30,8 +30,9 @@ static const char *USAGE =
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH] [--particles] [--all-walls] [--no-legend]\n"
-    "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
-    "       pfsph export RUN_DIR --houdini\n"
+    "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--droplet R]\n"
+    "                  [--threads N]\n"
+    "       pfsph export RUN_DIR --houdini [--ascii | --classic]\n"
     "       pfsph view [SCENE | RUN_DIR] [--screenshot FILE --frames N] [...]\n"
     "       pfsph --version\n"
     "       pfsph help [COMMAND]    (or pfsph COMMAND --help)\n";
@@ -106,7 +107,8 @@ static const char *HELP_RENDER =
     "  -h, --help              this text\n";
 
 static const char *HELP_MESH =
-    "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--threads N]\n"
+    "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--droplet R]\n"
+    "                  [--threads N]\n"
     "\n"
     "Reconstruct the liquid surface of every fluid frame of RUN_DIR (a finished or stopped\n"
     "run) into RUN_DIR/frames/liquid_NNNNN.{ply,obj,vtp}, one closed mesh per fluid phase with\n"
@@ -116,6 +118,8 @@ static const char *HELP_MESH =
     "  --formats LIST  comma-separated: ply, obj, vtp (default: the scene's, else ply,vtp)\n"
     "  --smooth N      Taubin smoothing passes of the mesh, 0..100 (default 0)\n"
     "  --isotropic     spherical kernels instead of anisotropic ones\n"
+    "  --droplet R     blob radius of isolated particles in spacings (default 0.62: their own\n"
+    "                  volume; -1: unbounded, the meshes before issue 33)\n"
     "  --threads N     OpenMP threads (the meshes are the same bytes for any count)\n"
     "  -h, --help      this text\n"
     "\n"
@@ -123,13 +127,18 @@ static const char *HELP_MESH =
     "for a 2D run is refused (exit status 2).\n";
 
 static const char *HELP_EXPORT =
-    "usage: pfsph export RUN_DIR --houdini\n"
+    "usage: pfsph export RUN_DIR --houdini [--ascii | --classic]\n"
     "\n"
-    "Write every fluid frame of RUN_DIR as Houdini ASCII geometry, RUN_DIR/frames/fluid_NNNNN.geo:\n"
-    "points with the attributes v, density, pressure, phase and id (id is 0 unless the run wrote\n"
-    "ids: output.fields [\"id\"]). docs/surfaces.md#houdini.\n"
+    "Write RUN_DIR's frames as Houdini geometry (binary JSON .bgeo, which Houdini 12 and later\n"
+    "read natively): frames/fluid_NNNNN (points ordered by id: P v id pscale density pressure\n"
+    "phase), diffuse_NNNNN (P v id pscale type lifetime), liquid_NNNNN (the liquid mesh: P N v,\n"
+    "primitive phase), bodies_NNNNN (body surfaces: primitive body, name) and RUN_DIR/solids\n"
+    "(the static solids' triangles). Ids need frames with ids (output.fields [\"id\"]).\n"
+    "docs/artists.md#houdini.\n"
     "\n"
-    "  --houdini   the format (the only one so far)\n"
+    "  --houdini   the format\n"
+    "  --ascii     JSON text (.geo) instead of binary\n"
+    "  --classic   the classic ASCII .geo (PGEOMETRY V5), fluid points only\n"
     "  -h, --help  this text\n";
 
 static int is_help(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h"); }
@@ -614,12 +623,15 @@ static int cmd_export(int argc, char **argv)
 {
     const char *dir = NULL;
     bool houdini = false;
+    int format = PFSPH_HOUDINI_BGEO;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         if (is_help(a)) {
             fputs(HELP_EXPORT, stdout);
             return 0;
         } else if (!strcmp(a, "--houdini")) houdini = true;
+        else if (!strcmp(a, "--ascii")) format = PFSPH_HOUDINI_JSON;
+        else if (!strcmp(a, "--classic")) format = PFSPH_HOUDINI_CLASSIC;
         else if (a[0] == '-') return usage_error("unknown option '%s'", a);
         else if (!dir) dir = a;
         else return usage_error("unexpected argument '%s'", a);
@@ -627,13 +639,24 @@ static int cmd_export(int argc, char **argv)
     if (!dir) return usage_error("%s", "export needs a run directory");
     if (!houdini) return usage_error("%s", "export needs a format: --houdini");
     pfsph_error err = {0};
-    int count = 0;
-    int rc = pfsph_export_houdini(dir, &count, &err);
+    pfsph_houdini_report r;
+    int rc = pfsph_export_houdini(dir, format, &r, &err);
     if (rc) {
         print_error(NULL, err.msg);
         return exit_code(rc);
     }
-    printf("exported %d frames into %s/frames/fluid_NNNNN.geo\n", count, dir);
+    const char *ext = format == PFSPH_HOUDINI_BGEO ? "bgeo" : "geo";
+    printf("exported %d frames into %s/frames/fluid_NNNNN.%s", r.frames, dir, ext);
+    if (r.diffuse) printf(", %d diffuse_NNNNN", r.diffuse);
+    if (r.liquid) printf(", %d liquid_NNNNN", r.liquid);
+    if (r.bodies) printf(", %d bodies_NNNNN", r.bodies);
+    if (r.solids) printf(", %d solids in %s/solids.%s", r.solids, dir, ext);
+    printf("\n");
+    if (r.no_ids)
+        fprintf(stderr,
+                "pfsph: note: the frames carry no particle ids, so the points have no `id` and keep the "
+                "frames' order, which changes from frame to frame; run with \"output\": {\"fields\": "
+                "[\"id\"]} for stable ids (docs/artists.md#houdini)\n");
     return 0;
 }
 
@@ -664,6 +687,14 @@ static int cmd_mesh(int argc, char **argv)
             if (i + 1 >= argc || *end || v < 0 || v > 100)
                 return usage_error("--smooth: '%s' is not 0..100", i + 1 < argc ? argv[i + 1] : "");
             so.smoothing = (int)v;
+            i++;
+            set = true;
+        } else if (!strcmp(a, "--droplet")) {
+            char *end = NULL;
+            double v = i + 1 < argc ? strtod(argv[i + 1], &end) : -2;
+            if (i + 1 >= argc || *end || !(v == -1 || (v >= 0 && v <= 2)))
+                return usage_error("--droplet: '%s' is not -1 or 0..2", i + 1 < argc ? argv[i + 1] : "");
+            so.droplet = v;
             i++;
             set = true;
         } else if (!strcmp(a, "--isotropic")) so.isotropic = set = true;

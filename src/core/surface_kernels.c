@@ -137,8 +137,8 @@ static void pca_sums(const float *bx, const float *by, const float *bz, size_t n
 /* Kernels of n points: centres, anisotropy, in grid cells of cellw. surf[i] (may be NULL) gets
  * 1 for particles near the surface (few neighbours, offset centre of mass or flattened
  * neighbourhood). *rad_max: the largest support radius [cells]. */
-int pfsph__surface_kernels(const double *x, size_t n, const pfsph_surface_opts *o, kern *K, uint8_t *surf,
-                           float *rad_max)
+int pfsph__surface_kernels(const double *x, size_t n, const pfsph_surface_opts *o, double drop_scale, kern *K,
+                           uint8_t *surf, float *rad_max)
 {
     const double d = o->spacing, r = o->pca_radius, h = o->support * d, cellw = o->cell * d;
     const double ks = 1.0 / lattice_sigma(o->pca_radius), cs = 0.5 * r * d; /* cells of half the radius */
@@ -268,6 +268,8 @@ int pfsph__surface_kernels(const double *x, size_t n, const pfsph_surface_opts *
                 k->g[4] = (float)(0.5 * (G[1][2] + G[2][1]));
                 k->g[5] = (float)G[2][2];
                 k->amp = (float)(d * d * d / (h * h * h * scale[0] * scale[1] * scale[2]) * 8.0 / PI);
+                /* an isolated particle: a droplet of its own volume (pfsph__surface_drop_scale) */
+                if (drop_scale > 0 && cnt < PFSPH__ISOLATED && !o->isotropic) k->amp *= (float)drop_scale;
                 double smax = scale[0] > scale[1] ? scale[0] : scale[1];
                 if (scale[2] > smax) smax = scale[2];
                 k->rad = (float)(h * smax / cellw);
@@ -299,6 +301,20 @@ static float kern_at(const kern *k, const double p[3])
     return k->amp * cubic_q2(t0 * t0 + t1 * t1 + t2 * t2);
 }
 
+/* A lone kn kernel's field at the distance R d is amp W(R / u), u = kn h / d its support in units
+ * of d and amp = (8 / pi) u^-3. Scaling its amplitude by iso / (amp W(R / u)) puts the iso-level
+ * at R d. The amplitude, not the support, shrinks: the field stays as smooth as the kn kernel's,
+ * which the marching follows closely (a narrower kernel's steep rim came out 25 % wider in radius
+ * than the level set it stood for, at a cell of d / 2). Splashsurf and Houdini shrink or drop such
+ * blobs likewise. Returns 0 when no bound applies (the kn blob is not larger than R d). */
+double pfsph__surface_drop_scale(const pfsph_surface_opts *o, double iso)
+{
+    if (o->isotropic || o->droplet < 0) return 0;
+    const double R = o->droplet > 0 ? o->droplet : cbrt(3.0 / (4.0 * PI)), u = o->kn * o->support;
+    const double f = 8.0 / PI / (u * u * u) * (double)cubic_q2((float)((R / u) * (R / u)));
+    return f > iso ? iso / f : 0;
+}
+
 double pfsph_surface_calibrate_iso(const pfsph_surface_opts *in)
 {
     pfsph_surface_opts o;
@@ -319,7 +335,7 @@ double pfsph_surface_calibrate_iso(const pfsph_surface_opts *in)
                 x[3 * c + 2] = -k * d;
                 c++;
             }
-    if (pfsph__surface_kernels(x, n, &o, K, NULL, &rmax)) goto out;
+    if (pfsph__surface_kernels(x, n, &o, 0, K, NULL, &rmax)) goto out;
     /* the true surface of the slab is half a spacing above its top layer; average over one
      * lattice cell of lateral positions */
     double sum = 0;

@@ -130,7 +130,7 @@ static void blocks_free(block *bl, size_t nb)
 
 /* one phase's points into m (appended) */
 static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph_surface_opts *o, float iso,
-                           const mc_table *T, pfsph_surface_mesh *m, pfsph_error *err)
+                           double drop, const mc_table *T, pfsph_surface_mesh *m, pfsph_error *err)
 {
     const double cellw = o->cell * o->spacing;
     kern *K = malloc((n ? n : 1) * sizeof *K);
@@ -148,7 +148,7 @@ static int reconstruct_one(const double *x, size_t n, uint8_t phase, const pfsph
     if (!K || !surf || !kc) goto out;
     float rmax;
     double w0 = omp_get_wtime();
-    if ((rc = pfsph__surface_kernels(x, n, o, K, surf, &rmax))) goto out;
+    if ((rc = pfsph__surface_kernels(x, n, o, drop, K, surf, &rmax))) goto out;
     double w1 = omp_get_wtime();
     m->seconds[0] += w1 - w0;
     /* the kernels by block: a block reads the block cells within R of its own */
@@ -373,6 +373,7 @@ int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n, c
                               i / 3, fabs(x[i]), reach);
     }
     const float iso = (float)(o.iso > 0 ? o.iso : pfsph_surface_calibrate_iso(&o));
+    const double drop = pfsph__surface_drop_scale(&o, iso);
     mc_table *T = malloc(sizeof *T);
     if (!T) return pfsph_fail(err, PFSPH_ENOMEM, "surface: out of memory");
     pfsph__surface_mc_table(T);
@@ -392,7 +393,7 @@ int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n, c
                 memcpy(xs + 3 * k, x + 3 * i, 3 * sizeof *xs);
                 k++;
             }
-        rc = reconstruct_one(xs, k, (uint8_t)p, &o, iso, T, m, err);
+        rc = reconstruct_one(xs, k, (uint8_t)p, &o, iso, drop, T, m, err);
     }
     free(xs);
     free(T);
@@ -407,5 +408,6 @@ void pfsph_surface_mesh_free(pfsph_surface_mesh *m)
     free(m->n);
     free(m->tri);
     free(m->phase);
+    free(m->vel);
     memset(m, 0, sizeof *m);
 }

@@ -111,9 +111,14 @@ int pfsph__surface_bmap_put(bmap *m, int64_t key, int32_t v);
 
 /* Kernels of n points: centres, anisotropy, in grid cells of cellw. surf[i] (may be NULL) gets
  * 1 for particles near the surface (few neighbours, offset centre of mass or flattened
- * neighbourhood). *rad_max: the largest support radius [cells]. */
-int pfsph__surface_kernels(const double *x, size_t n, const pfsph_surface_opts *o, kern *K, uint8_t *surf,
-                           float *rad_max);
+ * neighbourhood). *rad_max: the largest support radius [cells]. drop_scale > 0: the amplitude
+ * factor of isolated particles' kn kernels (pfsph__surface_drop_scale). */
+int pfsph__surface_kernels(const double *x, size_t n, const pfsph_surface_opts *o, double drop_scale, kern *K,
+                           uint8_t *surf, float *rad_max);
+/* The amplitude factor at which one lone kn kernel's field crosses `iso` at the radius
+ * o->droplet d, when that is smaller than the kn kernel's blob; 0 when no bound applies. */
+double pfsph__surface_drop_scale(const pfsph_surface_opts *o, double iso);
+#define PFSPH__ISOLATED 5 /* fewer particles than this within the PCA radius (itself included) */
 
 /* node values of a block: the rows (b, c) set in `rows` (bit b + 8 c), the others 0 */
 void pfsph__surface_block_field(block *bl, const kern *K, const grid *kg, int R, uint64_t rows);

@@ -25,6 +25,7 @@ int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, doubl
                       "element vertex %zu\nproperty float x\nproperty float y\nproperty float z\n"
                       "property float nx\nproperty float ny\nproperty float nz\n",
                       m->nverts);
+    if (m->vel) pfsph__enc_printf(&e, "property float vx\nproperty float vy\nproperty float vz\n");
     pfsph__enc_printf(&e,
                       "element face %zu\nproperty list uchar uint vertex_indices\nproperty uchar phase\n"
                       "end_header\n",
@@ -35,6 +36,8 @@ int pfsph_write_surface_ply(const char *path, const pfsph_surface_mesh *m, doubl
             pfsph__enc_put(&e, &v, 4);
         }
         for (int k = 0; k < 3; k++) pfsph__enc_put(&e, &m->n[3 * i + k], 4);
+        if (m->vel)
+            for (int k = 0; k < 3; k++) pfsph__enc_put(&e, &m->vel[3 * i + k], 4);
     }
     const uint8_t three = 3;
     for (size_t t = 0; t < m->ntris; t++) {
@@ -64,11 +67,12 @@ int pfsph_write_surface_obj(const char *path, const pfsph_surface_mesh *m, doubl
     return pfsph__enc_commit(&e, &af, err);
 }
 
-/* VTP PolyData of a mesh or an outline: points, Normals (point data), cells of `arity` indices
- * under `cells` ("Polys" or "Lines"), phase (cell data), TimeValue. Atomic. */
-static int write_polydata_vtp(const char *path, const double *v, const float *nrm, size_t nverts, const uint32_t *idx,
-                              const uint8_t *phase, size_t ncells, int arity, const char *cells, double time,
-                              pfsph_error *err)
+/* VTP PolyData of a mesh or an outline: points, Normals and velocity (when vel is not NULL) as
+ * point data, cells of `arity` indices under `cells` ("Polys" or "Lines"), phase (cell data),
+ * TimeValue. Atomic. */
+static int write_polydata_vtp(const char *path, const double *v, const float *nrm, const float *vel, size_t nverts,
+                              const uint32_t *idx, const uint8_t *phase, size_t ncells, int arity, const char *cells,
+                              double time, pfsph_error *err)
 {
     pfsph__afile af;
     pfsph__enc e;
@@ -91,6 +95,13 @@ static int write_polydata_vtp(const char *path, const double *v, const float *nr
                       "Name=\"Normals\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for (size_t i = 0; i < nverts; i++)
         pfsph__enc_printf(&e, "%.5f %.5f %.5f\n", nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]);
+    if (vel) {
+        pfsph__enc_printf(&e,
+                          "</DataArray>\n<DataArray type=\"Float32\" Name=\"velocity\" NumberOfComponents=\"3\" "
+                          "format=\"ascii\">\n");
+        for (size_t i = 0; i < nverts; i++)
+            pfsph__enc_printf(&e, "%.7g %.7g %.7g\n", vel[3 * i], vel[3 * i + 1], vel[3 * i + 2]);
+    }
     pfsph__enc_printf(
         &e, "</DataArray>\n</PointData>\n<%s>\n<DataArray type=\"UInt32\" Name=\"connectivity\" format=\"ascii\">\n",
         cells);
@@ -112,7 +123,7 @@ static int write_polydata_vtp(const char *path, const double *v, const float *nr
 
 int pfsph_write_surface_vtp(const char *path, const pfsph_surface_mesh *m, double time, pfsph_error *err)
 {
-    return write_polydata_vtp(path, m->v, m->n, m->nverts, m->tri, m->phase, m->ntris, 3, "Polys", time, err);
+    return write_polydata_vtp(path, m->v, m->n, m->vel, m->nverts, m->tri, m->phase, m->ntris, 3, "Polys", time, err);
 }
 
 /* ---- reader ---------------------------------------------------------------------------- */
@@ -149,18 +160,19 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
     const uint64_t nv = h.elem[0].count, nt = h.elem[1].count;
     const int idx_type = fp[0].type;
     if (nv >= (1u << 31) || nt >= (1u << 31)) BAD("too many vertices or faces");
-    int ix[3] = {-1, -1, -1}, in[3] = {-1, -1, -1}, itag = -1;
-    static const char *const pn[6] = {"x", "y", "z", "nx", "ny", "nz"};
+    int ix[3] = {-1, -1, -1}, in[3] = {-1, -1, -1}, iv[3] = {-1, -1, -1}, itag = -1;
+    static const char *const pn[9] = {"x", "y", "z", "nx", "ny", "nz", "vx", "vy", "vz"};
     for (int k = 0; k < nvp; k++)
-        for (int j = 0; j < 6; j++)
+        for (int j = 0; j < 9; j++)
             if (!strcmp(vp[k].name, pn[j])) {
                 if (vp[k].type != PFSPH__T_F32 && vp[k].type != PFSPH__T_F64)
                     BAD("property '%s' must be float or double", pn[j]);
                 if (j < 3) ix[j] = k;
-                else in[j - 3] = k;
+                else if (j < 6) in[j - 3] = k;
+                else iv[j - 6] = k;
             }
     if (ix[0] < 0 || ix[1] < 0 || ix[2] < 0) BAD("missing x, y or z");
-    const bool normals = in[0] >= 0 && in[1] >= 0 && in[2] >= 0;
+    const bool normals = in[0] >= 0 && in[1] >= 0 && in[2] >= 0, vels = iv[0] >= 0 && iv[1] >= 0 && iv[2] >= 0;
     /* the face's tag: the liquid's phase, or the body of a body surface */
     for (int k = 1; k < nfp; k++)
         if ((!strcmp(fp[k].name, "phase") || !strcmp(fp[k].name, "body")) && fp[k].type == PFSPH__T_U8) itag = k;
@@ -173,7 +185,8 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
     m->n = normals ? malloc(3 * (nv ? nv : 1) * sizeof *m->n) : NULL;
     m->tri = malloc(3 * (nt ? nt : 1) * sizeof *m->tri);
     m->phase = calloc(nt ? nt : 1, 1);
-    if (!m->v || (normals && !m->n) || !m->tri || !m->phase) {
+    m->vel = vels ? malloc(3 * (nv ? nv : 1) * sizeof *m->vel) : NULL;
+    if (!m->v || (normals && !m->n) || !m->tri || !m->phase || (vels && !m->vel)) {
         rc = pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
         goto done;
     }
@@ -183,6 +196,9 @@ int pfsph_read_surface_ply(const char *path, pfsph_surface_mesh *m, double *time
         if (normals)
             for (int k = 0; k < 3; k++)
                 m->n[3 * i + k] = (float)pfsph__get_as_double(vp[in[k]].type, d + vp[in[k]].offset);
+        if (vels)
+            for (int k = 0; k < 3; k++)
+                m->vel[3 * i + k] = (float)pfsph__get_as_double(vp[iv[k]].type, d + vp[iv[k]].offset);
     }
     for (size_t t = 0; t < nt; t++, d += frecord) {
         if (d[0] != 3) BAD("face %zu has %d vertices (triangles only)", t, d[0]);
@@ -205,7 +221,7 @@ done:
 
 int pfsph_write_contour_vtp(const char *path, const pfsph_surface_contour *c, double time, pfsph_error *err)
 {
-    return write_polydata_vtp(path, c->v, c->n, c->nverts, c->seg, c->phase, c->nsegs, 2, "Lines", time, err);
+    return write_polydata_vtp(path, c->v, c->n, NULL, c->nverts, c->seg, c->phase, c->nsegs, 2, "Lines", time, err);
 }
 
 static int mesh_particles(const pfsph_surface_output *so, int dim, double spacing, const char *dir, int frame,
@@ -223,6 +239,7 @@ static int mesh_particles(const pfsph_surface_output *so, int dim, double spacin
     o.isotropic = so->isotropic;
     o.smooth_iters = so->smoothing;
     o.cell = so->cell;
+    o.droplet = so->droplet;
     char path[PFSPH_PATH_LEN + 64];
     if (dim == 2) { /* the outline as polylines, VTP only (docs/surfaces.md#2d-contours) */
         pfsph_surface_contour c;
@@ -237,8 +254,23 @@ static int mesh_particles(const pfsph_surface_output *so, int dim, double spacin
     }
     pfsph_surface_mesh m;
     int rc = pfsph_surface_reconstruct(x, ps->phase, ps->n, &o, &m, err);
+    /* the liquid's velocity at the vertices (motion blur: docs/artists.md), from the particles
+     * within 2 spacings (a vertex lies about half a spacing beyond the outer layer) */
+    float *vel = rc ? NULL : malloc(3 * (ps->n ? ps->n : 1) * sizeof *vel);
+    if (!rc && !vel) rc = pfsph_fail(err, PFSPH_ENOMEM, "surface: out of memory");
+    for (size_t i = 0; !rc && i < ps->n; i++) {
+        vel[3 * i] = (float)ps->vx[i];
+        vel[3 * i + 1] = (float)ps->vy[i];
+        vel[3 * i + 2] = (float)ps->vz[i];
+    }
+    if (!rc && pfsph_surface_velocity(&m, x, vel, ps->n, 2 * spacing))
+        rc = pfsph_fail(err, PFSPH_ENOMEM, "surface: out of memory");
+    free(vel);
     free(x);
-    if (rc) return rc;
+    if (rc) {
+        pfsph_surface_mesh_free(&m);
+        return rc;
+    }
     if (so->ply) {
         snprintf(path, sizeof path, "%s/frames/liquid_%05d.ply", dir, frame);
         rc = pfsph_write_surface_ply(path, &m, time, err);
@@ -255,6 +287,8 @@ static int mesh_particles(const pfsph_surface_output *so, int dim, double spacin
     free(m.n);
     free(m.tri);
     free(m.phase);
+    free(m.vel);
+    m.vel = NULL;
     m.v = NULL;
     m.n = NULL;
     m.tri = NULL;

@@ -84,10 +84,8 @@ int pfsph__splat_add_set(pfsph__splat_set *ss, const cam *c, const pfsph_particl
         double rp = s->r / ssf;
         s->relief = (float)(rp <= 1.5 ? 0.0 : (rp >= 4.0 ? 1.0 : (rp - 1.5) / 2.5));
         if (kind == 1) {
-            /* walls recede in light grey unless their phase asks for a colour */
-            int ph = ps->phase[i];
-            if (ph < sc->nphases && sc->phases[ph].color_set) memcpy(s->col, sc->phases[ph].color, sizeof s->col);
-            else s->col[0] = 0.78f, s->col[1] = 0.78f, s->col[2] = 0.80f;
+            /* walls recede in light grey unless their phase asks for a colour (pfsph_wall_color) */
+            pfsph_wall_color(sc, ps->phase[i], s->col);
         } else if (kind == 2) {
             int t = ps->phase[i] < 3 ? ps->phase[i] : 0;
             memcpy(s->col, PFSPH__DIFFUSE_COL[t], sizeof s->col);
@@ -101,6 +99,29 @@ int pfsph__splat_add_set(pfsph__splat_set *ss, const cam *c, const pfsph_particl
         ss->n++;
     }
     return PFSPH_OK;
+}
+
+int pfsph_wall_color(const pfsph_scene *s, int phase, float out[3])
+{
+    static const float grey[3] = {0.78f, 0.78f, 0.80f};
+    /* muted, distinct from the fluids' palette and from the grey */
+    static const float plates[6][3] = {{0.80f, 0.55f, 0.35f}, {0.45f, 0.65f, 0.45f}, {0.55f, 0.50f, 0.75f},
+                                       {0.75f, 0.70f, 0.40f}, {0.40f, 0.65f, 0.70f}, {0.75f, 0.45f, 0.55f}};
+    memcpy(out, grey, sizeof grey);
+    if (phase < 0 || phase >= s->nphases) return 0;
+    if (s->phases[phase].color_set) {
+        memcpy(out, s->phases[phase].color, sizeof grey);
+        return 1;
+    }
+    int uncoloured = 0, rank = -1;
+    for (int p = 0; p < s->nphases; p++)
+        if (s->phases[p].kind == PFSPH_PHASE_SOLID && !s->phases[p].color_set) {
+            if (p == phase) rank = uncoloured;
+            uncoloured++;
+        }
+    if (uncoloured < 2 || rank <= 0) return 0;
+    memcpy(out, plates[(rank - 1) % 6], sizeof grey);
+    return 1;
 }
 
 /* Depth-test every splat overlapping rows [y0, y1) into its layer. */

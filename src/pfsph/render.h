@@ -72,6 +72,13 @@ typedef struct pfsph_cutaway {
 void pfsph_cutaway_init(pfsph_cutaway *cw, const struct pfsph_scene *s, const struct pfsph_particles *walls);
 bool pfsph_cutaway_hides(const pfsph_cutaway *cw, const double eye[3], const double p[3]);
 
+/* The colour walls of solid phase `phase` are drawn in (render and viewer): the phase's own
+ * "color"; else light grey for the first solid phase and, when a scene has several solid phases
+ * without colours (pf_wetting's five plates), a muted colour of its own for each of the others, so
+ * that they can be told apart (and named in the viewer's legend). Returns 1 when the colour is not
+ * the plain grey (the phase belongs in a legend). */
+int pfsph_wall_color(const struct pfsph_scene *s, int phase, float out[3]);
+
 /* Encode 8-bit RGB rows (top first) as a PNG and write it atomically. */
 int pfsph_write_png_rgb(const char *path, const uint8_t *rgb, int w, int h, pfsph_error *err);
 

@@ -106,6 +106,8 @@ typedef struct pfsph_surface_output {
     bool isotropic;     /* spherical kernels instead of Yu & Turk's anisotropic ones */
     int smoothing;      /* Taubin passes */
     double cell;        /* marching-cubes cell / spacing (0: default 0.5) */
+    double droplet;     /* blob radius of isolated particles / spacing (0: 0.62, their own volume;
+                         * -1: unbounded, as before issue 33); pfsph_surface_opts.droplet */
 } pfsph_surface_output;
 
 typedef struct pfsph_output {

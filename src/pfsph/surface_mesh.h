@@ -25,6 +25,10 @@ typedef struct pfsph_surface_opts {
                           * flat lattice surface lies half a spacing beyond its last layer */
     bool isotropic;    /* plain spherical kernels, no PCA (for comparison) */
     int smooth_iters;  /* Taubin mesh smoothing passes (0: none) */
+    double droplet;    /* blob radius of an isolated particle (fewer than 5 particles within the
+                          * PCA radius, itself included) / d: its kernel shrinks until a lone one
+                          * meshes as a ball of this radius (0: (3 / 4 pi)^(1/3) = 0.62, the ball of
+                          * the particle's own volume d^3; < 0: no bound, kn kernels as before) */
 } pfsph_surface_opts;
 
 /* A welded triangle mesh, counter-clockwise seen from outside (the liquid). */
@@ -34,6 +38,8 @@ typedef struct pfsph_surface_mesh {
     float *n;       /* 3 * nverts unit outward normals (minus the colour-field gradient) */
     uint32_t *tri;  /* 3 * ntris */
     uint8_t *phase; /* ntris: the fluid phase each face bounds */
+    float *vel;     /* 3 * nverts: the liquid's velocity at each vertex [m/s], or NULL (filled by
+                     * pfsph_surface_velocity, read back from a PLY's vx vy vz) */
     /* statistics of the last reconstruction (summed over phases) */
     size_t blocks;            /* sparse-grid blocks kept (those the surface crosses) */
     size_t blocks_peak;       /* blocks allocated at most at once */
@@ -56,6 +62,11 @@ int pfsph_surface_reconstruct(const double *x, const uint8_t *phase, size_t n, c
 double pfsph_surface_calibrate_iso(const pfsph_surface_opts *o);
 
 void pfsph_surface_mesh_free(pfsph_surface_mesh *m);
+
+/* m->vel (allocated here): at each vertex the particles' velocities v (3n, [m/s]) at x (3n, [m])
+ * averaged with the weights (1 - r^2 / R^2)^3 over the particles within R (Shepard); 0 where none
+ * is. Deterministic (each vertex sums its particles in one fixed order). PFSPH_ENOMEM. */
+int pfsph_surface_velocity(pfsph_surface_mesh *m, const double *x, const float *v, size_t n, double R);
 
 /* A 2D liquid's outline: closed polylines in the plane z = 0, as segments with the liquid on
  * their left (counter-clockwise around the liquid, clockwise around a hole). */

@@ -6,7 +6,7 @@
 
 #include "scene/scene_parser.h"
 
-/* output.surface: true, false or {"formats", "smoothing", "isotropic", "cell"} */
+/* output.surface: true, false or {"formats", "smoothing", "isotropic", "cell", "droplet"} */
 static int parse_surface(parser *p, const cJSON *v)
 {
     pfsph_surface_output *o = &p->s->output.surface;
@@ -14,12 +14,16 @@ static int parse_surface(parser *p, const cJSON *v)
     const char *P = "$.output.surface";
     if (cJSON_IsBool(v)) o->on = cJSON_IsTrue(v);
     else if (cJSON_IsObject(v)) {
-        static const char *const keys[] = {"formats", "smoothing", "isotropic", "cell", NULL};
+        static const char *const keys[] = {"formats", "smoothing", "isotropic", "cell", "droplet", NULL};
         TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
         o->on = true;
         TRY(pfsph__json_int(v, P, "smoothing", 0, 100, &o->smoothing, &p->ctx));
         TRY(pfsph__json_bool(v, P, "isotropic", &o->isotropic, &p->ctx));
         TRY(pfsph__json_number(v, P, "cell", 0.2, 2.0, &o->cell, &p->ctx));
+        TRY(pfsph__json_number(v, P, "droplet", -1, 2.0, &o->droplet, &p->ctx));
+        if (o->droplet < 0 && o->droplet != -1)
+            return pfsph__json_fail(&p->ctx, "$.output.surface.droplet",
+                                    "expected -1 (no bound), 0 (default) or a radius in spacings up to 2");
         const cJSON *f = get(v, "formats");
         if (f) {
             if (!cJSON_IsArray(f) || !cJSON_GetArraySize(f))
@@ -38,7 +42,8 @@ static int parse_surface(parser *p, const cJSON *v)
             }
         }
     } else
-        return pfsph__json_fail(&p->ctx, P, "expected true, false or an object (formats, smoothing, isotropic, cell)");
+        return pfsph__json_fail(&p->ctx, P,
+                                "expected true, false or an object (formats, smoothing, isotropic, cell, droplet)");
     /* 2D: the outline as VTP polylines only (docs/surfaces.md#2d-contours) */
     if (o->on && p->s->dim == 2) {
         if (get(v, "formats") && (o->ply || o->obj))

@@ -88,8 +88,7 @@ static size_t add_sprites(pfsph_vapp *A, size_t n0, const pfsph_particles *ps, d
         float col[3] = {0.8f, 0.2f, 0.8f};
         int ph = ps->phase[i];
         if (kind == 1) {
-            if (ph < sc->nphases && sc->phases[ph].color_set) memcpy(col, sc->phases[ph].color, sizeof col);
-            else col[0] = 0.78f, col[1] = 0.78f, col[2] = 0.80f;
+            pfsph_wall_color(sc, ph, col);
         } else if (kind == 2) {
             memcpy(col, PFSPH__DIFFUSE_COL[ph < 3 ? ph : 0], sizeof col);
         } else if (kind == 3 || A->by == PFSPH_VBY_PHASE) {

@@ -90,8 +90,9 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi)
         panel_text(A, 6 * s, y, s, line, INK);
         y += lh;
     }
-    snprintf(line, sizeof line, "FLUID %zu  WALLS %zu  BODIES %zu  DIFFUSE %zu%s%s%s", f->fluid.n, f->walls.n,
-             f->bodies.n, f->diffuse.n, A->show_walls ? "" : "  (WALLS HIDDEN)",
+    /* particles per set; bodies counted as bodies (their particles in brackets) */
+    snprintf(line, sizeof line, "FLUID %zu  WALLS %zu  BODIES %d (%zu PARTICLES)  DIFFUSE %zu%s%s%s", f->fluid.n,
+             f->walls.n, sc->nbodies, f->bodies.n, f->diffuse.n, A->show_walls ? "" : "  (WALLS HIDDEN)",
              A->show_bodies ? "" : "  (BODIES HIDDEN)", A->show_diffuse ? "" : "  (DIFFUSE HIDDEN)");
     panel_text(A, 6 * s, y, s, line, INK);
     const bool meshes = !A->is_live && sc->dim == 3 && (A->rf.liquid.ntris || A->rf.bmesh.ntris);
@@ -109,8 +110,9 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi)
     } else if (A->by == PFSPH_VBY_PHASE) {
         float yy = by;
         for (int p = sc->nphases - 1; p >= 0; p--) {
-            if (sc->phases[p].kind == PFSPH_PHASE_SOLID && !sc->phases[p].color_set) continue;
             float col[4] = {sc->phases[p].color[0], sc->phases[p].color[1], sc->phases[p].color[2], 1};
+            /* solids: those drawn in a colour of their own (pfsph_wall_color), not the grey */
+            if (sc->phases[p].kind == PFSPH_PHASE_SOLID && !pfsph_wall_color(sc, p, col)) continue;
             pfsph_vdraw_rect(A->draw, bx, yy, 6 * s, 5 * s, col);
             panel_text(A, bx + 9 * s, yy, s, sc->phases[p].name, INK);
             yy -= lh;

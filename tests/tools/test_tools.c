@@ -93,7 +93,7 @@ static void test_paraview(void **state)
     assert_non_null(j);
     assert_non_null(strstr(j, "\"steps\": 3"));
     assert_non_null(strstr(j, "\"cell_arrays\": [\"phase\"]"));
-    assert_non_null(strstr(j, "\"point_arrays\": [\"Normals\"]"));
+    assert_non_null(strstr(j, "\"point_arrays\": [\"Normals\", \"velocity\"]"));
 }
 
 /* a 2D run's outline (liquid.pvd of VTP polylines): a time series with Normals and phase, as many
@@ -151,14 +151,21 @@ static void test_blender_load(void **state)
     (void)state;
     if (!have("blender")) tu_skip("no blender");
     char cmd[4096], out[16384], want[256], path[1400];
-    snprintf(cmd, sizeof cmd, "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_load.py' -- '%s'",
-             tu_source_dir(), g_run);
+    snprintf(cmd, sizeof cmd,
+             "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_load.py' -- '%s' --save '%s/x.blend'",
+             tu_source_dir(), g_run, g_run);
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     const char *j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
-    printf("meshed: %.400s\n", j);
+    printf("meshed: %.700s\n", j);
     assert_non_null(strstr(j, "\"frame_end\": 2, \"frame_start\": 0"));
-    assert_non_null(strstr(j, "\"objects\": 3"));
+    /* 3 liquid frames and the tank (RUN/solids.ply, issue 33 item 10), the liquid with velocities
+     * (item 12); no factory cube, camera or light: the scene's own stage (item 9) */
+    assert_non_null(strstr(j, "\"objects\": 4"));
+    assert_non_null(strstr(j, "\"solids\": 1"));
+    assert_non_null(strstr(j, "\"solid 0 container\": 60"));
+    assert_non_null(strstr(j, "\"liquid_velocity\": true"));
+    assert_non_null(strstr(j, "\"stage\": [\"pfsph camera\", \"pfsph floor\", \"pfsph sun\"]"));
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/frames/liquid_%05d.ply", g_run, k);
         long n = ply_faces(path);
@@ -166,6 +173,17 @@ static void test_blender_load(void **state)
         snprintf(want, sizeof want, "\"%d\": %ld", k, n);
         assert_non_null(strstr(j, want));
     }
+    /* the saved file: what opening it shows */
+    snprintf(cmd, sizeof cmd,
+             "blender -b --factory-startup -noaudio '%s/x.blend' --python-expr \"import bpy; "
+             "print('BLEND', bpy.context.scene.camera.name, sorted(o.name for o in bpy.data.objects "
+             "if not o.name.startswith('liquid_')))\"",
+             g_run);
+    assert_int_equal(tu_run(cmd, out, sizeof out), 0);
+    const char *b0 = strstr(out, "BLEND ");
+    assert_non_null(b0);
+    printf("%.300s\n", b0);
+    assert_non_null(strstr(b0, "BLEND pfsph camera ['pfsph camera', 'pfsph floor', 'pfsph sun', 'solid 0 container']"));
     /* without meshes: the particles as point clouds (one per frame, each with its instanced sphere) */
     snprintf(cmd, sizeof cmd, "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_load.py' -- '%s'",
              tu_source_dir(), g_points);
@@ -174,7 +192,7 @@ static void test_blender_load(void **state)
     assert_non_null(j);
     printf("points: %.400s\n", j);
     assert_non_null(strstr(j, "\"fluid points\": 6"));
-    assert_non_null(strstr(j, "\"objects\": 7"));
+    assert_non_null(strstr(j, "\"objects\": 8")); /* and the tank */
     /* a rigid body: its own object, keyed every frame, falling (Blender's z is pfsph's y) */
     snprintf(cmd, sizeof cmd, "blender -b --factory-startup -noaudio -P '%s/tools/blender/pfsph_load.py' -- '%s'",
              tu_source_dir(), g_bodies);
@@ -182,7 +200,7 @@ static void test_blender_load(void **state)
     j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
     printf("bodies: %.600s\n", j);
-    assert_non_null(strstr(j, "\"objects\": 4"));
+    assert_non_null(strstr(j, "\"objects\": 5")); /* 3 liquid frames, the ball, the tank */
     const char *b = strstr(j, "\"body ball\": {");
     assert_non_null(b);
     double zf = 0, zl = 0;

@@ -9,6 +9,7 @@
 
 #include "pfsph/io.h"
 #include "pfsph/render.h"
+#include "pfsph/scene.h"
 #include "testutil.h"
 
 typedef tu_img img;
@@ -314,12 +315,36 @@ static void test_render_video(void **state)
     assert_true(st.st_size > 100);
 }
 
+/* pf_wetting's five plates (uncoloured solid phases): the first stays grey, the other four get
+ * colours of their own, all different (issue 33 item 13); a lone uncoloured solid stays grey */
+static void test_wall_colors(void **state)
+{
+    (void)state;
+    pfsph_scene *s = malloc(sizeof *s);
+    pfsph_error err = {0};
+    char path[1200];
+    snprintf(path, sizeof path, "%s/scenes/pf_wetting.json", tu_source_dir());
+    assert_int_equal(pfsph_scene_load(s, path, &err), 0);
+    float c[6][3];
+    int coloured = 0;
+    for (int p = 1; p <= 5; p++) coloured += pfsph_wall_color(s, p, c[p]);
+    assert_int_equal(coloured, 4);
+    assert_true(c[1][0] == 0.78f && c[1][1] == 0.78f);
+    for (int p = 2; p <= 5; p++)
+        for (int q = 1; q < p; q++) assert_memory_not_equal(c[p], c[q], sizeof c[p]);
+    assert_int_equal(pfsph_wall_color(s, 0, c[0]), 0); /* not a solid: plain grey, no legend */
+    s->nphases = 2;                                    /* one uncoloured solid phase: grey */
+    assert_int_equal(pfsph_wall_color(s, 1, c[1]), 0);
+    free(s);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_2d),
         cmocka_unit_test(test_render_wall_color),
+        cmocka_unit_test(test_wall_colors),
         cmocka_unit_test(test_render_3d_default_camera),
         cmocka_unit_test(test_render_3d_scene_camera),
         cmocka_unit_test(test_render_errors),

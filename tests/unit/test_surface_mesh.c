@@ -270,6 +270,47 @@ static void test_far_drop(void **state)
     free(x);
 }
 
+/* A lone particle (a splash's spray) meshes as a droplet of about its own volume d^3 (the ball
+ * of radius (3 / 4 pi)^(1/3) d = 0.62 d), not as the kn kernel's blob of 0.87 d and 2.8 d^3 (issue
+ * 33 item 14); droplet < 0 restores the old blob. Radii from the enclosed volume: the blob is only
+ * 2-3 cells across, so its vertices scatter about the level set. */
+static void test_droplet_bound(void **state)
+{
+    (void)state;
+    const double c[3] = {0.0031, 0.0017, -0.0023}, D3 = D * D * D;
+    pfsph_surface_opts o;
+    pfsph_surface_opts_default(&o, D);
+    pfsph_error err = {0};
+    pfsph_surface_mesh m;
+    assert_int_equal(pfsph_surface_reconstruct(c, NULL, 1, &o, &m, &err), 0);
+    assert_int_equal(check_manifold(&m), 2);
+    double v = volume(&m) / D3, r = cbrt(3 * v / (4 * PI));
+    size_t nv = m.nverts;
+    pfsph_surface_mesh_free(&m);
+    o.droplet = -1;
+    assert_int_equal(pfsph_surface_reconstruct(c, NULL, 1, &o, &m, &err), 0);
+    double v0 = volume(&m) / D3, r0 = cbrt(3 * v0 / (4 * PI));
+    printf("lone particle: %zu vertices, volume %.2f d^3, radius %.3f d; unbounded %zu vertices, volume %.2f d^3, "
+           "radius %.3f d\n",
+           nv, v, r, m.nverts, v0, r0);
+    pfsph_surface_mesh_free(&m);
+    assert_true(fabs(v - 1) < 0.25);
+    assert_true(v0 > 2.5);
+    /* an explicit bound: 0.75 d; and two particles d apart still merge into one droplet */
+    o.droplet = 0.75;
+    assert_int_equal(pfsph_surface_reconstruct(c, NULL, 1, &o, &m, &err), 0);
+    v = volume(&m) / D3;
+    printf("bound 0.75 d: radius %.3f d\n", cbrt(3 * v / (4 * PI)));
+    assert_true(fabs(cbrt(3 * v / (4 * PI)) - 0.75) < 0.06);
+    pfsph_surface_mesh_free(&m);
+    o.droplet = 0;
+    const double two[6] = {c[0], c[1], c[2], c[0] + D, c[1], c[2]};
+    assert_int_equal(pfsph_surface_reconstruct(two, NULL, 2, &o, &m, &err), 0);
+    assert_int_equal(components(&m), 1);
+    printf("two particles d apart: one droplet of %.2f d^3\n", volume(&m) / D3);
+    pfsph_surface_mesh_free(&m);
+}
+
 /* 2D lattice points inside the disc |x - c| < R (z = 0) */
 static size_t disc(double *x, size_t at, const double c[2], double R)
 {
@@ -384,8 +425,9 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sphere),  cmocka_unit_test(test_box),      cmocka_unit_test(test_two_drops),
-        cmocka_unit_test(test_threads), cmocka_unit_test(test_far_drop), cmocka_unit_test(test_contour_2d),
+        cmocka_unit_test(test_sphere),        cmocka_unit_test(test_box),      cmocka_unit_test(test_two_drops),
+        cmocka_unit_test(test_threads),       cmocka_unit_test(test_far_drop), cmocka_unit_test(test_contour_2d),
+        cmocka_unit_test(test_droplet_bound),
     };
     return tu_run_group(tests, NULL, NULL);
 }

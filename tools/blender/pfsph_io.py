@@ -113,7 +113,10 @@ def read_particles(path):
     if path.endswith(".ply"):
         v, _, _, _ = read_ply(path)
         pts = np.stack([v["x"], v["y"], v["z"]], axis=1)
-        return pts, {k: a for k, a in v.items() if k not in ("x", "y", "z")}
+        fields = {k: a for k, a in v.items() if k not in ("x", "y", "z", "vx", "vy", "vz")}
+        if "vx" in v:  # one vector, as the VTP files have it
+            fields["velocity"] = np.stack([v["vx"], v["vy"], v["vz"]], axis=1)
+        return pts, fields
     pts, pd, _, _, _ = read_vtp(path)
     return pts, pd
 
@@ -125,6 +128,15 @@ def read_mesh(path):
         return np.stack([v["x"], v["y"], v["z"]], axis=1), f, ff
     pts, _, polys, cd, _ = read_vtp(path)
     return pts, polys, cd
+
+
+def read_mesh_velocity(path):
+    """The liquid's velocity at the vertices of a surface file, (n, 3) or None (older runs, OBJ)."""
+    if path.endswith(".ply"):
+        v, _, _, _ = read_ply(path)
+        return np.stack([v["vx"], v["vy"], v["vz"]], axis=1) if "vx" in v else None
+    _, pd, _, _, _ = read_vtp(path)
+    return pd.get("velocity")
 
 
 def y_up_to_z_up(p):

@@ -15,6 +15,7 @@ import sys
 
 import bpy
 import numpy as np
+from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pfsph_io  # noqa: E402
@@ -51,7 +52,10 @@ def _mesh_object(name, verts, faces, coll):
 def _add_point_attributes(me, fields):
     for k, a in fields.items():
         a = np.asarray(a)
-        if a.ndim == 1:
+        if a.ndim == 1 and a.dtype.kind in "iu":  # phase, type, id: integers
+            at = me.attributes.new(k, "INT", "POINT")
+            at.data.foreach_set("value", a.astype(np.int32))
+        elif a.ndim == 1:
             at = me.attributes.new(k, "FLOAT", "POINT")
             at.data.foreach_set("value", a.astype(np.float32))
         elif a.ndim == 2 and a.shape[1] == 3:
@@ -95,11 +99,11 @@ def _material(name, color, kind):
     m.use_nodes = True
     bsdf = m.node_tree.nodes.get("Principled BSDF")
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
-    bsdf.inputs["Roughness"].default_value = 0.05 if kind == "water" else 0.6
-    if kind == "water":
+    bsdf.inputs["Roughness"].default_value = 0.05 if kind == "water" else 0.02 if kind == "glass" else 0.6
+    if kind in ("water", "glass"):
         key = "Transmission" if "Transmission" in bsdf.inputs else "Transmission Weight"
         bsdf.inputs[key].default_value = 1.0
-        bsdf.inputs["IOR"].default_value = 1.33
+        bsdf.inputs["IOR"].default_value = 1.33 if kind == "water" else 1.0  # thin glass: no lensing
     m.diffuse_color = (*color, 1.0)
     return m
 
@@ -126,6 +130,71 @@ def _quat_rotate_inv(q, v):
                   [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                   [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
     return v @ R  # row vectors: (R^T v^T)^T = v R
+
+
+def clear_startup():
+    """Remove every object of the startup scene (Blender's default cube, camera and light): the
+    command line loads into a fresh file, where they would show instead of the water. Not called
+    by load_run, which adds to whatever scene is open."""
+    for o in list(bpy.data.objects):
+        bpy.data.objects.remove(o)
+    for m in list(bpy.data.meshes):
+        if not m.users:
+            bpy.data.meshes.remove(m)
+
+
+def _z_up(p):
+    return Vector((p[0], -p[2], p[1]))
+
+
+def setup_camera(scene_json):
+    """The scene's camera (scene.json "camera"), else one framing the domain as `pfsph render` does."""
+    cam = scene_json.get("camera", {})
+    dmin = scene_json.get("domain", {}).get("min", [0, 0, 0]) + [0]
+    dmax = scene_json.get("domain", {}).get("max", [1, 1, 1]) + [0]
+    ext = max(dmax[k] - dmin[k] for k in range(3))
+    target = cam.get("target", [(dmin[k] + dmax[k]) / 2 for k in range(3)])
+    eye = cam.get("eye", [target[0] + 0.35 * ext, target[1] + 0.45 * ext, target[2] + 1.4 * ext])
+    data = bpy.data.cameras.new("pfsph camera")
+    data.angle_y = cam.get("fov", 40) * math.pi / 180
+    data.sensor_fit = "VERTICAL"
+    ob = bpy.data.objects.new("pfsph camera", data)
+    bpy.context.scene.collection.objects.link(ob)
+    ob.location = _z_up(eye)
+    direction = _z_up(target) - ob.location
+    ob.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+    bpy.context.scene.camera = ob
+    sc = bpy.context.scene
+    sc.render.resolution_x, sc.render.resolution_y = int(cam.get("width", 640)), int(cam.get("height", 360))
+    return cam
+
+
+def setup_lights():
+    """A sun, a sky-grey world and a floor just below y = 0."""
+    sun = bpy.data.lights.new("pfsph sun", "SUN")
+    sun.energy = 3.0
+    ob = bpy.data.objects.new("pfsph sun", sun)
+    ob.rotation_euler = (0.7, 0.2, 0.6)
+    bpy.context.scene.collection.objects.link(ob)
+    world = bpy.data.worlds.new("pfsph world")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.6, 0.65, 0.7, 1.0)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.8
+    bpy.context.scene.world = world
+    plane = bpy.data.meshes.new("pfsph floor")
+    s = 50.0
+    plane.from_pydata([(-s, -s, 0), (s, -s, 0), (s, s, 0), (-s, s, 0)], [], [(0, 1, 2, 3)])
+    fl = bpy.data.objects.new("pfsph floor", plane)
+    fl.location.z = -0.002
+    fl.data.materials.append(_material("pfsph floor", (0.35, 0.35, 0.33), "solid"))
+    bpy.context.scene.collection.objects.link(fl)
+
+
+def setup_stage(scene_json):
+    """Camera, sun, world and floor, so that a saved .blend renders the run as pfsph_render does."""
+    cam = setup_camera(scene_json)
+    setup_lights()
+    return cam
 
 
 def load_run(run_dir, max_frames=None):
@@ -167,6 +236,10 @@ def load_run(run_dir, max_frames=None):
             if "phase" in ff:
                 at = ob.data.attributes.new("phase", "INT", "FACE")
                 at.data.foreach_set("value", ff["phase"].astype(np.int32))
+            vel = pfsph_io.read_mesh_velocity(liquid[k])
+            if vel is not None:  # Cycles blurs a mesh's motion by its "velocity" attribute (m/s)
+                _add_point_attributes(ob.data, {"velocity": vel})
+                report["liquid_velocity"] = True
             _show_only_on(ob, k, first, last)
             report["liquid_faces"][k] = int(len(t))
         report["sets"]["liquid"] = len(coll.objects)
@@ -202,6 +275,14 @@ def load_run(run_dir, max_frames=None):
             for i, name in enumerate(DIFFUSE_TYPES):
                 sel = kind == i if kind is not None else np.zeros(len(pts), bool)
                 ob = _mesh_object(f"{name}_{k:05d}", pfsph_io.y_up_to_z_up(pts[sel]), None, coll)
+                # every field as a point attribute (type, lifetime, velocity, ...): shaders and
+                # geometry nodes read them; "velocity" also blurs the points' motion in Cycles
+                _add_point_attributes(ob.data, {f: a[sel] for f, a in fields.items() if len(a) == len(pts)})
+                report.setdefault("diffuse_points", {}).setdefault(name, 0)
+                report["diffuse_points"][name] += int(sel.sum())
+                if len(ob.data.attributes):
+                    report["diffuse_attributes"] = sorted(a.name for a in ob.data.attributes
+                                                          if not a.name.startswith(".") and a.name != "position")
                 ob.instance_type = "VERTS"
                 inst = tpls[i].copy()
                 coll.objects.link(inst)
@@ -209,6 +290,36 @@ def load_run(run_dir, max_frames=None):
                 _show_only_on(ob, k, first, last)
                 _show_only_on(inst, k, first, last)
         report["sets"]["diffuse"] = len(coll.objects)
+
+    solids_ply = os.path.join(run_dir, "solids.ply")
+    if os.path.exists(solids_ply):
+        # the static solids (tank walls, obstacles): written once per run, one object each, in
+        # their phase's colour (scene.json "color"), shown on every frame
+        coll = _collection("solids", root)
+        v, t, ff, comments = pfsph_io.read_ply(solids_ply)
+        pts = np.stack([v["x"], v["y"], v["z"]], axis=1).astype(np.float64)
+        phases = scene_json.get("phases", [])
+        report["solids"] = {}
+        for c in comments:
+            w = c.split()
+            if len(w) < 4 or w[0] != "solid":  # solid K SHAPE PHASE
+                continue
+            i, shape, phase = int(w[1]), w[2], " ".join(w[3:])
+            sel = ff["solid"] == i
+            used = np.unique(t[sel])
+            remap = -np.ones(len(pts), np.int64)
+            remap[used] = np.arange(len(used))
+            ob = _mesh_object(f"solid {i} {shape}", pfsph_io.y_up_to_z_up(pts[used]), remap[t[sel]], coll)
+            for p in ob.data.polygons:
+                p.use_smooth = shape in ("sphere", "cylinder")
+            col = next((ph.get("color") for ph in phases if ph.get("name") == phase and ph.get("color")), None)
+            if shape == "container":  # a tank is glass: the water inside shows from any side
+                ob.data.materials.append(_material("pfsph glass", tuple(col) if col else (0.9, 0.95, 1.0), "glass"))
+            else:
+                ob.data.materials.append(_material(f"pfsph solid {phase}", tuple(col) if col else (0.5, 0.45, 0.4),
+                                                   "solid"))
+            report["solids"][ob.name] = len(ob.data.polygons)
+        report["sets"]["solids"] = len(coll.objects)
 
     bodies_csv = os.path.join(run_dir, "bodies.csv")
     surf = pfsph_io.frame_files(run_dir, "surfaces", ("ply",))
@@ -265,13 +376,19 @@ def _main(argv):
     args = argv[argv.index("--") + 1:] if "--" in argv else []
     if not args:
         print("usage: blender -b -P pfsph_load.py -- RUN_DIR [--save FILE.blend] [--report FILE.json]")
+        print("  clears the startup scene (default cube, camera, light), loads the run and adds its stage:")
+        print("  the scene's camera, a sun, a grey world and a floor")
         return 2
     run_dir, save, rep = args[0], None, None
     if "--save" in args:
         save = args[args.index("--save") + 1]
     if "--report" in args:
         rep = args[args.index("--report") + 1]
+    clear_startup()
     report = load_run(run_dir)
+    with open(os.path.join(run_dir, "scene.json")) as f:
+        setup_stage(json.load(f))
+    report["stage"] = sorted(o.name for o in bpy.context.scene.collection.objects)
     print("pfsph_load: " + json.dumps(report, sort_keys=True))
     if rep:
         with open(rep, "w") as f:

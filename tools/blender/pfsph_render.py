@@ -1,7 +1,7 @@
 # Render a pfsph run directory in Blender's background mode: PNG frames and an mp4 (ffmpeg).
 #   blender -b -P tools/blender/pfsph_render.py -- RUN_DIR OUT_DIR [--size WxH] [--samples N]
 #                                                  [--frames A:B] [--engine CYCLES|BLENDER_EEVEE]
-# The scene's camera (scene.json "camera", else one framing the domain), a sun and a sky-grey world,
+# The loader's stage (pfsph_load.setup_stage: the scene's camera, a sun, a sky-grey world, a floor),
 # water (glass-like), foam (white) and solids (grey). Cycles on the CPU by default: it needs no
 # display, so it works on a headless machine. docs/artists.md.
 import json
@@ -11,53 +11,9 @@ import subprocess
 import sys
 
 import bpy
-from mathutils import Vector
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import pfsph_load  # noqa: E402
-
-
-def _z_up(p):
-    return Vector((p[0], -p[2], p[1]))
-
-
-def setup_camera(scene_json):
-    cam = scene_json.get("camera", {})
-    dmin = scene_json.get("domain", {}).get("min", [0, 0, 0]) + [0]
-    dmax = scene_json.get("domain", {}).get("max", [1, 1, 1]) + [0]
-    ext = max(dmax[k] - dmin[k] for k in range(3))
-    target = cam.get("target", [(dmin[k] + dmax[k]) / 2 for k in range(3)])
-    eye = cam.get("eye", [target[0] + 0.35 * ext, target[1] + 0.45 * ext, target[2] + 1.4 * ext])
-    data = bpy.data.cameras.new("pfsph camera")
-    data.angle_y = cam.get("fov", 40) * 3.14159265 / 180
-    data.sensor_fit = "VERTICAL"
-    ob = bpy.data.objects.new("pfsph camera", data)
-    bpy.context.scene.collection.objects.link(ob)
-    ob.location = _z_up(eye)
-    direction = _z_up(target) - ob.location
-    ob.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
-    bpy.context.scene.camera = ob
-    return cam
-
-
-def setup_lights():
-    sun = bpy.data.lights.new("pfsph sun", "SUN")
-    sun.energy = 3.0
-    ob = bpy.data.objects.new("pfsph sun", sun)
-    ob.rotation_euler = (0.7, 0.2, 0.6)
-    bpy.context.scene.collection.objects.link(ob)
-    world = bpy.data.worlds.new("pfsph world")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.6, 0.65, 0.7, 1.0)
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.8
-    bpy.context.scene.world = world
-    plane = bpy.data.meshes.new("pfsph floor")
-    s = 50.0
-    plane.from_pydata([(-s, -s, 0), (s, -s, 0), (s, s, 0), (-s, s, 0)], [], [(0, 1, 2, 3)])
-    fl = bpy.data.objects.new("pfsph floor", plane)
-    fl.location.z = -0.002
-    fl.data.materials.append(pfsph_load._material("pfsph floor", (0.35, 0.35, 0.33), "solid"))
-    bpy.context.scene.collection.objects.link(fl)
 
 
 def main(argv):
@@ -68,13 +24,11 @@ def main(argv):
         return 2
     run_dir, out_dir = args[0], os.path.abspath(args[1])
     opt = {args[i]: args[i + 1] for i in range(2, len(args) - 1, 2)}
-    for o in bpy.data.objects:  # the factory scene's cube, light and camera
-        bpy.data.objects.remove(o)
+    pfsph_load.clear_startup()
     report = pfsph_load.load_run(run_dir)
     with open(os.path.join(run_dir, "scene.json")) as f:
         scene_json = json.load(f)
-    cam = setup_camera(scene_json)
-    setup_lights()
+    cam = pfsph_load.setup_stage(scene_json)
     sc = bpy.context.scene
     sc.render.engine = opt.get("--engine", "CYCLES")
     if sc.render.engine == "CYCLES":
