@@ -185,7 +185,12 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     /* fluid and boundary grids: a start per cell, and the boundary's byte per cell of cells
      * near it (pfsph_grid_near) */
     const double grid_bytes = 2 * (cells + 1) * sizeof(uint32_t) + cells;
-    const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary;
+    /* diffuse material: its set at its cap, with the spatial sort's keys and permutations (two
+     * of each), the permutation buffer and a keep flag (src/physics/diffuse.c); its per-fluid
+     * arrays are the step's scratch */
+    const double per_diffuse = P + 4 * sizeof(uint32_t) + sizeof(pfsph_real) + 1;
+    const double nd_max = s->diffuse.enabled && s->diffuse.max_particles > 0 ? (double)s->diffuse.max_particles : 0;
+    const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary + nd_max * per_diffuse;
     if (n_fluid) *n_fluid = (size_t)nf;
     if (n_boundary) *n_boundary = (size_t)nb;
     if (bytes) *bytes = part_bytes + grid_bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)(part_bytes + grid_bytes);

@@ -24,6 +24,10 @@ void pfsph_diffuse_destroy(pfsph_diffuse *d);
  * and age existing diffuse particles; remove expired ones and those outside the domain; then
  * emit new ones (their x, v are already at t+dt, Eqs. 21-22). Never writes the fluid. */
 void pfsph_diffuse_step(pfsph_diffuse *d, const pfsph_ctx *ctx);
+/* The same with the caller's per-fluid-particle arrays (each at least ctx->fluid->n): old[3]
+ * for the start-of-step positions, emit for the emitters' counts; they hold nothing before or
+ * after the call. */
+void pfsph_diffuse_step_in(pfsph_diffuse *d, const pfsph_ctx *ctx, pfsph_real *const old[3], uint32_t *emit);
 
 /* The live diffuse particles: phase[] = type (enum pfsph_diffuse_type), aux[] = remaining
  * lifetime [s], id stable for a particle's life and never reused. Owned by d. */

@@ -27,14 +27,18 @@ struct pfsph_diffuse {
     uint64_t created, refused;
     uint32_t *emit; /* per fluid particle: count, then exclusive prefix (scratch) */
     size_t emit_cap;
+    /* The step's arrays lent for one pfsph_diffuse_step_in (NULL otherwise): start-of-step
+     * positions and emit counts in the simulation's per-particle scratch instead of 16 B per
+     * fluid particle of the module's own (issue 28) */
+    pfsph_real *lent_old[3];
+    uint32_t *lent_emit;
     uint8_t *keep; /* per diffuse particle (scratch) */
     size_t keep_cap;
-    pfsph_real *ox, *oy, *oz; /* per fluid particle: start-of-step positions (scratch) */
+    pfsph_real *ox, *oy, *oz;             /* per fluid particle: start-of-step positions (own or lent) */
+    pfsph_real *own_ox, *own_oy, *own_oz; /* the module's own, when nothing is lent */
     size_t old_cap;
-    uint32_t *perm, *key; /* per diffuse particle: spatial sort (scratch) */
+    uint32_t *perm, *key, *perm2, *key2; /* per diffuse particle: spatial sort (scratch) */
     size_t perm_cap;
-    uint32_t *bins; /* per grid cell + 1: counting sort (scratch) */
-    size_t bins_cap;
     void *tmp; /* permutation scratch, 4 bytes per diffuse particle */
     size_t tmp_cap;
 };
@@ -67,12 +71,13 @@ void pfsph_diffuse_destroy(pfsph_diffuse *d)
     pfsph_particles_free(&d->ps);
     free(d->emit);
     free(d->keep);
-    free(d->ox);
-    free(d->oy);
-    free(d->oz);
+    free(d->own_ox);
+    free(d->own_oy);
+    free(d->own_oz);
     free(d->perm);
     free(d->key);
-    free(d->bins);
+    free(d->perm2);
+    free(d->key2);
     free(d->tmp);
     free(d);
 }
@@ -435,9 +440,12 @@ static void generate(pfsph_diffuse *d, const pfsph_ctx *ctx)
     /* At the cap nothing can be created: skip the potentials (refusals are then not counted). */
     if (nf == 0 || d->p.sampling_rate <= 0 || room == 0) return;
     bool ok;
-    d->emit = ensure(d->emit, &d->emit_cap, (size_t)nf, sizeof(uint32_t), &ok);
-    if (!ok) return;
-    uint32_t *cnt = d->emit;
+    uint32_t *cnt = d->lent_emit;
+    if (!cnt) {
+        d->emit = ensure(d->emit, &d->emit_cap, (size_t)nf, sizeof(uint32_t), &ok);
+        if (!ok) return;
+        cnt = d->emit;
+    }
 #pragma omp parallel for schedule(dynamic, 512)
     for (long i = 0; i < nf; i++) cnt[i] = emit_count(d, ctx, (size_t)i);
     uint64_t total = 0;
@@ -483,15 +491,25 @@ static void generate(pfsph_diffuse *d, const pfsph_ctx *ctx)
 static int prepare_old(pfsph_diffuse *d, const pfsph_ctx *ctx)
 {
     const pfsph_particles *f = ctx->fluid;
-    bool ok1, ok2, ok3;
-    size_t cap = d->old_cap;
-    d->ox = ensure(d->ox, &cap, f->n, sizeof(pfsph_real), &ok1);
-    cap = d->old_cap;
-    d->oy = ensure(d->oy, &cap, f->n, sizeof(pfsph_real), &ok2);
-    cap = d->old_cap;
-    d->oz = ensure(d->oz, &cap, f->n, sizeof(pfsph_real), &ok3);
-    if (!ok1 || !ok2 || !ok3) return PFSPH_ENOMEM;
-    d->old_cap = cap;
+    if (d->lent_old[0]) {
+        d->ox = d->lent_old[0];
+        d->oy = d->lent_old[1];
+        d->oz = d->lent_old[2];
+    } else {
+        bool ok1, ok2, ok3;
+        pfsph_real **own[3] = {&d->own_ox, &d->own_oy, &d->own_oz};
+        size_t cap = d->old_cap;
+        *own[0] = ensure(*own[0], &cap, f->n, sizeof(pfsph_real), &ok1);
+        cap = d->old_cap;
+        *own[1] = ensure(*own[1], &cap, f->n, sizeof(pfsph_real), &ok2);
+        cap = d->old_cap;
+        *own[2] = ensure(*own[2], &cap, f->n, sizeof(pfsph_real), &ok3);
+        if (!ok1 || !ok2 || !ok3) return PFSPH_ENOMEM;
+        d->old_cap = cap;
+        d->ox = d->own_ox;
+        d->oy = d->own_oy;
+        d->oz = d->own_oz;
+    }
     const pfsph_real dt = (pfsph_real)ctx->dt;
     const long n = (long)f->n;
 #pragma omp parallel for schedule(static)
@@ -511,14 +529,15 @@ static void sort_spatially(pfsph_diffuse *d, const pfsph_grid *g)
     pfsph_particles *ps = &d->ps;
     const size_t n = ps->n;
     if (n < 2) return;
-    bool ok1, ok2, ok3, ok4;
+    bool ok[5];
     size_t pc = d->perm_cap;
-    d->perm = ensure(d->perm, &pc, n, sizeof(uint32_t), &ok1);
-    pc = d->perm_cap;
-    d->key = ensure(d->key, &pc, n, sizeof(uint32_t), &ok2);
-    d->bins = ensure(d->bins, &d->bins_cap, g->ncells + 1, sizeof(uint32_t), &ok3);
-    d->tmp = ensure(d->tmp, &d->tmp_cap, n, sizeof(pfsph_real) > 4 ? sizeof(pfsph_real) : 4, &ok4);
-    if (!ok1 || !ok2 || !ok3 || !ok4) return; /* unsorted is still correct */
+    uint32_t **arr[4] = {&d->perm, &d->key, &d->perm2, &d->key2};
+    for (int k = 0; k < 4; k++) {
+        pc = d->perm_cap;
+        *arr[k] = ensure(*arr[k], &pc, n, sizeof(uint32_t), &ok[k]);
+    }
+    d->tmp = ensure(d->tmp, &d->tmp_cap, n, sizeof(pfsph_real) > 4 ? sizeof(pfsph_real) : 4, &ok[4]);
+    if (!ok[0] || !ok[1] || !ok[2] || !ok[3] || !ok[4]) return; /* unsorted is still correct */
     d->perm_cap = pc;
 #pragma omp parallel for schedule(static)
     for (long i = 0; i < (long)n; i++) {
@@ -529,13 +548,40 @@ static void sort_spatially(pfsph_diffuse *d, const pfsph_grid *g)
             c[a] = !(t > 0) ? 0 : (t >= (pfsph_real)g->nc[a] ? (size_t)g->nc[a] - 1 : (size_t)t);
         }
         d->key[i] = (uint32_t)((c[2] * (size_t)g->nc[1] + c[1]) * (size_t)g->nc[0] + c[0]);
+        d->perm[i] = (uint32_t)i;
     }
-    uint32_t *b = d->bins;
-    memset(b, 0, (g->ncells + 1) * sizeof(uint32_t));
-    for (size_t i = 0; i < n; i++) b[d->key[i] + 1]++;
-    for (size_t c = 0; c < g->ncells; c++) b[c + 1] += b[c];
-    for (size_t i = 0; i < n; i++) d->perm[b[d->key[i]]++] = (uint32_t)i;
-    pfsph_particles_permute(ps, d->perm, n, d->tmp);
+    /* A stable LSD radix sort, a byte of the cell key a pass: the order of a stable counting
+     * sort over the cells without its array of a count per cell (4 B per fluid grid cell: 1.1 GB
+     * for the 128 m cube of the diffuse paper's Table 1, issue 28) */
+    uint32_t *key = d->key, *perm = d->perm, *key2 = d->key2, *perm2 = d->perm2;
+    for (int shift = 0; shift < 32 && (g->ncells - 1) >> shift; shift += 8) {
+        size_t cnt[257] = {0};
+        for (size_t i = 0; i < n; i++) cnt[((key[i] >> shift) & 255u) + 1]++;
+        for (int b = 0; b < 256; b++) cnt[b + 1] += cnt[b];
+        for (size_t i = 0; i < n; i++) {
+            const size_t at = cnt[(key[i] >> shift) & 255u]++;
+            key2[at] = key[i];
+            perm2[at] = perm[i];
+        }
+        uint32_t *t = key;
+        key = key2;
+        key2 = t;
+        t = perm;
+        perm = perm2;
+        perm2 = t;
+    }
+    pfsph_particles_permute(ps, perm, n, d->tmp);
+}
+
+void pfsph_diffuse_step_in(pfsph_diffuse *d, const pfsph_ctx *ctx, pfsph_real *const old[3], uint32_t *emit)
+{
+    if (!d) return;
+    for (int a = 0; a < 3; a++) d->lent_old[a] = old[a];
+    d->lent_emit = emit;
+    pfsph_diffuse_step(d, ctx);
+    for (int a = 0; a < 3; a++) d->lent_old[a] = NULL;
+    d->lent_emit = NULL;
+    d->ox = d->oy = d->oz = NULL;
 }
 
 void pfsph_diffuse_step(pfsph_diffuse *d, const pfsph_ctx *ctx)
@@ -574,12 +620,17 @@ static int diffuse_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_err
     (void)state;
     (void)bad;
     (void)err;
-    pfsph_diffuse_step(st->df, st->ctx);
+    /* the accelerations' arrays hold nothing after the integrator (the next step writes them
+     * before it reads them), nor does the stages' shared scratch between stages */
+    pfsph_ctx *c = st->ctx;
+    pfsph_real *const old[3] = {c->ax, c->ay, c->az};
+    pfsph_diffuse_step_in(st->df, c, old, (uint32_t *)st->scratch[0]);
     return PFSPH_OK;
 }
 
 const pfsph_stage_ops pfsph_stage_diffuse = {.name = "diffuse",
                                              .slot = PFSPH_STAGE_DIFFUSE,
                                              .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_ORDER | PFSPH_D_DT,
-                                             .writes = PFSPH_D_DIFFUSE,
+                                             .writes = PFSPH_D_DIFFUSE | PFSPH_D_ACC, /* ACC: lent */
+                                             .nscratch = 1,
                                              .run = diffuse_run};
