@@ -207,6 +207,7 @@ void pfsph_ctx_set_model(pfsph_ctx *c, const pfsph_scene *s)
         c->domain_max[a] = s->domain_max[a];
     }
     c->seed = s->seed;
+    c->interactive = s->mode == PFSPH_MODE_INTERACTIVE;
     c->nphases = s->nphases;
     c->phases = s->phases;
     c->pairwise = &s->pairwise;

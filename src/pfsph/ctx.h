@@ -43,6 +43,7 @@ typedef struct pfsph_ctx {
     double gravity[3];                   /* m/s^2 */
     double domain_min[3], domain_max[3]; /* fluid leaving it is removed */
     uint64_t seed;                       /* for counter-based random numbers */
+    int interactive;                     /* the scene's mode is "interactive" (docs/interactive.md) */
     int nphases;
     const pfsph_phase *phases;             /* nphases entries */
     const pfsph_pairwise_params *pairwise; /* resolved; pairwise->enabled may be false */

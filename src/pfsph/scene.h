@@ -31,6 +31,10 @@ enum pfsph_shape {
  * and the time step shrinks by that factor; needed at density ratios of about 100 and more). */
 enum pfsph_pressure_scale { PFSPH_PRESSURE_PHASE = 0, PFSPH_PRESSURE_COMMON };
 
+/* The regime (docs/interactive.md): "physical" steps as the accuracy limits say; "interactive"
+ * takes steps of the order of a 1/30 s frame where the pair-force model stays stable. */
+enum pfsph_mode { PFSPH_MODE_PHYSICAL = 0, PFSPH_MODE_INTERACTIVE };
+
 /* A region of fluid particles. */
 typedef struct pfsph_block {
     int shape;             /* BOX or SPHERE (or CYLINDER) */
@@ -142,6 +146,7 @@ typedef struct pfsph_scene {
      * values, in the order of its row's keys */
     char solver[PFSPH_NAME_LEN];
     double solver_settings[PFSPH_SOLVER_MAX_KEYS];
+    int mode; /* enum pfsph_mode */
     /* time stepping */
     double cfl;            /* dt <= cfl * spacing / vmax */
     double dt_min, dt_max; /* s */

@@ -19,6 +19,7 @@
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 static const char *const kind_names[] = {"fluid", "gas", "solid", NULL};
 static const char *const pressure_scale_names[] = {"phase", "common", NULL}; /* enum order */
+static const char *const mode_names[] = {"physical", "interactive", NULL};   /* enum pfsph_mode */
 
 static int axis_index(const char *path, parser *p, const cJSON *obj, int *axis)
 {
@@ -589,9 +590,9 @@ static int parse_root(parser *p, const cJSON *root)
 {
     pfsph_scene *s = p->s;
     static const char *const keys[] = {
-        "name",     "dimension", "particle_radius", "support_factor", "gravity", "domain",  "solver",
-        "time",     "seed",      "threads",         "phases",         "fluid",   "solids",  "bodies",
-        "emitters", "pairwise",  "diffuse",         "output",         "camera",  "comment", NULL};
+        "name",    "dimension", "particle_radius", "support_factor", "gravity", "domain", "solver",   "time",
+        "seed",    "threads",   "phases",          "fluid",          "solids",  "bodies", "emitters", "pairwise",
+        "diffuse", "output",    "camera",          "comment",        "mode",    NULL};
     if (!cJSON_IsObject(root)) return pfsph__json_fail(&p->ctx, "$", "a scene must be a JSON object { ... }");
     TRY(pfsph__json_check_keys(root, "$", keys, &p->ctx));
     /* Dimension first: it decides how many components every vector has. */
@@ -611,9 +612,13 @@ static int parse_root(parser *p, const cJSON *root)
     if (seed != floor(seed)) return pfsph__json_fail(&p->ctx, "$.seed", "expected an integer, got %g", seed);
     s->seed = (uint64_t)seed;
     TRY(pfsph__json_int(root, "$", "threads", 0, 4096, &s->threads, &p->ctx));
+    TRY(json_enum(p, root, "$", "mode", mode_names, &s->mode));
     TRY(parse_domain(p, root));
     TRY(parse_solver(p, root));
     TRY(parse_time(p, root));
+    /* interactive: steps of up to half a 1/30 s frame unless the scene bounds them itself */
+    if (s->mode == PFSPH_MODE_INTERACTIVE && !(get(root, "time") && get(get(root, "time"), "dt_max")))
+        s->dt_max = 1.0 / 60;
     TRY(parse_phases(p, root));
     TRY(parse_solids(p, root));
     TRY(parse_fluid(p, root));

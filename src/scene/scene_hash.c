@@ -181,7 +181,7 @@ TABLE(film_table, FILM);
 #define T pfsph_scene
 #define SCENE(X) X(OA, source) X(OA, name)                                                          \
     X(F, dim) X(F, particle_radius) X(F, support_factor) X(A, gravity) X(A, domain_min)             \
-    X(A, domain_max) X(A, solver) X(A, solver_settings) X(F, cfl) X(F, dt_min) X(F, dt_max)         \
+    X(A, domain_max) X(A, solver) X(A, solver_settings) X(F, mode) X(F, cfl) X(F, dt_min) X(F, dt_max)         \
     X(O, end_time) X(F, fps) X(F, seed) X(O, threads) X(F, sound_speed) X(F, gamma)                 \
     X(F, pressure_scale) X(F, nphases) X(SN, phases, nphases) X(F, nblocks) X(SN, blocks, nblocks)    \
     X(F, nsolids) X(SN, solids, nsolids) X(F, nbodies) X(SN, bodies, nbodies) X(F, nemitters)       \

@@ -64,6 +64,7 @@ typedef struct pfsph_vlive {
     bool failed;
     char msg[1200];     /* the last error or refusal, for the overlay */
     double sps;         /* steps per second, over the last half second */
+    double rtf;         /* real-time factor: simulated s per wall s, over the last half second */
     uint64_t published; /* snapshots published */
 } pfsph_vlive;
 

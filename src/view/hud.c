@@ -35,7 +35,7 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi)
     float y = 6 * s;
     if (A->is_live) {
         pthread_mutex_lock(&A->L.mu);
-        double sps = A->L.sps;
+        double sps = A->L.sps, rtf = A->L.rtf;
         bool paused = A->L.paused, failed = A->L.failed;
         char msg[1200];
         snprintf(msg, sizeof msg, "%s", A->L.msg);
@@ -57,8 +57,9 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi)
         pthread_mutex_unlock(&A->L.mu);
         char fps[32] = "";
         if (A->fps > 0) snprintf(fps, sizeof fps, "  %.0f FPS", A->fps); /* none yet in the first half second */
-        snprintf(line, sizeof line, "LIVE  T=%.4f S  STEP %llu  %.1f STEPS/S%s%s", f->time,
-                 (unsigned long long)f->steps, sps, fps,
+        /* the real-time factor: simulated seconds per wall second (1 or more: real time) */
+        snprintf(line, sizeof line, "LIVE  T=%.4f S  STEP %llu  %.1f STEPS/S  %.2fX REAL TIME%s%s", f->time,
+                 (unsigned long long)f->steps, sps, rtf, fps,
                  failed       ? "  STOPPED"
                      : paused ? "  PAUSED"
                               : "");

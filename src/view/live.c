@@ -111,6 +111,7 @@ void *pfsph_vlive_main(void *arg)
     long frame = 0;
     double w0 = omp_get_wtime();
     uint64_t st0 = 0;
+    double t0 = pfsph_sim_time(L->sim); /* simulated time at w0 */
     publish(L);
     pthread_mutex_lock(&L->mu);
     while (!L->quit) {
@@ -133,6 +134,7 @@ void *pfsph_vlive_main(void *arg)
             L->msg[0] = 0;
             frame = 0;
             st0 = 0;
+            t0 = 0;
             w0 = omp_get_wtime();
             pthread_mutex_unlock(&L->mu);
             publish(L);
@@ -142,9 +144,11 @@ void *pfsph_vlive_main(void *arg)
         apply_cmds(L);
         if (L->failed || (L->paused && !L->step_once)) {
             L->sps = 0;
+            L->rtf = 0;
             pthread_cond_wait(&L->cv, &L->mu);
             w0 = omp_get_wtime();
             st0 = pfsph_sim_steps(L->sim);
+            t0 = pfsph_sim_time(L->sim);
             continue;
         }
         L->step_once = false;
@@ -169,7 +173,9 @@ void *pfsph_vlive_main(void *arg)
         if (now - w0 >= 0.5) {
             uint64_t st = pfsph_sim_steps(L->sim);
             L->sps = (double)(st - st0) / (now - w0);
+            L->rtf = (pfsph_sim_time(L->sim) - t0) / (now - w0);
             st0 = st;
+            t0 = pfsph_sim_time(L->sim);
             w0 = now;
         }
         if (!L->end_noted && pfsph_sim_time(L->sim) >= s0->end_time - 1e-12) {

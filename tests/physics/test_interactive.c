@@ -1,0 +1,178 @@
+/* The interactive scenes (issue 30, docs/interactive.md) run in their "interactive" mode without
+ * a blow-up, and what the paper shows still holds:
+ * - scenes/pf_wetting_3d_interactive.json, 4 s: five drops (12^3 particles each, no gravity) on
+ *   plates of 150, 120, 90, 60 and 30 degrees. Each drop's contact angle (tests/pf_measure.h,
+ *   pfm_drop_angle: a sphere fitted to the outline) is averaged over samples every 0.1 s in the
+ *   last second; the drops stand in the order of their targets (each flatter than the one
+ *   before), the angles of targets 60 degrees and above lie within 15 degrees of them, every
+ *   lowest particle lies within a spacing of its plate, and no particle leaves the domain. The
+ *   30 degree drop is not held to 15 degrees: the cold liquid stops it near 63 degrees
+ *   (docs/interactive.md, "Left to do").
+ * - scenes/pf_double_bubble_3d_interactive.json, 2 s: two soap bubbles driven together stay two
+ *   bubbles: each gas stays one connected component, no gas particle further than 2.5 of its
+ *   bubble's radii from its centroid, and the two gas centroids stay apart by more than a
+ *   radius (they touch and flatten, they do not merge).
+ * Knobs for studies: PF_WET and PF_BUBBLE (other scene files), PF_T (end time [s]), PF_ONLY
+ * (a cmocka test-name filter, e.g. "test_double_bubble"). */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pf_measure.h"
+#include "pfsph/scene.h"
+#include "pfsph/sim.h"
+#include "testutil.h"
+
+static pfsph_sim *load(const char *env, const char *rel, pfsph_scene *s)
+{
+    char path[1024];
+    const char *given = getenv(env);
+    if (given) snprintf(path, sizeof path, "%s", given);
+    else snprintf(path, sizeof path, "%s/%s", tu_source_dir(), rel);
+    pfsph_error err = {0};
+    int rc = pfsph_scene_load(s, path, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    assert_int_equal(s->mode, PFSPH_MODE_INTERACTIVE);
+    pfsph_sim *sim = NULL;
+    rc = pfsph_sim_create(&sim, s, &err);
+    if (rc) print_message("%s\n", err.msg);
+    assert_int_equal(rc, PFSPH_OK);
+    return sim;
+}
+
+static void test_wetting(void **state)
+{
+    (void)state;
+    static pfsph_scene s;
+    pfsph_sim *sim = load("PF_WET", "scenes/pf_wetting_3d_interactive.json", &s);
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    const double t_end = tu_env_num("PF_T", 4.0), dts = 0.1;
+    const int nd = s.nsolids, ns = (int)lround(t_end / dts);
+    assert_true(nd >= 1 && nd <= PFM_MAXDROP);
+    double x0[PFM_MAXDROP], x1[PFM_MAXDROP], target[PFM_MAXDROP], sum[PFM_MAXDROP] = {0}, low[PFM_MAXDROP];
+    int cnt[PFM_MAXDROP] = {0};
+    for (int q = 0; q < nd; q++) {
+        x0[q] = s.solids[q].min[0];
+        x1[q] = s.solids[q].max[0];
+        target[q] = s.pairwise.angle_deg[0][s.solids[q].phase];
+    }
+    for (int k = 1; k <= ns; k++) {
+        tu_advance(sim, dts * k);
+        char line[512];
+        int l = snprintf(line, sizeof line, "t = %.1f s, %llu steps:", pfsph_sim_time(sim),
+                         (unsigned long long)pfsph_sim_steps(sim));
+        for (int q = 0; q < nd; q++) {
+            const double th = pfm_drop_angle(c, x0[q], x1[q]);
+            low[q] = 1e30;
+            for (size_t i = 0; i < c->fluid->n; i++)
+                if (c->fluid->x[i] >= x0[q] && c->fluid->x[i] < x1[q])
+                    low[q] = fmin(low[q], c->fluid->y[i] / c->spacing);
+            if (dts * k > t_end - 1 + 1e-9 && isfinite(th)) sum[q] += th, cnt[q]++;
+            l += snprintf(line + l, sizeof line - (size_t)l, " %6.1f", th);
+        }
+        print_message("%s\n", line);
+    }
+    assert_int_equal(pfsph_sim_removed(sim), 0);
+    int ok = 1;
+    double prev = INFINITY;
+    for (int q = 0; q < nd; q++) {
+        const double mean = cnt[q] ? sum[q] / cnt[q] : NAN;
+        print_message("target %5.1f deg: measured %6.1f deg (%d samples), lowest particle %.2f d\n", target[q], mean,
+                      cnt[q], low[q]);
+        ok &= (target[q] < 60 || fabs(mean - target[q]) <= 15) && low[q] < 1.0 && mean < prev;
+        prev = mean;
+    }
+    assert_true(ok);
+    pfsph_sim_destroy(sim);
+}
+
+/* A gas in 3D: its centroid, its connected components (links shorter than h) and its
+ * farthest particle from the centroid. */
+typedef struct gas3 {
+    double c[3], rmax;
+    int components;
+} gas3;
+
+static int uf_root(int *par, int i)
+{
+    while (par[i] != i) i = par[i] = par[par[i]];
+    return i;
+}
+
+static void gas_measure(const pfsph_ctx *c, int phase, gas3 *g)
+{
+    const pfsph_particles *f = c->fluid;
+    const double h2 = (double)c->h * (double)c->h;
+    size_t *idx = malloc(f->n * sizeof *idx);
+    int *par = malloc(f->n * sizeof *par);
+    assert_non_null(idx);
+    assert_non_null(par);
+    size_t m = 0;
+    g->c[0] = g->c[1] = g->c[2] = 0;
+    for (size_t i = 0; i < f->n; i++)
+        if (f->phase[i] == phase) {
+            idx[m] = i;
+            par[m] = (int)m;
+            g->c[0] += f->x[i], g->c[1] += f->y[i], g->c[2] += f->z[i];
+            m++;
+        }
+    for (int a = 0; a < 3; a++) g->c[a] /= m ? (double)m : 1;
+    g->rmax = 0;
+    for (size_t a = 0; a < m; a++) {
+        const size_t i = idx[a];
+        const double dx = f->x[i] - g->c[0], dy = f->y[i] - g->c[1], dz = f->z[i] - g->c[2];
+        g->rmax = fmax(g->rmax, sqrt(dx * dx + dy * dy + dz * dz));
+        for (size_t b = a + 1; b < m; b++) {
+            const size_t j = idx[b];
+            const double ex = f->x[i] - f->x[j], ey = f->y[i] - f->y[j], ez = f->z[i] - f->z[j];
+            if (ex * ex + ey * ey + ez * ez < h2) par[uf_root(par, (int)a)] = uf_root(par, (int)b);
+        }
+    }
+    g->components = 0;
+    for (size_t a = 0; a < m; a++) g->components += uf_root(par, (int)a) == (int)a;
+    free(idx);
+    free(par);
+}
+
+static void test_double_bubble(void **state)
+{
+    (void)state;
+    static pfsph_scene s;
+    pfsph_sim *sim = load("PF_BUBBLE", "scenes/pf_double_bubble_3d_interactive.json", &s);
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    const double t_end = tu_env_num("PF_T", 2.0), dts = 0.1;
+    const int ns = (int)lround(t_end / dts);
+    int gas[2], ng = 0;
+    for (int p = 0; p < s.nphases && ng < 2; p++)
+        if (s.phases[p].kind == PFSPH_PHASE_GAS) gas[ng++] = p;
+    assert_int_equal(ng, 2);
+    const double R = s.blocks[0].radius;
+    int ok = 1;
+    for (int k = 1; k <= ns; k++) {
+        tu_advance(sim, dts * k);
+        gas3 b[2];
+        for (int g = 0; g < 2; g++) gas_measure(c, gas[g], &b[g]);
+        const double sep =
+            sqrt(pow(b[0].c[0] - b[1].c[0], 2) + pow(b[0].c[1] - b[1].c[1], 2) + pow(b[0].c[2] - b[1].c[2], 2));
+        print_message("t = %.1f s, %llu steps: components %d %d, rmax/R %.2f %.2f, centroids %.2f R apart\n",
+                      pfsph_sim_time(sim), (unsigned long long)pfsph_sim_steps(sim), b[0].components, b[1].components,
+                      b[0].rmax / R, b[1].rmax / R, sep / R);
+        for (int g = 0; g < 2; g++) ok &= b[g].components == 1 && b[g].rmax < 2.5 * R;
+        ok &= sep > R;
+    }
+    assert_int_equal(pfsph_sim_removed(sim), 0);
+    assert_true(ok);
+    pfsph_sim_destroy(sim);
+}
+
+int main(int argc, char **argv)
+{
+    tu_init(argc, argv);
+    omp_set_num_threads(2);
+    if (getenv("PF_ONLY")) cmocka_set_test_filter(getenv("PF_ONLY"));
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_wetting), cmocka_unit_test(test_double_bubble)};
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
