@@ -170,7 +170,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
      * and a quarter more for compression near walls and in splashes; boundary lists: half a
      * neighbourhood for every fluid particle (a particle on a wall has about half) */
     const double q = s->support_factor, full = s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q;
-    const double nlist = ops && ops->neighbour_lists
+    const double nlist = pfsph__solver_lists(ops, s->solver_settings, (double)nf_max)
         ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) + pfsph_nlist_bytes_per_particle(0.5 * full, 1)
         : 0;
     const int nscr =
