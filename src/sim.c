@@ -330,7 +330,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
      * the estimate counts it */
     const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
-    sim->st.lists = pfsph__solver_lists(sim->st.solver, s->solver_settings, n_most);
+    sim->st.lists = pfsph__sim_lists(s, n_most);
 
     auto_sound_speed(sim);
     pfsph_solver_config cfg_, *cfg = &cfg_; /* the solver keeps what it needs */

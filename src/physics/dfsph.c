@@ -49,7 +49,7 @@ static const pfsph_solver_key keys[NKEYS] = {
     {"divergence_max_iterations", 100, 0, 10000, 1, "divergence corrections per step at most; 0: none"},
     {"neighbour_lists", 0, -1, 1, PFSPH_KEY_AUTO_BOOL,
      "true: neighbour lists (~300 B per particle in 3D), false: grid walks (the same bits), "
-     "\"auto\": lists up to 2e6 fluid particles"},
+     "\"auto\": lists while they fit a quarter of the memory"},
 };
 
 static int check(const double *v, const char **key, char *msg, size_t len)

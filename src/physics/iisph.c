@@ -39,7 +39,7 @@ static const pfsph_solver_key keys[NKEYS] = {
     {"max_iterations", 50, 1, 10000, 1, "Jacobi iterations per step at most"},
     {"neighbour_lists", 0, -1, 1, PFSPH_KEY_AUTO_BOOL,
      "true: neighbour lists (~300 B per particle in 3D), false: grid walks (the same bits), "
-     "\"auto\": lists up to 2e6 fluid particles"},
+     "\"auto\": lists while they fit a quarter of the memory"},
 };
 
 static int check(const double *v, const char **key, char *msg, size_t len)

@@ -36,14 +36,6 @@ int pfsph_solver_key_index(const pfsph_solver_ops *ops, const char *key)
     return -1;
 }
 
-int pfsph__solver_lists(const pfsph_solver_ops *ops, const double *settings, double n_fluid)
-{
-    if (!ops || !ops->neighbour_lists) return 0;
-    const int k = pfsph_solver_key_index(ops, "neighbour_lists");
-    const double v = k >= 0 && settings ? settings[k] : 0;
-    return v > 0 || (v == 0 && n_fluid <= PFSPH_NLIST_AUTO_MAX);
-}
-
 double pfsph__speed_bound_one_step(double c, const pfsph_ctx *ctx)
 {
     const double b = 20 * c;

@@ -57,7 +57,7 @@ typedef struct pfsph_solver_ops {
     /* Non-zero: the solver walks the neighbours many times per step, from neighbour lists
      * (ctx->nlist, built after the density stage; memory: src/core/nlist.h) or, when ctx->nlist
      * is NULL, by grid walks with the same terms in the same order (physics/neighbours.h). Its
-     * key "neighbour_lists" (true, false, "auto") chooses: pfsph__solver_lists. */
+     * key "neighbour_lists" (true, false, "auto") chooses: pfsph__sim_lists (sim_estimate.c). */
     int neighbour_lists;
     /* Non-zero: amax_np, the non-pressure acceleration dt_limit receives, leaves viscosity out:
      * |g| + the largest pair-force acceleration (an upper bound of |g + a_pair|). Viscosity
@@ -102,16 +102,6 @@ const pfsph_solver_ops *pfsph_solver_find(const char *name);
 const pfsph_solver_ops *pfsph_solver_at(int i);
 /* The index of key in the row's keys, or -1. */
 int pfsph_solver_key_index(const pfsph_solver_ops *ops, const char *key);
-
-/* Fluid particles up to which "neighbour_lists": "auto" builds the lists (docs/solvers.md,
- * "Neighbour lists"): above, grid walks, and the ~300 B per particle of the 3D lists are saved. */
-#define PFSPH_NLIST_AUTO_MAX 2000000.0
-
-/* Whether a step of this solver builds neighbour lists, for its settings (in the order of its
- * keys) and n_fluid, the most fluid particles of the run (at the start, plus what emitters add
- * by the end): its "neighbour_lists" key, or with "auto" n_fluid <= PFSPH_NLIST_AUTO_MAX. 0 for
- * a solver without lists. The estimate and the simulation both ask here. */
-int pfsph__solver_lists(const pfsph_solver_ops *ops, const double *settings, double n_fluid);
 
 /* Most solvers the registry holds (solver.c checks it at compile time). */
 #define PFSPH_MAX_SOLVERS 16
