@@ -12,6 +12,7 @@
 #include <omp.h>
 
 #include "cli/omp_env.h"
+#include "core/stage.h"
 #include "pfsph/grid.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
@@ -21,6 +22,7 @@ static void usage(void)
 {
     fprintf(stderr,
             "usage: bench [--particles N] [--steps N] [--warmup N] [--solver wcsph|pcisph|dfsph|iisph]\n"
+            "             [--lists auto|true|false]\n"
             "             [--pairwise [--no-thermostat]] [--threads N] [--diffuse N] [--diffuse-emit-all]\n"
             "Runs a 3D dam break of about N fluid particles (default 50000) for --steps steps\n"
             "(default 20) after --warmup steps (default 3) and prints throughput figures.\n"
@@ -29,7 +31,8 @@ static void usage(void)
             "--diffuse-emit-all sets phi_e_min = 0 so every moving fluid particle evaluates the\n"
             "velocity difference of Eqs. 10-13 (worst case of the generation stage).\n"
             "--wall-viscosity NU gives the container its own wall viscosity [m^2/s] (the\n"
-            "friction loop then reads the per-solid wall table; 1e-3 is the fluid's own).\n");
+            "friction loop then reads the per-solid wall table; 1e-3 is the fluid's own).\n"
+            "--lists sets the solver's \"neighbour_lists\" (DFSPH, IISPH; default auto).\n");
 }
 
 /* Mean number of neighbours j != i within h of each fluid particle: fluid ones through the
@@ -122,7 +125,7 @@ int main(int argc, char **argv)
 {
     pfsph_omp_wait_default(argv); /* as pfsph does */
     long target = 50000, steps = 20, warmup = 3;
-    const char *solver = "wcsph";
+    const char *solver = "wcsph", *lists = NULL;
     int pairwise = 0, threads = 0, emit_all = 0, no_thermo = 0;
     long ndiffuse = -1;
     double wall_nu = -1;
@@ -147,6 +150,9 @@ int main(int argc, char **argv)
                 return 2;
             }
             solver = v;
+            i++;
+        } else if (!strcmp(a, "--lists") && v && (!strcmp(v, "auto") || !strcmp(v, "true") || !strcmp(v, "false"))) {
+            lists = v;
             i++;
         } else if (!strcmp(a, "--pairwise")) pairwise = 1;
         else if (!strcmp(a, "--no-thermostat")) no_thermo = 1;
@@ -201,13 +207,17 @@ int main(int argc, char **argv)
                  2 * ndiffuse + 100000, emit_all ? 0.0 : 0.5);
     char wallkey[64] = "";
     if (wall_nu >= 0) snprintf(wallkey, sizeof wallkey, ", \"viscosity\": %.9g", wall_nu);
+    char lkey[64] = "";
+    if (lists)
+        snprintf(lkey, sizeof lkey, ", \"neighbour_lists\": %s%s%s", strcmp(lists, "auto") ? "" : "\"", lists,
+                 strcmp(lists, "auto") ? "" : "\"");
     char json[8192];
     snprintf(json, sizeof json,
              "{\"name\": \"bench\", \"dimension\": 3, \"particle_radius\": %.9g,\n"
              "\"gravity\": [0, -9.81, 0], \"threads\": %d,\n"
              "\"domain\": {\"min\": [%.9g, %.9g, %.9g], \"max\": [%.9g, %.9g, %.9g]},\n"
              "\"solver\": {\"type\": \"%s\", \"tolerance\": 0.005, \"min_iterations\": 3, "
-             "\"max_iterations\": 50},\n"
+             "\"max_iterations\": 50%s},\n"
              "\"time\": {\"end\": 100, \"cfl\": 0.4, \"dt_max\": 0.004},\n"
              "\"phases\": [{\"name\": \"water\", \"kind\": \"fluid\", \"rest_density\": 1000, "
              "\"viscosity\": 1e-3}, {\"name\": \"wall\", \"kind\": \"solid\"}],\n"
@@ -218,7 +228,7 @@ int main(int argc, char **argv)
              "\"phase\": \"wall\"%s}],\n"
              "\"output\": {\"directory\": \"bench_run\", \"formats\": [], \"boundary\": false}"
              "%s%s}\n",
-             r, threads, -m, -m, -m, tx + m, ty + m, tz + m, solver, bx, by, bz, tx, ty, tz, wallkey, pair, dif);
+             r, threads, -m, -m, -m, tx + m, ty + m, tz + m, solver, lkey, bx, by, bz, tx, ty, tz, wallkey, pair, dif);
 
     static pfsph_scene scene;
     pfsph_error err = {0};
@@ -328,12 +338,12 @@ int main(int argc, char **argv)
            rss / 1e6, bpp);
 
     /* One line for grep. */
-    printf("BENCH solver=%s pairwise=%d threads=%d fluid=%zu boundary=%zu steps=%ld wall_s=%.3f "
+    printf("BENCH solver=%s lists=%d pairwise=%d threads=%d fluid=%zu boundary=%zu steps=%ld wall_s=%.3f "
            "psteps_per_s=%.4g iters=%.2f nb_fluid=%.1f nb_bnd=%.1f cand=%.1f bytes_per_particle=%.0f "
            "diffuse=%zu diffuse_s=%.4f fluid_s=%.4f diffuse_pct=%.1f cpu_s=%.4f status=%s\n",
-           solver, pairwise, threads > 0 ? threads : omp_get_max_threads(), n_fluid0, n_bnd, done, wall, rate, avg_it,
-           nbf, nbb, ncand, bpp, dc[0] + dc[1] + dc[2], dif_s, fluid_s, fluid_s > 0 ? 100 * dif_s / fluid_s : 0,
-           cpu_tot, rc == PFSPH_OK ? "ok" : "failed");
+           solver, pfsph_sim_step_state(sim)->lists, pairwise, threads > 0 ? threads : omp_get_max_threads(), n_fluid0,
+           n_bnd, done, wall, rate, avg_it, nbf, nbb, ncand, bpp, dc[0] + dc[1] + dc[2], dif_s, fluid_s,
+           fluid_s > 0 ? 100 * dif_s / fluid_s : 0, cpu_tot, rc == PFSPH_OK ? "ok" : "failed");
     pfsph_sim_destroy(sim);
     return rc == PFSPH_OK ? 0 : 3;
 }

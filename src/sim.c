@@ -328,6 +328,10 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
     if ((rc = pfsph__sim_alloc_scratch(sim, sim->st.em ? sim->fluid.cap : sim->fluid.n))) goto nomem;
+    /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
+     * the estimate counts it */
+    const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
+    sim->st.lists = pfsph__sim_lists(s, n_most);
 
     auto_sound_speed(sim);
     pfsph_solver_config cfg_, *cfg = &cfg_; /* the solver keeps what it needs */

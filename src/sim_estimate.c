@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/nlist.h"
 #include "scene/shapes.h"
@@ -114,6 +115,45 @@ double pfsph_scene_emitter_speed(const pfsph_scene *s)
     return v;
 }
 
+/* Neighbour lists: a full neighbourhood within h (pi q^2 in 2D, 4/3 pi q^3 in 3D, q = h / d)
+ * and a quarter more for compression near walls and in splashes; boundary lists: half a
+ * neighbourhood for every fluid particle (a particle on a wall has about half). At most what
+ * they hold: 537 B per fluid particle in 3D at q = 2, where the bench's dam break holds 228. */
+static double nlist_neighbours(const pfsph_scene *s)
+{
+    const double q = s->support_factor;
+    return s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q;
+}
+
+static double nlist_bytes_per_particle(const pfsph_scene *s)
+{
+    const double full = nlist_neighbours(s);
+    return pfsph_nlist_bytes_per_particle(1.25 * full, 1) + pfsph_nlist_bytes_per_particle(0.5 * full, 1);
+}
+
+static double physical_memory(void)
+{
+#if defined(_SC_PHYS_PAGES) && defined(_SC_PAGE_SIZE)
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    if (pages > 0 && size > 0) return (double)pages * (double)size;
+#endif
+    return 8.0 * 1073741824.0; /* unknown: a small workstation's */
+}
+
+/* Lists where they fit comfortably: "auto" builds them while their estimate is at most a quarter
+ * of this machine's memory (and their entries fit the lists' 32-bit offsets); above, the grid
+ * walks give the same bits at 0.4x the solver's speed (docs/solvers.md, "Neighbour lists"). */
+int pfsph__sim_lists(const pfsph_scene *s, double n_fluid)
+{
+    const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
+    if (!ops || !ops->neighbour_lists) return 0;
+    const int k = pfsph_solver_key_index(ops, "neighbour_lists");
+    const double v = k >= 0 ? s->solver_settings[k] : 0;
+    if (v != 0) return v > 0;
+    const double entries = 1.125 * 1.25 * nlist_neighbours(s) * n_fluid;
+    return entries < (double)UINT32_MAX && n_fluid * nlist_bytes_per_particle(s) <= 0.25 * physical_memory();
+}
+
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary, size_t *bytes, pfsph_error *err)
 {
     double d = 2 * s->particle_radius;
@@ -166,13 +206,8 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     int nstage = 1; /* the stages' shared scratch: the integrator's energies */
     if (shared && ops->nscratch > nstage) nstage = ops->nscratch;
     const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
-    /* neighbour lists: a full neighbourhood within h (pi q^2 in 2D, 4/3 pi q^3 in 3D, q = h / d)
-     * and a quarter more for compression near walls and in splashes; boundary lists: half a
-     * neighbourhood for every fluid particle (a particle on a wall has about half) */
-    const double q = s->support_factor, full = s->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q;
-    const double nlist = ops && ops->neighbour_lists
-        ? pfsph_nlist_bytes_per_particle(1.25 * full, 1) + pfsph_nlist_bytes_per_particle(0.5 * full, 1)
-        : 0;
+    /* neighbour lists, when the run builds them */
+    const double nlist = pfsph__sim_lists(s, (double)nf_max) ? nlist_bytes_per_particle(s) : 0;
     const int nscr =
         SCR_COMMON + nstage + (ops && !shared ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
     /* output: the surface layers of a frame (a byte each) and, with pair forces, the

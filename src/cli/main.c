@@ -291,6 +291,12 @@ static int check_memory(const pfsph_scene *s, int verbose)
         else printf("particles: %zu fluid, %zu boundary\n", nf, nb);
         printf("memory estimate: %.1f MiB (%.0f bytes per fluid particle)%s\n", (double)bytes / 1048576.0,
                nf + ne ? (double)bytes / (double)(nf + ne) : 0.0, ne ? ", for the most fluid" : "");
+        const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
+        if (ops && ops->neighbour_lists) /* $.solver.neighbour_lists */
+            printf("neighbour lists: %s\n",
+                   pfsph__sim_lists(s, (double)(nf + ne))
+                       ? "yes"
+                       : "no (grid walks: the same results, less memory, slower solver)");
     }
     if (mem > 0 && (double)bytes > 0.8 * (double)mem) {
         fprintf(stderr,

@@ -86,6 +86,7 @@ typedef struct pfsph_step {
     struct pfsph_bodies *bodies;         /* NULL: no rigid bodies */
     struct pfsph_emitters *em;           /* NULL: no emitters */
     struct pfsph_nlist *nlist, *nlist_b; /* the lists' storage (ctx->nlist points here when built) */
+    int lists; /* the density stage builds the lists (the solver's choice: pfsph__sim_lists) */
     /* the clock: the step begins at time and never passes t_limit */
     double time, t_limit;
     uint64_t step;

@@ -120,6 +120,10 @@ int pfsph_sim_restore_emitters(pfsph_sim *sim, int n, const struct pfsph_emitter
 /* Number of particles and bytes a scene would need, without allocating them. n_fluid: the
  * fluid it starts with; bytes: with the most its emitters can add by the scene's end. */
 int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_boundary, size_t *bytes, pfsph_error *err);
+/* Whether a run of s with at most n_fluid fluid particles builds neighbour lists: the solver's
+ * "neighbour_lists" key, or with "auto" whether their estimate fits a quarter of this machine's
+ * memory (docs/solvers.md, "Neighbour lists"); 0 for a solver without lists. */
+int pfsph__sim_lists(const pfsph_scene *s, double n_fluid);
 /* The most particles the scene's emitters can have added by time t [s] (0 without emitters);
  * PFSPH_EINPUT (message with the JSON path) for a nozzle the lattice cannot feed. */
 int pfsph_scene_emitted_max(const pfsph_scene *s, double t, size_t *n, pfsph_error *err);

@@ -162,16 +162,17 @@ int pfsph__density_check(pfsph_step *st, pfsph_blowup *bad)
     return PFSPH_OK;
 }
 
-/* Number density; with neighbour lists (solvers that walk the neighbours many times a step)
- * the density's walk also fills them: positions stay put until the integration, and the loop
- * drops the lists after any stage that writes positions or the order. */
+/* Number density; with neighbour lists (solvers that walk the neighbours many times a step,
+ * when they chose lists: st->lists) the density's walk also fills them: positions stay put
+ * until the integration, and the loop drops the lists after any stage that writes positions or
+ * the order. */
 static int density_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
 {
     (void)state;
     pfsph_ctx *c = st->ctx;
     pfsph_particles *f = c->fluid;
     c->nlist = c->nlist_b = NULL;
-    if (st->solver->neighbour_lists) {
+    if (st->lists) {
         const double q = (double)c->h / (double)c->spacing; /* a full neighbourhood, and a quarter */
         const double guess = 1.25 * (c->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q);
         int rc = pfsph__number_density_list(c, c->nd, st->nlist, st->nlist_b, guess);

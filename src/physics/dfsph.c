@@ -3,13 +3,14 @@
  * predicted velocities, both Jacobi iterations on a clamped pressure (p >= 0) with the DFSPH
  * factor of each particle; time steps limited by the CFL condition and the non-pressure
  * forces other than viscosity (no sound speed). The passes walk the step's neighbour lists
- * (src/core/nlist.h). Derivation and choices: docs/solvers.md, "DFSPH". */
+ * (src/core/nlist.h) or, without them, the grid (physics/neighbours.h: the same bits).
+ * Derivation and choices: docs/solvers.md, "DFSPH". */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/nlist.h"
 #include "core/reduce.h"
+#include "physics/neighbours.h"
 #include "physics/solver.h"
 
 #define OMEGA 0.5
@@ -39,13 +40,16 @@ typedef pfsph_real v4r_u __attribute__((vector_size(4 * sizeof(pfsph_real)), ali
  * tolerance than PCISPH's: at 0.005 its 2D tank at rest kept vmax ~0.2 m/s (docs/solvers.md,
  * "DFSPH"); one minimum correction: its warm start is often within tolerance already (the 7k dam
  * break to 1 s: 13.4 s wall with 1, 15.5 s with 2, 19.1 s with PCISPH's 3). */
-enum { K_TOL, K_MIN, K_MAX, K_DIV_TOL, K_DIV_MAX, NKEYS };
+enum { K_TOL, K_MIN, K_MAX, K_DIV_TOL, K_DIV_MAX, K_LISTS, NKEYS };
 static const pfsph_solver_key keys[NKEYS] = {
     {"tolerance", 0.001, 1e-5, 0.1, 0, "mean relative density error the density solve stops at"},
     {"min_iterations", 1, 1, 1000, 1, "density corrections per step at least"},
     {"max_iterations", 50, 1, 10000, 1, "density corrections per step at most"},
     {"divergence_tolerance", 0.001, 1e-6, 0.1, 0, "mean |D delta / Dt| dt / delta0 the divergence solve stops at"},
     {"divergence_max_iterations", 100, 0, 10000, 1, "divergence corrections per step at most; 0: none"},
+    {"neighbour_lists", 0, -1, 1, PFSPH_KEY_AUTO_BOOL,
+     "true: neighbour lists (~300 B per particle in 3D), false: grid walks (the same bits), "
+     "\"auto\": lists while they fit a quarter of the memory"},
 };
 
 static int check(const double *v, const char **key, char *msg, size_t len)
@@ -91,51 +95,58 @@ static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph
 {
     const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
     const pfsph_nlist *nl = ctx->nlist, *bl = ctx->nlist_b;
-    const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
+    const pfsph_kernel *k = &ctx->kern;
+    const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0, h2 = k->h * k->h;
     const double few = 0.6 * D->full;
     const size_t n = f->n;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-        xq[4 * i] = xi; /* the positions stay put until the integration */
-        xq[4 * i + 1] = yi;
-        xq[4 * i + 2] = zi;
-        double gx = 0, gy = 0, gz = 0, s2 = 0;
-        int nn = (int)(nl->start[i + 1] - nl->start[i]);
-        for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-            const uint32_t j = nl->idx[e];
-            pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
-            double w = nl->dw[e];
-            double ax = w * dx, ay = w * dy, az = w * dz;
-            gx += ax;
-            gy += ay;
-            gz += az;
-            s2 += (ax * ax + ay * ay + az * az) / (double)ctx->mass[f->phase[j]];
+    const pfsph_hits_fn hits = pfsph_hits_select();
+#pragma omp parallel
+    {
+        pfsph_hits H; /* grid walks (no lists) */
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+            xq[4 * i] = xi; /* the positions stay put until the integration */
+            xq[4 * i + 1] = yi;
+            xq[4 * i + 2] = zi;
+            double gx = 0, gy = 0, gz = 0, s2 = 0;
+            int nn = 0;
+            PFSPH_FOR_NEIGHBOURS(nl, ctx->grid, hits, &H, k, f->x, f->y, f->z, i, xi, yi, zi, h2, (uint32_t)i, j, dwj, {
+                pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
+                double w = dwj;
+                double ax = w * dx, ay = w * dy, az = w * dz;
+                gx += ax;
+                gy += ay;
+                gz += az;
+                s2 += (ax * ax + ay * ay + az * az) / (double)ctx->mass[f->phase[j]];
+                nn++;
+            });
+            pfsph_real bx = 0, by = 0, bz = 0, bc = 0;
+            if (b->n)
+                PFSPH_FOR_NEIGHBOURS(bl, ctx->bgrid, hits, &H, k, b->x, b->y, b->z, i, xi, yi, zi, h2, UINT32_MAX, j,
+                                     dw, {
+                                         pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
+                                         double w = (double)(b->aux[j] * inv_v0) * dw;
+                                         gx += w * dx;
+                                         gy += w * dy;
+                                         gz += w * dz;
+                                         nn++;
+                                         /* the order and rounding of pressure.c's wall term, so that a_p keeps
+                                          * its bits */
+                                         pfsph_real sb = b->aux[j] * dw;
+                                         bx += sb * dx;
+                                         by += sb * dy;
+                                         bz += sb * dz;
+                                         bc += sb * (b->vx[j] * dx + b->vy[j] * dy + b->vz[j] * dz);
+                                     });
+            bsum[0][i] = bx;
+            bsum[1][i] = by;
+            bsum[2][i] = bz;
+            bsum[3][i] = bc;
+            double A = (gx * gx + gy * gy + gz * gz) / (double)ctx->mass[f->phase[i]] + s2;
+            double fi = A > 1e-30 * s2 && A > 0 ? 1.0 / A : 0.0;
+            fac[i] = (pfsph_real)(nn + 1 < few ? -fi : fi);
         }
-        pfsph_real bx = 0, by = 0, bz = 0, bc = 0;
-        for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
-            const uint32_t j = bl->idx[e];
-            pfsph_real dx = xi - b->x[j], dy = yi - b->y[j], dz = zi - b->z[j];
-            const pfsph_real dw = bl->dw[e];
-            double w = (double)(b->aux[j] * inv_v0) * dw;
-            gx += w * dx;
-            gy += w * dy;
-            gz += w * dz;
-            nn++;
-            /* the order and rounding of pressure.c's wall term, so that a_p keeps its bits */
-            pfsph_real sb = b->aux[j] * dw;
-            bx += sb * dx;
-            by += sb * dy;
-            bz += sb * dz;
-            bc += sb * (b->vx[j] * dx + b->vy[j] * dy + b->vz[j] * dz);
-        }
-        bsum[0][i] = bx;
-        bsum[1][i] = by;
-        bsum[2][i] = bz;
-        bsum[3][i] = bc;
-        double A = (gx * gx + gy * gy + gz * gz) / (double)ctx->mass[f->phase[i]] + s2;
-        double fi = A > 1e-30 * s2 && A > 0 ? 1.0 / A : 0.0;
-        fac[i] = (pfsph_real)(nn + 1 < few ? -fi : fi);
     }
 }
 
@@ -185,8 +196,12 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
     const pfsph_real dt = (pfsph_real)c->dt;
     const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
     const pfsph_real *nd = c->nd;
+    const pfsph_kernel *k = &c->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const pfsph_hits_fn hits = pfsph_hits_select();
 #pragma omp parallel
     {
+        pfsph_hits H; /* grid walks (no lists) */
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             if (upd) p[i] = updated(c, divergence, rate, fac, p, i);
@@ -197,11 +212,12 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
             const v4r Xi = ld4(xq + 4 * i);
             const pfsph_real pi = Xi[3];
             v4r A = {0, 0, 0, 0};
-            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-                const v4r Xj = ld4(xq + 4 * (size_t)nl->idx[e]);
-                const pfsph_real s = (pi + Xj[3]) * nl->dw[e];
-                A += s * (Xi - Xj); /* lanes 0-2: a += s x_ij (lane 3 unused) */
-            }
+            PFSPH_FOR_NEIGHBOURS(nl, c->grid, hits, &H, k, f->x, f->y, f->z, i, Xi[0], Xi[1], Xi[2], h2, (uint32_t)i, j,
+                                 dw, {
+                                     const v4r Xj = ld4(xq + 4 * (size_t)j);
+                                     const pfsph_real s = (pi + Xj[3]) * dw;
+                                     A += s * (Xi - Xj); /* lanes 0-2: a += s x_ij (lane 3 unused) */
+                                 });
             pfsph_real ax = A[0], ay = A[1], az = A[2];
             if (pi > 0) { /* Akinci 2012: the wall pushes with p_i alone (pressure.c) */
                 const pfsph_real wb = pi * inv_v0;
@@ -234,23 +250,31 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *xq, const pfsph_r
     const pfsph_nlist *nl = c->nlist;
     const size_t n = f->n;
     const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        const v4r Xi = ld4(xq + 4 * i), Vi = ld4(v4 + 4 * i);
-        const pfsph_real vxi = Vi[0], vyi = Vi[1], vzi = Vi[2];
-        pfsph_real s = 0;
-        for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-            const size_t j4 = 4 * (size_t)nl->idx[e];
-            /* (v_i - v_j) . x_ij, summed x + y, then + z as the scalar expression */
-            const v4r P = (Vi - ld4(v4 + j4)) * (Xi - ld4(xq + j4));
-            const pfsph_real vd = P[0] + P[1] + P[2];
-            s += vd * nl->dw[e];
+    const pfsph_kernel *k = &c->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const pfsph_hits_fn hits = pfsph_hits_select();
+#pragma omp parallel
+    {
+        pfsph_hits H; /* grid walks (no lists) */
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const v4r Xi = ld4(xq + 4 * i), Vi = ld4(v4 + 4 * i);
+            const pfsph_real vxi = Vi[0], vyi = Vi[1], vzi = Vi[2];
+            pfsph_real s = 0;
+            PFSPH_FOR_NEIGHBOURS(nl, c->grid, hits, &H, k, f->x, f->y, f->z, i, Xi[0], Xi[1], Xi[2], h2, (uint32_t)i, j,
+                                 dw, {
+                                     const size_t j4 = 4 * (size_t)j;
+                                     /* (v_i - v_j) . x_ij, summed x + y, then + z as the scalar expression */
+                                     const v4r P = (Vi - ld4(v4 + j4)) * (Xi - ld4(xq + j4));
+                                     const pfsph_real vd = P[0] + P[1] + P[2];
+                                     s += vd * dw;
+                                 });
+            const pfsph_real sb = vxi * bsum[0][i] + vyi * bsum[1][i] + vzi * bsum[2][i] - bsum[3][i];
+            rate[i] = s + sb * inv_v0;
+            /* the compression it stands for (residual()), in the same pass */
+            double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
+            err[i] = (pfsph_real)(res > 0 ? res / nd0 : 0);
         }
-        const pfsph_real sb = vxi * bsum[0][i] + vyi * bsum[1][i] + vzi * bsum[2][i] - bsum[3][i];
-        rate[i] = s + sb * inv_v0;
-        /* the compression it stands for (residual()), in the same pass */
-        double fi, res = residual_of(c, divergence, rate, fac, i, &fi);
-        err[i] = (pfsph_real)(res > 0 ? res / nd0 : 0);
     }
 }
 

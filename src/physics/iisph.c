@@ -1,12 +1,13 @@
 /* Implicit incompressible SPH (Ihmsen, Cornelis, Solenthaler, Horvath, Teschner 2014, IEEE TVCG
  * 20(3)) in the number-density form of PF Eq. 23: relaxed Jacobi on the pressure Poisson
  * equation of the advection-predicted density, with Akinci boundary particles. Derivation and
- * measurements: docs/solvers.md, "IISPH". */
+ * measurements: docs/solvers.md, "IISPH". The passes walk the step's neighbour lists or, without
+ * them, the grid (physics/neighbours.h: the same bits). */
 #include <math.h>
 #include <stdlib.h>
 
-#include "core/nlist.h"
 #include "core/reduce.h"
+#include "physics/neighbours.h"
 #include "physics/solver.h"
 
 /* Relaxed Jacobi, omega = 0.5 as the paper recommends (Sec. 3.3): a_ii counts only particle i's
@@ -31,11 +32,14 @@ typedef pfsph_real v4r_u __attribute__((vector_size(4 * sizeof(pfsph_real)), ali
 #define ld4(p) (*(const v4r_u *)(p))
 
 /* its scene keys under $.solver, in the order of the scene's solver_settings (PCISPH's defaults) */
-enum { K_TOL, K_MIN, K_MAX, NKEYS };
+enum { K_TOL, K_MIN, K_MAX, K_LISTS, NKEYS };
 static const pfsph_solver_key keys[NKEYS] = {
     {"tolerance", 0.005, 1e-5, 0.1, 0, "mean relative density error the Jacobi iteration stops at"},
     {"min_iterations", 3, 1, 1000, 1, "Jacobi iterations per step at least"},
     {"max_iterations", 50, 1, 10000, 1, "Jacobi iterations per step at most"},
+    {"neighbour_lists", 0, -1, 1, PFSPH_KEY_AUTO_BOOL,
+     "true: neighbour lists (~300 B per particle in 3D), false: grid walks (the same bits), "
+     "\"auto\": lists while they fit a quarter of the memory"},
 };
 
 static int check(const double *v, const char **key, char *msg, size_t len)
@@ -86,8 +90,12 @@ static void predict_advection(const pfsph_ctx *c, const pfsph_real *p, pfsph_rea
     const pfsph_real fdt = (pfsph_real)dt, inv_v0 = (pfsph_real)1 / c->V0;
     pfsph_real *xq = scr[XQ], *va = scr[W4], *aii = scr[AII], *dadv = scr[DADV];
     pfsph_real *bx_ = scr[BX], *by_ = scr[BY], *bz_ = scr[BZ];
+    const pfsph_kernel *k = &c->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const pfsph_hits_fn hits = pfsph_hits_select();
 #pragma omp parallel
     {
+        pfsph_hits H; /* grid walks (no lists) */
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             xq[4 * i] = f->x[i];
@@ -104,27 +112,28 @@ static void predict_advection(const pfsph_ctx *c, const pfsph_real *p, pfsph_rea
             const v4r Xi = ld4(xq + 4 * i), Vi = ld4(va + 4 * i);
             double gx = 0, gy = 0, gz = 0, s2 = 0;
             pfsph_real rate = 0;
-            for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-                const size_t j4 = 4 * (size_t)nl->idx[e];
-                const v4r X = Xi - ld4(xq + j4), P = (Vi - ld4(va + j4)) * X;
-                const pfsph_real w = nl->dw[e];
-                rate += (P[0] + P[1] + P[2]) * w;
-                const double ax = (double)(w * X[0]), ay = (double)(w * X[1]), az = (double)(w * X[2]);
-                gx += ax;
-                gy += ay;
-                gz += az;
-                s2 += (ax * ax + ay * ay + az * az) / (double)c->mass[f->phase[nl->idx[e]]];
-            }
+            PFSPH_FOR_NEIGHBOURS(
+                nl, c->grid, hits, &H, k, f->x, f->y, f->z, i, Xi[0], Xi[1], Xi[2], h2, (uint32_t)i, j, w, {
+                    const size_t j4 = 4 * (size_t)j;
+                    const v4r X = Xi - ld4(xq + j4), P = (Vi - ld4(va + j4)) * X;
+                    rate += (P[0] + P[1] + P[2]) * w;
+                    const double ax = (double)(w * X[0]), ay = (double)(w * X[1]), az = (double)(w * X[2]);
+                    gx += ax;
+                    gy += ay;
+                    gz += az;
+                    s2 += (ax * ax + ay * ay + az * az) / (double)c->mass[f->phase[j]];
+                });
             pfsph_real bx = 0, by = 0, bz = 0, bc = 0;
-            for (uint32_t e = bl->start[i]; e < bl->start[i + 1]; e++) {
-                const uint32_t j = bl->idx[e];
-                const pfsph_real dx = Xi[0] - b->x[j], dy = Xi[1] - b->y[j], dz = Xi[2] - b->z[j];
-                const pfsph_real s = b->aux[j] * bl->dw[e];
-                bx += s * dx;
-                by += s * dy;
-                bz += s * dz;
-                bc += s * (b->vx[j] * dx + b->vy[j] * dy + b->vz[j] * dz);
-            }
+            if (b->n)
+                PFSPH_FOR_NEIGHBOURS(
+                    bl, c->bgrid, hits, &H, k, b->x, b->y, b->z, i, Xi[0], Xi[1], Xi[2], h2, UINT32_MAX, j, dw, {
+                        const pfsph_real dx = Xi[0] - b->x[j], dy = Xi[1] - b->y[j], dz = Xi[2] - b->z[j];
+                        const pfsph_real s = b->aux[j] * dw;
+                        bx += s * dx;
+                        by += s * dy;
+                        bz += s * dz;
+                        bc += s * (b->vx[j] * dx + b->vy[j] * dy + b->vz[j] * dz);
+                    });
             bx_[i] = bx;
             by_[i] = by;
             bz_[i] = bz;
@@ -150,15 +159,20 @@ static void pressure_accel(const pfsph_ctx *c, pfsph_real *const *scr, pfsph_rea
     const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
     const pfsph_real *xq = scr[XQ], *bx = scr[BX], *by = scr[BY], *bz = scr[BZ];
     pfsph_real *a4 = scr[W4];
+    const pfsph_kernel *k = &c->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const pfsph_hits_fn hits = pfsph_hits_select();
+    pfsph_hits H; /* grid walks (no lists); this thread's: called inside the parallel region */
 #pragma omp for schedule(static)
     for (size_t i = 0; i < n; i++) {
         const v4r Xi = ld4(xq + 4 * i);
         const pfsph_real pi = Xi[3];
         v4r A = {0, 0, 0, 0};
-        for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-            const v4r Xj = ld4(xq + 4 * (size_t)nl->idx[e]);
-            A += ((pi + Xj[3]) * nl->dw[e]) * (Xi - Xj);
-        }
+        PFSPH_FOR_NEIGHBOURS(nl, c->grid, hits, &H, k, f->x, f->y, f->z, i, Xi[0], Xi[1], Xi[2], h2, (uint32_t)i, j, dw,
+                             {
+                                 const v4r Xj = ld4(xq + 4 * (size_t)j);
+                                 A += ((pi + Xj[3]) * dw) * (Xi - Xj);
+                             });
         pfsph_real ax = A[0], ay = A[1], az = A[2];
         if (pi > 0) { /* Akinci 2012: the wall pushes with p_i alone (pressure.c) */
             const pfsph_real wb = pi * inv_v0;
@@ -195,9 +209,13 @@ static int iterate(const iisph *S, const pfsph_ctx *c, pfsph_real *p, pfsph_real
     const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
     pfsph_real *xq = scr[XQ], *err = scr[ERR], *pn = scr[PN];
     const pfsph_real *a4 = scr[W4], *aii = scr[AII], *dadv = scr[DADV], *bx = scr[BX], *by = scr[BY], *bz = scr[BZ];
+    const pfsph_kernel *k = &c->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const pfsph_hits_fn hits = pfsph_hits_select();
     for (int it = 0;; it++) {
 #pragma omp parallel
         {
+            pfsph_hits H; /* grid walks (no lists) */
             if (it > 0) { /* the last pass's update (predict_advection filled lane 3 for the first) */
 #pragma omp for schedule(static)
                 for (size_t i = 0; i < n; i++) {
@@ -210,12 +228,13 @@ static int iterate(const iisph *S, const pfsph_ctx *c, pfsph_real *p, pfsph_real
             for (size_t i = 0; i < n; i++) {
                 const v4r Ai = ld4(a4 + 4 * i), Xi = ld4(xq + 4 * i);
                 pfsph_real s = 0;
-                for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
-                    const size_t j4 = 4 * (size_t)nl->idx[e];
-                    /* lane 3: a's is 0 */
-                    const v4r P = (Ai - ld4(a4 + j4)) * (Xi - ld4(xq + j4));
-                    s += (P[0] + P[1] + P[2]) * nl->dw[e];
-                }
+                PFSPH_FOR_NEIGHBOURS(nl, c->grid, hits, &H, k, f->x, f->y, f->z, i, Xi[0], Xi[1], Xi[2], h2,
+                                     (uint32_t)i, j, dw, {
+                                         const size_t j4 = 4 * (size_t)j;
+                                         /* lane 3: a's is 0 */
+                                         const v4r P = (Ai - ld4(a4 + j4)) * (Xi - ld4(xq + j4));
+                                         s += (P[0] + P[1] + P[2]) * dw;
+                                     });
                 s += (Ai[0] * bx[i] + Ai[1] * by[i] + Ai[2] * bz[i]) * inv_v0;
                 /* the predicted density error delta_adv + (A p)_i - delta0 */
                 const double res = (double)dadv[i] + dt2 * (double)s - nd0;

@@ -11,9 +11,13 @@
 typedef struct pfsph_solver_key {
     const char *name;
     double def, min, max;
-    int integer; /* non-zero: an integer */
+    int integer; /* non-zero: an integer; PFSPH_KEY_AUTO_BOOL: a choice */
     const char *doc;
 } pfsph_solver_key;
+
+/* A key's `integer` for a choice the scene writes as true, false or "auto", stored 1, -1 and 0
+ * (min -1, max 1; "auto" is 0 so that a scene without the key keeps its hash). */
+#define PFSPH_KEY_AUTO_BOOL 2
 
 /* The scene's solver settings, resolved by the simulation (sound speed chosen, pressure
  * scale decided), so that a solver reads no scene. */
@@ -50,8 +54,10 @@ typedef struct pfsph_solver_ops {
      * what it reads), so it lies in the stages' shared scratch instead of arrays of its own
      * (nscratch4 must be 0). */
     int scratch_per_call;
-    /* Non-zero: the step builds neighbour lists (ctx->nlist) after the density stage, for a
-     * solver that walks the neighbours many times per step (memory: src/core/nlist.h). */
+    /* Non-zero: the solver walks the neighbours many times per step, from neighbour lists
+     * (ctx->nlist, built after the density stage; memory: src/core/nlist.h) or, when ctx->nlist
+     * is NULL, by grid walks with the same terms in the same order (physics/neighbours.h). Its
+     * key "neighbour_lists" (true, false, "auto") chooses: pfsph__sim_lists (sim_estimate.c). */
     int neighbour_lists;
     /* Non-zero: amax_np, the non-pressure acceleration dt_limit receives, leaves viscosity out:
      * |g| + the largest pair-force acceleration (an upper bound of |g + a_pair|). Viscosity

@@ -155,6 +155,20 @@ int pfsph__json_bool(const cJSON *obj, const char *path, const char *key, bool *
     return PFSPH_OK;
 }
 
+int pfsph__json_tristate(const cJSON *obj, const char *path, const char *key, int *out, pfsph_jctx *ctx)
+{
+    const cJSON *v = get(obj, key);
+    if (!v) return PFSPH_OK;
+    char kp[512];
+    child_path(kp, sizeof kp, path, key);
+    if (cJSON_IsBool(v)) *out = cJSON_IsTrue(v) ? 1 : -1;
+    else if (cJSON_IsString(v) && v->valuestring && !strcmp(v->valuestring, "auto")) *out = 0;
+    else if (cJSON_IsString(v) && v->valuestring)
+        return pfsph__json_fail(ctx, kp, "expected true, false or \"auto\", got \"%.64s\"", v->valuestring);
+    else return pfsph__json_fail(ctx, kp, "expected true, false or \"auto\", got %s", type_name(v));
+    return PFSPH_OK;
+}
+
 int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char *out, size_t cap, pfsph_jctx *ctx)
 {
     const cJSON *v = get(obj, key);

@@ -21,6 +21,8 @@ int pfsph__json_number(const cJSON *obj, const char *path, const char *key, doub
                        pfsph_jctx *ctx);
 int pfsph__json_int(const cJSON *obj, const char *path, const char *key, long lo, long hi, int *out, pfsph_jctx *ctx);
 int pfsph__json_bool(const cJSON *obj, const char *path, const char *key, bool *out, pfsph_jctx *ctx);
+/* true, false or "auto": *out = 1, -1 or 0. */
+int pfsph__json_tristate(const cJSON *obj, const char *path, const char *key, int *out, pfsph_jctx *ctx);
 int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char *out, size_t cap, pfsph_jctx *ctx);
 /* An array of exactly n numbers, each in [lo, hi]. */
 int pfsph__json_vec(const cJSON *obj, const char *path, const char *key, int n, double lo, double hi, double *out,

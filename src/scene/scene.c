@@ -86,7 +86,11 @@ static int parse_solver(parser *p, const cJSON *root)
         for (int k = 0; k < ops->nkeys; k++) {
             const pfsph_solver_key *key = &ops->keys[k];
             double v = key->def;
-            if (key->integer) {
+            if (key->integer == PFSPH_KEY_AUTO_BOOL) {
+                int iv = (int)key->def;
+                TRY(pfsph__json_tristate(o, P, key->name, &iv, &p->ctx));
+                v = iv;
+            } else if (key->integer) {
                 int iv = (int)key->def;
                 TRY(pfsph__json_int(o, P, key->name, (long)key->min, (long)key->max, &iv, &p->ctx));
                 v = iv;

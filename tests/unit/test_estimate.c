@@ -178,32 +178,79 @@ static double run_peak(const char *scene, const char *dir)
     return (double)ru.ru_maxrss * 1024.0;
 }
 
+/* Issue 28: the estimate follows the neighbour-list choice. A 3D DFSPH (IISPH) scene with lists
+ * counts about 537 B per fluid particle more than with grid walks (src/sim_estimate.c); "auto"
+ * takes lists for a small scene, and grid walks where the lists' 32-bit offsets would overflow
+ * (2.2e8 particles, whatever the machine's memory); WCSPH builds none whatever the key says. */
+static double lists_estimate(const char *solver, const char *lists, double side, size_t *nf, int *built)
+{
+    char json[1024], key[64] = "";
+    if (lists) snprintf(key, sizeof key, ",\"neighbour_lists\":%s", lists);
+    snprintf(json, sizeof json,
+             "{\"dimension\":3,\"particle_radius\":0.005,\"domain\":{\"min\":[-0.1,-0.1,-0.1],"
+             "\"max\":[%g,%g,%g]},\"solver\":{\"type\":\"%s\"%s},"
+             "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0,0],\"max\":[%g,%g,%g]}]}",
+             side + 0.1, side + 0.1, side + 0.1, solver, key, side, side, side);
+    static pfsph_scene s;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(&s, json, "lists", &err), PFSPH_OK);
+    size_t bytes = 0;
+    assert_int_equal(pfsph_scene_estimate(&s, nf, NULL, &bytes, &err), PFSPH_OK);
+    *built = pfsph__sim_lists(&s, (double)*nf);
+    return (double)bytes;
+}
+
+static void test_lists_follow_mode(void **state)
+{
+    (void)state;
+    static const char *const solvers[] = {"dfsph", "iisph"};
+    size_t nf;
+    int on_built, off_built, auto_built;
+    for (int k = 0; k < 2; k++) {
+        const double on = lists_estimate(solvers[k], "true", 0.2, &nf, &on_built),
+                     off = lists_estimate(solvers[k], "false", 0.2, &nf, &off_built);
+        const double per = (on - off) / (double)nf;
+        printf("%s: %zu fluid particles, %.0f B each with lists, %.0f without: the lists %.0f B\n", solvers[k], nf,
+               on / (double)nf, off / (double)nf, per);
+        assert_true(on_built && !off_built);
+        assert_true(per > 1.05 * 530 && per < 1.05 * 545);
+        assert_true(lists_estimate(solvers[k], NULL, 0.2, &nf, &auto_built) == on && auto_built);
+    }
+    /* 6 m at d = 1 cm: 2.2e8 particles, 1.2e10 list entries */
+    const double big_off = lists_estimate("dfsph", "false", 6.0, &nf, &off_built);
+    assert_true(nf > 200000000);
+    assert_true(lists_estimate("dfsph", NULL, 6.0, &nf, &auto_built) == big_off && !auto_built);
+    assert_true(lists_estimate("dfsph", "true", 6.0, &nf, &on_built) > big_off && on_built);
+    assert_true(lists_estimate("wcsph", "true", 0.2, &nf, &on_built) ==
+                lists_estimate("wcsph", "false", 0.2, &nf, &off_built));
+    assert_true(!on_built && !off_built);
+}
+
 /* Item 7: the estimate is not below what a run holds at its peak (resident size of a run of
  * a 2D scene of 160,000 particles, less that of the same program on 16 particles), nor far
  * above it. 160,000 rather than 40,000: the small run's size varies by about 0.2 MiB, which at
  * 40,000 particles was 2 % of the measurement, as much as the estimate's margin (ratios
  * 1.01-1.03 over three runs). Under the sanitizers the run's own size means nothing: only the
  * estimate's. */
-static void test_estimate_vs_run(void **state)
+static void peak_vs_estimate(const char *solver, const char *tag)
 {
-    (void)state;
     static const char *const fmt =
         "{\"dimension\":2,\"particle_radius\":%s,\"gravity\":[0,-9.81],"
         "\"domain\":{\"min\":[-0.05,-0.05],\"max\":[1.05,1.05]},\"time\":{\"end\":0.01,\"fps\":100},"
         "\"phases\":[{\"name\":\"water\"},{\"name\":\"wall\",\"kind\":\"solid\"}],"
         "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0],\"max\":[%s,%s]}],"
         "\"solids\":[{\"shape\":\"container\",\"min\":[0,0],\"max\":[1,1],\"phase\":\"wall\"}],"
-        "\"output\":{\"formats\":[\"vtp\"],\"checkpoint_interval\":1}}";
+        "\"output\":{\"formats\":[\"vtp\"],\"checkpoint_interval\":1}%s}";
     char json[2048], path[600], dir[600];
-    snprintf(json, sizeof json, fmt, "0.00125", "1", "1");
-    snprintf(path, sizeof path, "%s/peak.json", tu_tmpdir());
+    snprintf(json, sizeof json, fmt, "0.00125", "1", "1", solver);
+    snprintf(path, sizeof path, "%s/peak%s.json", tu_tmpdir(), tag);
     assert_int_equal(tu_write_file(path, json), 0);
     static pfsph_scene s;
     pfsph_error err = {0};
     assert_int_equal(pfsph_scene_parse(&s, json, "peak", &err), PFSPH_OK);
     size_t nf, nb, bytes;
     assert_int_equal(pfsph_scene_estimate(&s, &nf, &nb, &bytes, &err), PFSPH_OK);
-    printf("estimate %.1f MiB (%.0f B per fluid particle) for %zu fluid + %zu boundary\n", bytes / 1048576.0,
+    printf("%s: estimate %.1f MiB (%.0f B per fluid particle) for %zu fluid + %zu boundary\n", tag, bytes / 1048576.0,
            (double)bytes / nf, nf, nb);
 #if defined(__SANITIZE_ADDRESS__) || defined(PFSPH_SANITIZED)
     /* clang's UBSan run measured 239 B per particle against 238 estimated */
@@ -216,13 +263,13 @@ static void test_estimate_vs_run(void **state)
         printf("this process holds %ld KiB (valgrind?): no measurement\n", self.ru_maxrss);
         tu_skip("a forked child would start with this process's size (valgrind?)");
     }
-    snprintf(dir, sizeof dir, "%s/peak_run", tu_tmpdir());
+    snprintf(dir, sizeof dir, "%s/peak%s_run", tu_tmpdir(), tag);
     double peak = run_peak(path, dir);
     char small[600];
-    snprintf(json, sizeof json, fmt, "0.00125", "0.005", "0.005");
-    snprintf(small, sizeof small, "%s/base.json", tu_tmpdir());
+    snprintf(json, sizeof json, fmt, "0.00125", "0.005", "0.005", solver);
+    snprintf(small, sizeof small, "%s/base%s.json", tu_tmpdir(), tag);
     assert_int_equal(tu_write_file(small, json), 0);
-    snprintf(dir, sizeof dir, "%s/base_run", tu_tmpdir());
+    snprintf(dir, sizeof dir, "%s/base%s_run", tu_tmpdir(), tag);
     double base = run_peak(small, dir);
     double used = peak - base;
     printf("run peak RSS %.1f MiB, the program alone %.1f MiB: %.0f B per fluid particle; estimate / measured %.2f\n",
@@ -231,14 +278,26 @@ static void test_estimate_vs_run(void **state)
     assert_true((double)bytes <= 2.0 * used);
 }
 
+static void test_estimate_vs_run(void **state)
+{
+    (void)state;
+    peak_vs_estimate("", "pcisph");
+}
+
+/* Issue 28: DFSPH with grid walks instead of neighbour lists, as a large scene runs it */
+static void test_estimate_vs_run_dfsph_grid(void **state)
+{
+    (void)state;
+    peak_vs_estimate(",\"solver\":{\"type\":\"dfsph\",\"neighbour_lists\":false}", "dfsph_grid");
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_counts_match_walk),
-        cmocka_unit_test(test_huge_counts_fast),
-        cmocka_unit_test(test_grid_term),
-        cmocka_unit_test(test_estimate_vs_run),
+        cmocka_unit_test(test_counts_match_walk), cmocka_unit_test(test_huge_counts_fast),
+        cmocka_unit_test(test_grid_term),         cmocka_unit_test(test_lists_follow_mode),
+        cmocka_unit_test(test_estimate_vs_run),   cmocka_unit_test(test_estimate_vs_run_dfsph_grid),
     };
     return tu_run_group(tests, NULL, NULL);
 }

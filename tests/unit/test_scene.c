@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pfsph/checkpoint.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 #include "scene/shapes.h"
@@ -297,6 +298,26 @@ static void test_two_containers_keep_fluid(void **state)
     free(s);
 }
 
+/* Issue 28: $.solver.neighbour_lists is true, false or "auto" (stored 1, -1, 0); "auto" is the
+ * default and keeps the hash of a scene that does not name it (its checkpoints resume). */
+static void test_neighbour_lists_key(void **state)
+{
+    (void)state;
+    static const char *const vals[] = {NULL, "\"auto\"", "true", "false"};
+    static const double want[] = {0, 0, 1, -1};
+    uint64_t h[4];
+    for (int i = 0; i < 4; i++) {
+        char json[512];
+        snprintf(json, sizeof json, SCENE3(",\"solver\":{\"type\":\"dfsph\"%s%s}"),
+                 vals[i] ? ",\"neighbour_lists\":" : "", vals[i] ? vals[i] : "");
+        expect_ok(json);
+        assert_true(pfsph_scene_solver_setting(&g_scene, "neighbour_lists") == want[i]);
+        h[i] = pfsph_scene_hash(&g_scene);
+    }
+    assert_true(h[0] == h[1]);
+    assert_true(h[2] != h[1] && h[3] != h[1] && h[2] != h[3]);
+}
+
 static void test_error_leaves_scene_unchanged(void **state)
 {
     (void)state;
@@ -534,6 +555,10 @@ static const bad_case bad_cases[] = {
      "unknown value"},
     {"solver_iterations", SCENE3(",\"solver\":{\"min_iterations\":10,\"max_iterations\":5}"), "$.solver.min_iterations",
      "greater than max_iterations"},
+    {"solver_lists_number", SCENE3(",\"solver\":{\"type\":\"dfsph\",\"neighbour_lists\":1}"),
+     "$.solver.neighbour_lists", "expected true, false or \"auto\", got a number"},
+    {"solver_lists_string", SCENE3(",\"solver\":{\"type\":\"iisph\",\"neighbour_lists\":\"yes\"}"),
+     "$.solver.neighbour_lists", "expected true, false or \"auto\", got \"yes\""},
     {"dimension_4", "{\"dimension\":4," DOM3 "," FLUID3 "}", "$.dimension", "must be 2 or 3"},
     {"dimension_string", "{\"dimension\":\"3d\"," DOM3 "," FLUID3 "}", "$.dimension", "must be 2 or 3"},
     {"shape_unknown", "{" DOM3 ",\"fluid\":[{\"shape\":\"cube\"}]}", "$.fluid[0].shape", "unknown value \"cube\""},
@@ -637,6 +662,7 @@ int main(int argc, char **argv)
     static const struct CMUnitTest fixed[] = {
         cmocka_unit_test(test_full_scene),
         cmocka_unit_test(test_defaults),
+        cmocka_unit_test(test_neighbour_lists_key),
         cmocka_unit_test(test_2d),
         cmocka_unit_test(test_touching_blocks_ok),
         cmocka_unit_test(test_two_containers_keep_fluid),

@@ -49,6 +49,10 @@ static const cli_case cases[] = {
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"pairwise\":{\"thermostat\":{\"kT\":-1}}}",
      "$.pairwise.thermostat.kT: value -1 is out of range"},
+    {"lists.json", /* issue 28: DFSPH's neighbour lists are true, false or "auto" */
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"solver\":{\"type\":\"dfsph\",\"neighbour_lists\":\"never\"}}",
+     "$.solver.neighbour_lists: expected true, false or \"auto\", got \"never\""},
 };
 #define NCASES (sizeof cases / sizeof cases[0])
 
