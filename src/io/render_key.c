@@ -48,12 +48,26 @@ void pfsph__draw_text(uint8_t *rgb, int w, int h, int x0, int y0, int sc, const 
     }
 }
 
+static void panel(uint8_t *rgb, int w, int h, int x0, int y0, int pw, int ph);
+
 /* A colour bar at the right edge for the field the fluid is coloured by, its range at the ends
- * (the numbers in the built-in font: digits, '.', '-', 'e'). */
+ * (the numbers in the caption's font: digits, '.', '-', 'e'), on a light panel. */
 static void colour_bar(uint8_t *rgb, int w, int h, int sc, const double range[2])
 {
     const int bw = 10 * sc, bh = h / 3, x0 = w - bw - 8 * sc - 40 * sc, y0 = h / 3;
     if (x0 < 0 || bh < 8) return;
+    char out[2][32];
+    int nw = 0;
+    for (int e = 0; e < 2; e++) {
+        char num[32];
+        snprintf(num, sizeof num, "%.3g", range[1 - e]);
+        size_t j = 0; /* "1.5e+03" -> "1.5e03": the font has no '+' */
+        for (const char *t = num; *t && j + 1 < sizeof out[e]; t++)
+            if (*t != '+') out[e][j++] = *t;
+        out[e][j] = 0;
+        if ((int)j * 6 * sc > nw) nw = (int)j * 6 * sc;
+    }
+    panel(rgb, w, h, x0 - 3 * sc, y0 - 3 * sc, bw + 3 * sc + nw + 5 * sc, bh + 6 * sc);
     for (int y = 0; y < bh; y++) {
         float c[3];
         pfsph__viridis(1.0 - (double)y / (bh - 1), c);
@@ -62,15 +76,7 @@ static void colour_bar(uint8_t *rgb, int w, int h, int sc, const double range[2]
             for (int k = 0; k < 3; k++) p[k] = (uint8_t)lrint(c[k] * 255.0f);
         }
     }
-    for (int e = 0; e < 2; e++) {
-        char num[32], out[32];
-        snprintf(num, sizeof num, "%.3g", range[1 - e]);
-        size_t j = 0; /* "1.5e+03" -> "1.5e03": the font has no '+' */
-        for (const char *t = num; *t && j + 1 < sizeof out; t++)
-            if (*t != '+') out[j++] = *t;
-        out[j] = 0;
-        pfsph__draw_text(rgb, w, h, x0 + bw + 3 * sc, e ? y0 + bh - 7 * sc : y0, sc, out);
-    }
+    for (int e = 0; e < 2; e++) pfsph__draw_text(rgb, w, h, x0 + bw + 3 * sc, e ? y0 + bh - 7 * sc : y0, sc, out[e]);
 }
 
 /* ---- the key ---------------------------------------------------------------------------- */
