@@ -101,7 +101,8 @@ static const char *HELP_RENDER =
     "                          bodies' (frames/surfaces_*.ply), otherwise drawn as solids\n"
     "  --all-walls             3D: keep the tank walls facing the camera (cut away by default,\n"
     "                          so that what stands in the tank shows)\n"
-    "  --no-legend             no colour bar for the field the fluid is coloured by\n"
+    "  --no-legend             no key: colour bar (field, unit), legend of the colours\n"
+    "                          (phases, walls, bodies, spray/foam/bubbles), scale bar\n"
     "  --color-by FIELD        phase, speed, density or pressure (default: the scene camera's)\n"
     "  --size WxH              image size in pixels, 16..16384 each (default: the camera's)\n"
     "  -h, --help              this text\n";

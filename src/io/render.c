@@ -199,7 +199,20 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
     snprintf(cap, sizeof cap, "frame %d  t=%.3f s", frame, time);
     int tsc = oh >= 400 ? 2 : 1;
     pfsph__draw_text(x->rgb, ow, oh, 6 * tsc, oh - 9 * tsc - 4, tsc, cap);
-    if (x->color_by != PFSPH__COLOR_PHASE && !mesh && !x->no_legend) pfsph__draw_legend(x->rgb, ow, oh, tsc, range);
+    if (!x->no_legend) {
+        pfsph__key key = {.sc = sc,
+                          .cam = &x->c,
+                          .ss = ss,
+                          .tsc = tsc,
+                          .color_by = x->color_by,
+                          .range = {range[0], range[1]},
+                          .fluid_phases = x->color_by == PFSPH__COLOR_PHASE && !mesh,
+                          .liquid_mesh = mesh,
+                          .walls = bnd,
+                          .bodies = (bod && bod->n) || bmeshes,
+                          .diffuse = dif};
+        pfsph__draw_key(x->rgb, ow, oh, &key);
+    }
 
     return pfsph_write_png_rgb(png_path, x->rgb, ow, oh, err);
 oom:

@@ -17,6 +17,7 @@ static void look_at(cam *c, const double eye[3], const double target[3], const d
         c->eye[k] = eye[k];
         c->fwd[k] = target[k] - eye[k];
     }
+    c->dist = sqrt(pfsph__rdot3(c->fwd, c->fwd));
     pfsph__rnorm3(c->fwd);
     pfsph__rcross3(c->fwd, up, c->right);
     pfsph__rnorm3(c->right);

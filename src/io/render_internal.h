@@ -42,6 +42,7 @@ typedef struct pfsph__rcam {
     double eye[3], right[3], up[3], fwd[3];
     double f;      /* perspective: focal length in pixels; ortho: pixels per metre */
     double cx, cy; /* ortho: world x, y at the image centre */
+    double dist;   /* perspective: the eye's distance to the target [m] (the scale bar's depth) */
     int w, h;      /* supersampled image size */
 } pfsph__rcam;
 
@@ -112,12 +113,28 @@ void pfsph__shade_solid(const float n[3], const float col[3], float out[3]);
 /* The colour of body b of the bodies' surface file: its phase's, as its particles are drawn. */
 void pfsph__body_color(const pfsph_scene *sc, int b, float col[3]);
 
-/* ---- caption and legend (render_raster.c) ------------------------------------------------ */
+/* ---- caption and key (render_key.c) ------------------------------------------------------ */
 
-/* Text in the built-in 5x7 font (digits, "framets=.- "), scale sc, into 8-bit RGB rows. */
+/* The caption in the built-in 5x7 font (digits, "framets=.- "), scale sc, into 8-bit RGB rows. */
 void pfsph__draw_text(uint8_t *rgb, int w, int h, int x0, int y0, int sc, const char *txt);
-/* The colour bar of the fluid's field at the right edge, its range at the ends. */
-void pfsph__draw_legend(uint8_t *rgb, int w, int h, int sc, const double range[2]);
+
+/* What a preview's key shows (pfsph__draw_key); tsc: the caption's text scale. */
+typedef struct pfsph__key {
+    const pfsph_scene *sc;
+    const pfsph__rcam *cam; /* the supersampled camera; ss its factor */
+    int ss, tsc;
+    int color_by;                           /* PFSPH__COLOR_*: a colour bar unless phase or the liquid is a mesh */
+    double range[2];                        /* the colour bar's range */
+    bool fluid_phases;                      /* the fluid's particles are drawn in their phases' colours */
+    bool liquid_mesh;                       /* the liquid is drawn as a water surface */
+    const pfsph_particles *walls, *diffuse; /* NULL: none drawn */
+    bool bodies;                            /* the scene's bodies are drawn */
+} pfsph__key;
+
+/* The key of a preview: the colour bar of the fluid's field with its name and unit (right), a
+ * legend of what is drawn in a colour of its own, with names: fluid phases, the water surface,
+ * walls, bodies, spray/foam/bubbles (top left), and a scale bar (bottom right). */
+void pfsph__draw_key(uint8_t *rgb, int w, int h, const pfsph__key *k);
 
 /* ---- files (frame_list.c, video.c) -------------------------------------------------------- */
 

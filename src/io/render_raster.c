@@ -1,7 +1,7 @@
 /* The renderer's rasteriser (render_internal.h): particles splatted as shaded spheres (screen
  * discs with per-pixel depth, Lambert + ambient + a little specular), meshes rasterised as
  * triangles (the liquid shaded as water, the bodies as flat-shaded solids), their colours, the
- * background, and the caption and legend in a tiny built-in font. */
+ * background (the caption and the key: render_key.c). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -107,8 +107,19 @@ int pfsph_wall_color(const pfsph_scene *s, int phase, float out[3])
     /* muted, distinct from the fluids' palette and from the grey */
     static const float plates[6][3] = {{0.80f, 0.55f, 0.35f}, {0.45f, 0.65f, 0.45f}, {0.55f, 0.50f, 0.75f},
                                        {0.75f, 0.70f, 0.40f}, {0.40f, 0.65f, 0.70f}, {0.75f, 0.45f, 0.55f}};
+    /* the walls' grey when a fluid or gas phase is drawn in a grey like it (the bubble scenes'
+     * near-white gas): a darker slate, so that the gas does not read as wall */
+    static const float slate[3] = {0.46f, 0.48f, 0.53f};
     memcpy(out, grey, sizeof grey);
     if (phase < 0 || phase >= s->nphases) return 0;
+    int dark = 0;
+    for (int p = 0; p < s->nphases; p++) {
+        if (s->phases[p].kind == PFSPH_PHASE_SOLID) continue;
+        float d = 0;
+        for (int k = 0; k < 3; k++) d = fmaxf(d, fabsf(s->phases[p].color[k] - grey[k]));
+        if (d < 0.2f) dark = 1;
+    }
+    if (dark) memcpy(out, slate, sizeof slate);
     if (s->phases[phase].color_set) {
         memcpy(out, s->phases[phase].color, sizeof grey);
         return 1;
@@ -119,7 +130,7 @@ int pfsph_wall_color(const pfsph_scene *s, int phase, float out[3])
             if (p == phase) rank = uncoloured;
             uncoloured++;
         }
-    if (uncoloured < 2 || rank <= 0) return 0;
+    if (uncoloured < 2 || rank <= 0) return dark;
     memcpy(out, plates[(rank - 1) % 6], sizeof grey);
     return 1;
 }
@@ -189,68 +200,6 @@ void pfsph__background(int y, int h, double out[3])
     double t = h > 1 ? (double)y / (h - 1) : 0;
     const double top[3] = {0.945, 0.950, 0.965}, bot[3] = {0.840, 0.850, 0.875};
     for (int k = 0; k < 3; k++) out[k] = (1 - t) * top[k] + t * bot[k];
-}
-
-/* ---- caption: a tiny built-in 5x7 font ------------------------------------------------ */
-
-static const char GLYPH_CH[] = "0123456789framets=.- ";
-static const uint8_t GLYPH[][7] = {
-    {0x0E, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0E}, {0x04, 0x0C, 0x04, 0x04, 0x04, 0x04, 0x0E},
-    {0x0E, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1F}, {0x1F, 0x02, 0x04, 0x02, 0x01, 0x11, 0x0E},
-    {0x02, 0x06, 0x0A, 0x12, 0x1F, 0x02, 0x02}, {0x1F, 0x10, 0x1E, 0x01, 0x01, 0x11, 0x0E},
-    {0x06, 0x08, 0x10, 0x1E, 0x11, 0x11, 0x0E}, {0x1F, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08},
-    {0x0E, 0x11, 0x11, 0x0E, 0x11, 0x11, 0x0E}, {0x0E, 0x11, 0x11, 0x0F, 0x01, 0x02, 0x0C},
-    {0x06, 0x09, 0x08, 0x1C, 0x08, 0x08, 0x08}, {0x00, 0x00, 0x16, 0x19, 0x10, 0x10, 0x10},
-    {0x00, 0x00, 0x0E, 0x01, 0x0F, 0x11, 0x0F}, {0x00, 0x00, 0x1A, 0x15, 0x15, 0x11, 0x11},
-    {0x00, 0x00, 0x0E, 0x11, 0x1F, 0x10, 0x0E}, {0x08, 0x08, 0x1C, 0x08, 0x08, 0x09, 0x06},
-    {0x00, 0x00, 0x0E, 0x10, 0x0E, 0x01, 0x1E}, {0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00},
-    {0x00, 0x00, 0x00, 0x00, 0x00, 0x0C, 0x0C}, {0x00, 0x00, 0x00, 0x1F, 0x00, 0x00, 0x00},
-    {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00},
-};
-
-void pfsph__draw_text(uint8_t *rgb, int w, int h, int x0, int y0, int sc, const char *txt)
-{
-    for (const char *t = txt; *t; t++, x0 += 6 * sc) {
-        const char *g = strchr(GLYPH_CH, *t);
-        if (!g) continue;
-        const uint8_t *rows = GLYPH[g - GLYPH_CH];
-        for (int r = 0; r < 7; r++)
-            for (int c = 0; c < 5; c++) {
-                if (!(rows[r] & (0x10 >> c))) continue;
-                for (int a = 0; a < sc; a++)
-                    for (int b = 0; b < sc; b++) {
-                        int x = x0 + c * sc + b, y = y0 + r * sc + a;
-                        if (x < 0 || y < 0 || x >= w || y >= h) continue;
-                        uint8_t *p = rgb + 3 * ((size_t)y * w + x);
-                        p[0] = 55, p[1] = 58, p[2] = 66;
-                    }
-            }
-    }
-}
-
-/* A colour bar at the right edge for the field the fluid is coloured by, its range at the ends
- * (the numbers in the built-in font: digits, '.', '-', 'e'). */
-void pfsph__draw_legend(uint8_t *rgb, int w, int h, int sc, const double range[2])
-{
-    const int bw = 10 * sc, bh = h / 3, x0 = w - bw - 8 * sc - 40 * sc, y0 = h / 3;
-    if (x0 < 0 || bh < 8) return;
-    for (int y = 0; y < bh; y++) {
-        float c[3];
-        pfsph__viridis(1.0 - (double)y / (bh - 1), c);
-        for (int x = 0; x < bw; x++) {
-            uint8_t *p = rgb + 3 * ((size_t)(y0 + y) * w + x0 + x);
-            for (int k = 0; k < 3; k++) p[k] = (uint8_t)lrint(c[k] * 255.0f);
-        }
-    }
-    for (int e = 0; e < 2; e++) {
-        char num[32], out[32];
-        snprintf(num, sizeof num, "%.3g", range[1 - e]);
-        size_t j = 0; /* "1.5e+03" -> "1.5e03": the font has no '+' */
-        for (const char *t = num; *t && j + 1 < sizeof out; t++)
-            if (*t != '+') out[j++] = *t;
-        out[j] = 0;
-        pfsph__draw_text(rgb, w, h, x0 + bw + 3 * sc, e ? y0 + bh - 7 * sc : y0, sc, out);
-    }
 }
 
 /* ---- meshes ---------------------------------------------------------------------------- */

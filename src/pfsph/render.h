@@ -13,7 +13,7 @@ typedef struct pfsph_render_opts {
     int first, last;      /* frame range, last < 0 for all */
     bool quiet;           /* kept for callers; the library never prints (see progress) */
     bool all_walls;       /* 3D: keep the walls that face the camera (default: cut away) */
-    bool no_legend;       /* no colour bar for the coloured field */
+    bool no_legend;       /* no key: colour bar, legend of phases, bodies and diffuse kinds, scale bar */
     bool particles;       /* draw the fluid's and the bodies' particles even where
                             * frames/liquid_NNNNN.ply (a surface mesh, shaded as water) and
                             * frames/surfaces_NNNNN.ply (the bodies' meshes) exist */
@@ -75,8 +75,10 @@ bool pfsph_cutaway_hides(const pfsph_cutaway *cw, const double eye[3], const dou
 /* The colour walls of solid phase `phase` are drawn in (render and viewer): the phase's own
  * "color"; else light grey for the first solid phase and, when a scene has several solid phases
  * without colours (pf_wetting's five plates), a muted colour of its own for each of the others, so
- * that they can be told apart (and named in the viewer's legend). Returns 1 when the colour is not
- * the plain grey (the phase belongs in a legend). */
+ * that they can be told apart (and named in the viewer's legend). The grey turns a darker slate
+ * when a fluid or gas phase is drawn in a grey like it (within 0.2 per channel: the bubble scenes'
+ * near-white gas). Returns 1 when the colour is not the plain light grey (the phase belongs in a
+ * legend). */
 int pfsph_wall_color(const struct pfsph_scene *s, int phase, float out[3]);
 
 /* Encode 8-bit RGB rows (top first) as a PNG and write it atomically. */

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "io/colormap.h"
+#include "io/font.h"
 
 typedef struct layer {
     GLuint fbo, col, depth;
@@ -495,40 +496,15 @@ void pfsph_vdraw_colorbar(pfsph_vdraw *d, float x, float y, float w, float h)
     }
 }
 
-/* A 3x5 pixel font of our own (upper case, digits, the punctuation the overlay uses): small
- * enough to type in and read here, so the viewer needs no font library or font file. */
-static const struct glyph {
-    char c;
-    const char *rows; /* 5 rows of 3, '#' lit */
-} FONT[] = {
-    {'0', "####.##.##.####"}, {'1', ".#.##..#..#.###"},  {'2', "###..#####..###"}, {'3', "###..#.##..####"},
-    {'4', "#.##.####..#..#"}, {'5', "####..###..####"},  {'6', "####..####.####"}, {'7', "###..#..#.#..#."},
-    {'8', "####.#####.####"}, {'9', "####.####..####"},  {'A', ".#.#.#####.##.#"}, {'B', "##.#.###.#.###."},
-    {'C', ".###..#..#...##"}, {'D', "##.#.##.##.###."},  {'E', "####..##.#..###"}, {'F', "####..##.#..#.."},
-    {'G', ".###..#.##.#.##"}, {'H', "#.##.#####.##.#"},  {'I', "###.#..#..#.###"}, {'J', "..#..#..##.#.#."},
-    {'K', "#.##.###.#.##.#"}, {'L', "#..#..#..#..###"},  {'M', "#.#####.##.##.#"}, {'N', "##.#.##.##.##.#"},
-    {'O', ".#.#.##.##.#.#."}, {'P', "##.#.###.#..#.."},  {'Q', ".#.#.##.###..##"}, {'R', "##.#.###.#.##.#"},
-    {'S', ".###...#...###."}, {'T', "###.#..#..#..#."},  {'U', "#.##.##.##.####"}, {'V', "#.##.##.##.#.#."},
-    {'W', "#.##.########.#"}, {'X', "#.##.#.#.#.##.#"},  {'Y', "#.##.#.#..#..#."}, {'Z', "###..#.#.#..###"},
-    {'.', "............#.."}, {'-', "......###......"},  {'=', "...###...###..."}, {'/', "..#..#.#.#..#.."},
-    {':', "....#.....#...."}, {'%', "#.#..#.#.#..#.#"},  {',', ".........#.#..."}, {'(', ".#.#..#..#...#."},
-    {')', ".#...#..#..#.#."}, {'+', "....#.###.#...."},  {'[', "##.#..#..#..##."}, {']', ".##..#..#..#.##"},
-    {'_', "............###"}, {'>', "#...#...#.#.#.."},  {'<', "..#.#.#...#...#"}, {'*', "....#.#.#.#...."},
-    {'^', ".#.#.#........."}, {'\'', ".#..#.........."},
-};
-
 float pfsph_vdraw_text(pfsph_vdraw *d, float x, float y, float sc, const char *s, const float rgba[4])
 {
     for (; *s; s++) {
-        char c = *s >= 'a' && *s <= 'z' ? (char)(*s - 'a' + 'A') : *s;
-        const char *rows = NULL;
-        for (size_t g = 0; g < sizeof FONT / sizeof FONT[0]; g++)
-            if (FONT[g].c == c) rows = FONT[g].rows;
-        if (rows && strlen(rows) == 15)
-            for (int r = 0; r < 5; r++)
-                for (int k = 0; k < 3; k++)
-                    if (rows[3 * r + k] == '#') pfsph_vdraw_rect(d, x + k * sc, y + r * sc, sc, sc, rgba);
-        x += 4 * sc;
+        const char *rows = pfsph_font_glyph(*s);
+        if (rows)
+            for (int r = 0; r < PFSPH_FONT_H; r++)
+                for (int k = 0; k < PFSPH_FONT_W; k++)
+                    if (rows[PFSPH_FONT_W * r + k] == '#') pfsph_vdraw_rect(d, x + k * sc, y + r * sc, sc, sc, rgba);
+        x += PFSPH_FONT_ADVANCE * sc;
     }
     return x;
 }

@@ -48,7 +48,7 @@ void pfsph_vdraw_mesh(pfsph_vdraw *d, const pfsph_vmesh *m, int water);
 /* Composite the layers over the background into the frame. */
 void pfsph_vdraw_composite(pfsph_vdraw *d);
 /* Overlay, in pixels from the top left: a filled rectangle, text (3x5 font scaled by sc; letters
- * are drawn upper case), and the colour bar of io/colormap.h. */
+ * are drawn upper case: io/font.h), and the colour bar of io/colormap.h. */
 void pfsph_vdraw_rect(pfsph_vdraw *d, float x, float y, float w, float h, const float rgba[4]);
 float pfsph_vdraw_text(pfsph_vdraw *d, float x, float y, float sc, const char *s, const float rgba[4]);
 void pfsph_vdraw_colorbar(pfsph_vdraw *d, float x, float y, float w, float h);

@@ -1,6 +1,7 @@
 /* PNG previews: a hand-made run directory (scene.json + frames written with the frame writers)
  * is rendered; the images must have the requested size, show particles where they project and
  * leave the corners as background. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -250,6 +251,130 @@ static void test_render_wall_color(void **state)
     free(m.rgb);
 }
 
+/* The key (issue 33 item 13): coloured by phase, a legend at the top left with a swatch of each
+ * phase's colour (water, gas, the walls) and of each diffuse kind drawn, and their names; a
+ * scale bar of 0.2 m at the bottom right, exactly as long as 0.2 m of the picture (2D); coloured
+ * by speed, the colour bar's name and unit above it; --no-legend: none of it. The gas (near-white
+ * grey) is drawn unlike the walls, which turn slate. */
+static const char SCENE_KEY[] =
+    "{\n"
+    "  \"name\": \"render key 2d\", \"dimension\": 2, \"particle_radius\": 0.01,\n"
+    "  \"gravity\": [0, -9.81],\n"
+    "  \"domain\": {\"min\": [0, 0], \"max\": [1, 1]},\n"
+    "  \"time\": {\"end\": 0.1, \"fps\": 10},\n"
+    "  \"phases\": [\n"
+    "    {\"name\": \"water\", \"kind\": \"fluid\", \"color\": [0.1, 0.3, 0.9]},\n"
+    "    {\"name\": \"gas\", \"kind\": \"gas\", \"color\": [0.95, 0.95, 0.95]},\n"
+    "    {\"name\": \"wall\", \"kind\": \"solid\"}\n"
+    "  ],\n"
+    "  \"fluid\": [{\"shape\": \"box\", \"min\": [0.1, 0.1], \"max\": [0.4, 0.4], \"phase\": \"water\"}],\n"
+    "  \"solids\": [{\"shape\": \"container\", \"min\": [0.02, 0.02], \"max\": [0.98, 0.98],\n"
+    "              \"layers\": 1, \"phase\": \"wall\"}]\n"
+    "}\n";
+
+static int near(const unsigned char *p, const uint8_t c[3])
+{
+    return abs(p[0] - c[0]) <= 1 && abs(p[1] - c[1]) <= 1 && abs(p[2] - c[2]) <= 1;
+}
+
+static const uint8_t INK[3] = {55, 58, 66};
+
+/* Pixels of colour c in [x0, x1) x [y0, y1). */
+static int count_in(const img *m, int x0, int y0, int x1, int y1, const uint8_t c[3])
+{
+    int n = 0;
+    for (int y = y0; y < y1; y++)
+        for (int x = x0; x < x1; x++) n += near(px(m, x, y), c);
+    return n;
+}
+
+static void rgb8(const float f[3], uint8_t c[3])
+{
+    for (int k = 0; k < 3; k++) c[k] = (uint8_t)lrintf(f[k] * 255.0f);
+}
+
+static void test_render_key(void **state)
+{
+    (void)state;
+    const char *run = make_run("runkey", SCENE_KEY);
+    char p[700];
+    pfsph_particles fl, bd, df;
+    pfsph_io_opts o = {.dim = 2, .write_speed = true};
+    assert_int_equal(pfsph_particles_init(&fl, 64), PFSPH_OK);
+    block(&fl, 0.1, 0.1, 0, 16, 16, 1, 0.02, 0, 0.1); /* water */
+    block(&fl, 0.6, 0.1, 0, 10, 10, 1, 0.02, 1, 0);   /* gas */
+    snprintf(p, sizeof p, "%s/frames/fluid_00000.vtp", run);
+    write_or_fail(p, &fl, &o);
+    pfsph_particles_free(&fl);
+    assert_int_equal(pfsph_particles_init(&bd, 64), PFSPH_OK);
+    block(&bd, 0.02, 0.02, 0, 49, 1, 1, 0.02, 2, 0); /* floor */
+    o.aux_name = "volume";
+    snprintf(p, sizeof p, "%s/frames/boundary_00000.vtp", run);
+    write_or_fail(p, &bd, &o);
+    pfsph_particles_free(&bd);
+    assert_int_equal(pfsph_particles_init(&df, 8), PFSPH_OK);
+    for (uint8_t t = 0; t < 3; t++) block(&df, 0.7 + 0.05 * t, 0.8, 0, 1, 1, 1, 0.05, t, 0); /* spray, foam, bubble */
+    o.aux_name = "lifetime";
+    snprintf(p, sizeof p, "%s/frames/diffuse_00000.vtp", run);
+    write_or_fail(p, &df, &o);
+    pfsph_particles_free(&df);
+
+    pfsph_scene *sc = malloc(sizeof *sc);
+    pfsph_error err = {0};
+    snprintf(p, sizeof p, "%s/scene.json", run);
+    if (pfsph_scene_load(sc, p, &err)) fail_msg("%s", err.msg);
+    float wf[3];
+    assert_int_equal(pfsph_wall_color(sc, 2, wf), 1); /* not the plain grey: the gas is grey */
+    uint8_t water[3], gas[3], wall[3];
+    rgb8(sc->phases[0].color, water);
+    rgb8(sc->phases[1].color, gas);
+    rgb8(wf, wall);
+    free(sc);
+    const uint8_t spray[3] = {250, 250, 250}, foam[3] = {204, 209, 217}, bubble[3] = {140, 199, 250};
+
+    pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1, .quiet = true};
+    int count = -1;
+    if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
+    snprintf(p, sizeof p, "%s/png/frame_00000.png", run);
+    img m = tu_read_png(p);
+    /* the legend, top left: a swatch of each colour and the names' letters */
+    const uint8_t *sw[] = {water, gas, wall, spray, foam, bubble};
+    for (int i = 0; i < 6; i++) assert_true(count_in(&m, 0, 0, 110, 110, sw[i]) >= 16);
+    assert_true(count_in(&m, 0, 0, 110, 110, INK) > 100);
+    /* the gas is not drawn like the walls */
+    int gx, gy, wx, wy;
+    to_px(m.w, m.h, 0.7, 0.2, &gx, &gy);
+    to_px(m.w, m.h, 0.8, 0.02, &wx, &wy);
+    const unsigned char *g = px(&m, gx, gy), *w = px(&m, wx, wy);
+    assert_true(abs(g[0] - w[0]) + abs(g[1] - w[1]) + abs(g[2] - w[2]) > 120);
+    /* the scale bar, bottom right: 0.2 m is 0.2 * 0.94 * 180 = 33.8 pixels */
+    int longest = 0;
+    for (int y = 150; y < 180; y++) {
+        int run_len = 0;
+        for (int x = 200; x < 320; x++) {
+            run_len = near(px(&m, x, y), INK) ? run_len + 1 : 0;
+            if (run_len > longest) longest = run_len;
+        }
+    }
+    assert_true(abs(longest - 34) <= 1);
+    free(m.rgb);
+
+    /* by speed: the colour bar's name and unit above the bar */
+    ro.color_by = "speed";
+    if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
+    m = tu_read_png(p);
+    assert_true(count_in(&m, 200, 30, 320, 58, INK) > 60);
+    free(m.rgb);
+    /* --no-legend: no key */
+    ro.no_legend = true;
+    if (pfsph_render_run(run, &ro, &count, &err)) fail_msg("%s", err.msg);
+    m = tu_read_png(p);
+    assert_int_equal(count_in(&m, 200, 30, 320, 58, INK), 0);
+    assert_int_equal(count_in(&m, 0, 0, 110, 110, INK), 0);
+    assert_int_equal(count_in(&m, 200, 140, 320, 180, INK), 0);
+    free(m.rgb);
+}
+
 static void test_render_3d_default_camera(void **state)
 {
     (void)state;
@@ -344,6 +469,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_render_2d),
         cmocka_unit_test(test_render_wall_color),
+        cmocka_unit_test(test_render_key),
         cmocka_unit_test(test_wall_colors),
         cmocka_unit_test(test_render_3d_default_camera),
         cmocka_unit_test(test_render_3d_scene_camera),
