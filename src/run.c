@@ -402,6 +402,15 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
     fflush(f);
 }
 
+/* The rows so far reached stats.csv or bodies.csv (flushed), else PFSPH_EIO naming the file:
+ * a full disk must not cut the statistics silently. */
+static int csv_flushed(FILE *f, const char *path, pfsph_error *err)
+{
+    int bad = fflush(f) != 0 || ferror(f) || pfsph__write_fault(path);
+    int e = errno;
+    return bad ? pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", path, strerror(e ? e : EIO)) : PFSPH_OK;
+}
+
 typedef struct run_info {
     int resumed_from; /* checkpoint frame, -1: fresh run */
     int ckpt_frame;   /* last checkpoint written by this process, -1: none */
@@ -622,6 +631,9 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
              "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s%s\n",
              s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "",
              pfsph_thermostat_kT(pfsph_sim_ctx(sim)) > 0 ? ",kT,kT_set" : "");
+    char csv_path[PFSPH_PATH_LEN + 64], bcsv_path[PFSPH_PATH_LEN + 64];
+    snprintf(csv_path, sizeof csv_path, "%s/stats.csv", dir);
+    snprintf(bcsv_path, sizeof bcsv_path, "%s/bodies.csv", dir);
     snprintf(path, sizeof path, "%s/stats.csv", dir);
     long kept = -1;
     if (resume && (rc = truncate_csv(path, header, frame0, &kept, err))) {
@@ -676,6 +688,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (!rc) written++;
         csv_row(csv, 0, sim);
         if (bcsv) bodies_rows(bcsv, 0, sim);
+        if (!rc) rc = csv_flushed(csv, csv_path, err);
+        if (!rc && bcsv) rc = csv_flushed(bcsv, bcsv_path, err);
     } else {
         written = frame0 / fi + 1; /* on disk from before */
     }
@@ -690,8 +704,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     snprintf(stash, sizeof stash, "%s/.last_good.bin", dir);
     int good = 0;
     int good_frame = frame0;
-    pfsph_error enc_err;
-    if (pfsph_checkpoint_stash(stash, sim, frame0, &enc_err) == PFSPH_OK) good = 1;
+    if (!rc && (rc = pfsph_checkpoint_stash(stash, sim, frame0, err)) == PFSPH_OK) good = 1;
     const double time0 = pfsph_sim_time(sim);
     double last_report = omp_get_wtime();
     if (o && o->progress) { /* at once, before the first step */
@@ -745,16 +758,22 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         }
         csv_row(csv, frame, sim);
         if (bcsv) bodies_rows(bcsv, frame, sim);
+        if (!rc) rc = csv_flushed(csv, csv_path, err);
+        if (!rc && bcsv) rc = csv_flushed(bcsv, bcsv_path, err);
         /* every ci frames, and at the last one (so that --end can extend the run from there) */
         if (!rc && ci > 0 && (frame % ci == 0 || frame == nframes)) {
             double c0 = omp_get_wtime();
-            rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &ckpt_bytes, err);
-            ckpt_s = omp_get_wtime() - c0;
-            ckpt_frame = frame;
+            size_t bytes = 0;
+            rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &bytes, err);
+            if (!rc) { /* only a checkpoint on disk, renamed into place, goes into summary.json */
+                ckpt_s = omp_get_wtime() - c0;
+                ckpt_frame = frame;
+                ckpt_bytes = bytes;
+            }
         }
         /* written beside the old stash and renamed over it: should this fail (a full disk), the
-         * previous frame's state stays the last good one */
-        if (!rc && pfsph_checkpoint_stash(stash, sim, frame, &enc_err) == PFSPH_OK) {
+         * previous frame's state stays the last good one, and the run stops with the error */
+        if (!rc && (rc = pfsph_checkpoint_stash(stash, sim, frame, err)) == PFSPH_OK) {
             good = 1;
             good_frame = frame;
         }
@@ -775,8 +794,10 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
             o->progress(&p, o->user);
         }
     }
-    fclose(csv);
-    if (bcsv) fclose(bcsv);
+    /* the last rows' close is checked too; the first error is the one reported */
+    if (fclose(csv) != 0 && !rc) rc = pfsph_fail(err, PFSPH_EIO, "%s: close failed: %s", csv_path, strerror(errno));
+    if (bcsv && fclose(bcsv) != 0 && !rc)
+        rc = pfsph_fail(err, PFSPH_EIO, "%s: close failed: %s", bcsv_path, strerror(errno));
     if (good) unlink(stash);
     pfsph_error e2;
     const char *status = rc == PFSPH_OK ? "finished" : rc == PFSPH_EUNSTABLE ? "unstable" : "failed";
@@ -792,6 +813,9 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     if (!rc && rc2) {
         *err = e2;
         rc = rc2;
+    } else if (rc && rc2) { /* both lost: say so, the first error first */
+        size_t len = strlen(err->msg);
+        snprintf(err->msg + len, sizeof err->msg - len, "; and %s", e2.msg);
     }
     return rc;
 }

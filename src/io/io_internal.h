@@ -30,6 +30,11 @@ int pfsph__afile_finish(pfsph__afile *a, int durable, pfsph_error *err);
 int pfsph__rename_durable(const char *src, const char *dest, pfsph_error *err);
 /* Close and remove the temporary file; safe to call twice. */
 void pfsph__afile_abort(pfsph__afile *a);
+/* The test hook for a full disk (docs/robustness.md): with PFSPH_FAULT_WRITE="TEXT" or
+ * "TEXT:N" in the environment, the N-th (default the first) and every later checked write to
+ * a file whose path contains TEXT fails as on a full disk: returns 1 and sets errno to ENOSPC.
+ * 0 otherwise (always, without the variable). Every writer calls it where it checks a write. */
+int pfsph__write_fault(const char *path);
 
 /* Read a whole file into a malloc'ed buffer with one extra NUL byte after the data. */
 int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_error *err);

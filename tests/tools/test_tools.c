@@ -156,7 +156,7 @@ static void test_blender_load(void **state)
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     const char *j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
-    printf("meshed: %.400s\n", j);
+    printf("meshed: %.400s\n", j ? j : "");
     assert_non_null(strstr(j, "\"frame_end\": 2, \"frame_start\": 0"));
     assert_non_null(strstr(j, "\"objects\": 3"));
     for (int k = 0; k < 3; k++) {
@@ -172,7 +172,7 @@ static void test_blender_load(void **state)
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
-    printf("points: %.400s\n", j);
+    printf("points: %.400s\n", j ? j : "");
     assert_non_null(strstr(j, "\"fluid points\": 6"));
     assert_non_null(strstr(j, "\"objects\": 7"));
     /* a rigid body: its own object, keyed every frame, falling (Blender's z is pfsph's y) */
@@ -181,7 +181,7 @@ static void test_blender_load(void **state)
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
-    printf("bodies: %.600s\n", j);
+    printf("bodies: %.600s\n", j ? j : "");
     assert_non_null(strstr(j, "\"objects\": 4"));
     const char *b = strstr(j, "\"body ball\": {");
     assert_non_null(b);
