@@ -194,18 +194,23 @@ static int dir_entries(const char *dir, char *buf, size_t cap)
 }
 
 /* RUN/run.json: what the run itself was asked for (the end time), so that a resume without
- * an end time continues to the same end. */
-static int write_run_json(const char *dir, double end, double fps, pfsph_error *err)
+ * an end time continues to the same end; and the frame interval its files are numbered by,
+ * which a resume must keep (docs/checkpoints.md). */
+static int write_run_json(const char *dir, double end, double fps, int frame_interval, pfsph_error *err)
 {
     char text[256], path[PFSPH_PATH_LEN + 64];
-    snprintf(text, sizeof text, "{\n\t\"end_time\":\t%.17g,\n\t\"fps\":\t%.17g\n}\n", end, fps);
+    snprintf(text, sizeof text, "{\n\t\"end_time\":\t%.17g,\n\t\"fps\":\t%.17g,\n\t\"frame_interval\":\t%d\n}\n", end,
+             fps, frame_interval);
     snprintf(path, sizeof path, "%s/" RUN_JSON, dir);
     return pfsph_write_file_atomic(path, text, strlen(text), err);
 }
 
-/* The end time recorded in RUN/run.json; *end unchanged (and PFSPH_OK) when there is none. */
-static int read_run_end(const char *dir, double *end, pfsph_error *err)
+/* The end time recorded in RUN/run.json (end NULL: not wanted) and its frame interval (*fi
+ * 0 when it has none: written before it was recorded); *end unchanged (and PFSPH_OK) when
+ * there is no file. */
+static int read_run_json(const char *dir, double *end, int *fi, pfsph_error *err)
 {
+    *fi = 0;
     char path[PFSPH_PATH_LEN + 64];
     snprintf(path, sizeof path, "%s/" RUN_JSON, dir);
     unsigned char *data;
@@ -218,7 +223,13 @@ static int read_run_end(const char *dir, double *end, pfsph_error *err)
     if (rc) return rc;
     cJSON *j = cJSON_ParseWithLength((const char *)data, len);
     free(data);
+    const cJSON *fj = cJSON_GetObjectItemCaseSensitive(j, "frame_interval");
+    if (cJSON_IsNumber(fj) && fj->valuedouble >= 1 && fj->valuedouble <= 1e6) *fi = (int)fj->valuedouble;
     const cJSON *e = cJSON_GetObjectItemCaseSensitive(j, "end_time");
+    if (!end) {
+        cJSON_Delete(j);
+        return PFSPH_OK;
+    }
     if (!cJSON_IsNumber(e) || !(e->valuedouble >= 0) || !isfinite(e->valuedouble)) {
         cJSON_Delete(j);
         return pfsph_fail(err, PFSPH_EINPUT,
@@ -556,9 +567,19 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     char path[PFSPH_PATH_LEN + 64];
     int rc;
     bool resume = o && o->resume;
-    if (resume && o->end_time < 0) {
+    if (resume) {
         /* the run's own end, which may have been given on its command line */
-        if ((rc = read_run_end(dir, &end, err)) || (rc = check_end(s, end, err))) return rc;
+        int run_fi = 0;
+        if ((rc = read_run_json(dir, o->end_time < 0 ? &end : NULL, &run_fi, err)) || (rc = check_end(s, end, err)))
+            return rc;
+        /* the files on disk are numbered frame / frame_interval and the .pvd collections give
+         * them index * frame_interval / fps: another interval would relabel them (issue 33) */
+        if (run_fi && run_fi != s->output.frame_interval)
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: $.output.frame_interval: %d, but the run's frames were written every %d frames "
+                              "(%s/" RUN_JSON "): a resume keeps the interval its files are numbered by; set it "
+                              "back to %d, or run afresh with --force",
+                              s->source, s->output.frame_interval, run_fi, dir, run_fi);
     }
     if (!resume) {
         char names[256];
@@ -578,7 +599,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         snprintf(path, sizeof path, "%s/scene.json", dir);
         if ((rc = pfsph_write_file_atomic(path, o->scene_text, strlen(o->scene_text), err))) return rc;
     }
-    if ((!resume || o->end_time >= 0) && (rc = write_run_json(dir, end, s->fps, err))) return rc;
+    if ((!resume || o->end_time >= 0) && (rc = write_run_json(dir, end, s->fps, s->output.frame_interval, err)))
+        return rc;
     pfsph_sim *sim = NULL;
     if ((rc = pfsph_sim_create(&sim, s, err))) return rc;
 
