@@ -99,6 +99,11 @@ typedef struct pfsph_body_def {
     pfsph_keyframe keys[PFSPH_MAX_KEYFRAMES];
 } pfsph_body_def;
 
+/* A body's density (mass > 0: mass / volume, else density) within the range of rigid bodies
+ * (0.1..1e5 kg/m^3): 0; else 1 with the reason in msg. The scene parser checks bodies of
+ * known volume, pfsph_bodies_create mesh bodies once their volume is known. */
+int pfsph__body_density_check(double density, double mass, double volume, char *msg, size_t cap);
+
 /* output.surface: liquid surface meshes while running (docs/surfaces.md) */
 typedef struct pfsph_surface_output {
     bool on;
