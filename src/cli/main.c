@@ -181,51 +181,6 @@ static void print_error(const char *prefix, const char *msg)
     fputc('\n', stderr);
 }
 
-/* The whole file as a C string; NULL with errno set (EISDIR for a directory, EILSEQ for a
- * NUL byte, which no scene file holds). */
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    struct stat sb;
-    if (fstat(fileno(f), &sb) == 0 && S_ISDIR(sb.st_mode)) {
-        fclose(f);
-        errno = EISDIR;
-        return NULL;
-    }
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t r = fread(buf + n, 1, cap - n - 1, f);
-        n += r;
-        if (r == 0) break;
-        if (n + 1 == cap) {
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                break;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-    }
-    int rerr = ferror(f) ? errno : 0;
-    fclose(f);
-    if (buf && rerr) {
-        free(buf);
-        errno = rerr;
-        return NULL;
-    }
-    if (buf) buf[n] = 0;
-    if (buf && memchr(buf, 0, n)) {
-        free(buf);
-        errno = EILSEQ;
-        return NULL;
-    }
-    return buf;
-}
-
 /* Loads SCENE (or the default when path is NULL); prints the error. */
 static int load_scene(const char *path, pfsph_scene *s, char **text)
 {
@@ -235,15 +190,11 @@ static int load_scene(const char *path, pfsph_scene *s, char **text)
         *text = strdup(pfsph_scene_default_json());
         rc = pfsph_scene_parse(s, *text, "<default scene>", &err);
     } else {
-        *text = read_text(path);
-        if (!*text) {
-            char msg[PFSPH_PATH_LEN + 128];
-            if (errno == EISDIR) snprintf(msg, sizeof msg, "%s: is a directory, not a scene file", path);
-            else if (errno == EILSEQ)
-                snprintf(msg, sizeof msg, "%s: not a scene file (it holds a NUL byte; scenes are JSON text)", path);
-            else snprintf(msg, sizeof msg, "%s: cannot read: %s", path, strerror(errno));
-            print_error(NULL, msg);
-            return errno == ENOMEM ? 1 : 2;
+        /* the library's reader, with its 16 MiB cap (/dev/zero grew to 1 GB: issue 33) */
+        rc = pfsph_scene_read_text(path, text, &err);
+        if (rc) {
+            print_error(NULL, err.msg);
+            return rc == PFSPH_ENOMEM ? 1 : 2; /* a scene that cannot be read is bad input */
         }
         rc = pfsph_scene_parse(s, *text, path, &err);
     }

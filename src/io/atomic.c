@@ -177,6 +177,13 @@ int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_
         fclose(f);
         return pfsph_fail(err, PFSPH_EIO, "%s: not a regular file", path);
     }
+    /* frames and checkpoints are read whole: a cap far above any this program writes keeps a
+     * wrong file (a disk image named like a frame) from taking the machine's memory */
+    if ((unsigned long long)st.st_size > PFSPH__READ_MAX_BYTES) {
+        fclose(f);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: %.3g GiB, larger than the %llu GiB pfsph reads; not one of its files",
+                          path, (double)st.st_size / 1073741824.0, PFSPH__READ_MAX_BYTES >> 30);
+    }
     size_t n = (size_t)st.st_size;
     unsigned char *buf = malloc(n + 1);
     if (!buf) {

@@ -36,7 +36,10 @@ void pfsph__afile_abort(pfsph__afile *a);
  * 0 otherwise (always, without the variable). Every writer calls it where it checks a write. */
 int pfsph__write_fault(const char *path);
 
-/* Read a whole file into a malloc'ed buffer with one extra NUL byte after the data. */
+/* Read a whole file into a malloc'ed buffer with one extra NUL byte after the data: a regular
+ * file of at most PFSPH__READ_MAX_BYTES (PFSPH_EINPUT otherwise, naming it). Frames read back by
+ * render, mesh, export and view, and checkpoints, come through here (docs/robustness.md). */
+#define PFSPH__READ_MAX_BYTES (8ull << 30)
 int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_error *err);
 
 /* The start of every frame reader (PLY, VTP, surface PLY): out (out_size bytes) cleared, so

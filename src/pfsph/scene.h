@@ -181,8 +181,14 @@ void pfsph_scene_defaults(pfsph_scene *s);
  * returns PFSPH_EINPUT and err->msg reads "<source>: <json path>: <reason>". */
 int pfsph_scene_parse(pfsph_scene *s, const char *json, const char *source, pfsph_error *err);
 
-/* Read a file and parse it. */
+/* Read a file and parse it (pfsph_scene_read_text, then pfsph_scene_parse). */
 int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err);
+/* The whole scene file as a C string (*text, free()): at most PFSPH_SCENE_MAX_BYTES, no NUL
+ * byte, a regular file or a pipe; PFSPH_EINPUT naming the file otherwise (a directory, a frame
+ * file, /dev/zero), PFSPH_EIO when it cannot be opened or read. The one reader of scene files:
+ * the library and the pfsph program (docs/robustness.md). */
+#define PFSPH_SCENE_MAX_BYTES ((size_t)16 << 20)
+int pfsph_scene_read_text(const char *path, char **text, pfsph_error *err);
 
 /* The embedded default scene (a small 3D dam break against an obstacle), as JSON text. */
 const char *pfsph_scene_default_json(void);

@@ -92,10 +92,14 @@ static int resolve_mesh(const pfsph_scene *s, const char *P, const char *file, c
     snprintf(kp, sizeof kp, "%s.file", P);
     if (!file[0]) return pfsph__json_fail(ctx, kp, "must not be empty");
     const char *slash = strrchr(s->source, '/');
+    /* built in a buffer of its own: out lies in the scene, like s->source, and gcc 12 cannot
+     * tell that they do not overlap (-Wrestrict) */
+    char buf[2 * PFSPH_PATH_LEN];
     int w;
-    if (file[0] == '/' || !slash || s->source[0] == '<') w = snprintf(out, cap, "%s", file);
-    else w = snprintf(out, cap, "%.*s/%s", (int)(slash - s->source), s->source, file);
+    if (file[0] == '/' || !slash || s->source[0] == '<') w = snprintf(buf, sizeof buf, "%s", file);
+    else w = snprintf(buf, sizeof buf, "%.*s/%s", (int)(slash - s->source), s->source, file);
     if (w < 0 || (size_t)w >= cap) return pfsph__json_fail(ctx, kp, "path too long");
+    memcpy(out, buf, (size_t)w + 1);
     return PFSPH_OK;
 }
 
