@@ -673,6 +673,10 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
         free(s);
         return pfsph__json_fail(&ctx, "$", "invalid JSON: the text is empty");
     }
+    if (pfsph__json_check_nul_escapes(json, &ctx)) {
+        free(s);
+        return PFSPH_EINPUT;
+    }
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithOpts(json, &end, 1);
     if (!root) {
@@ -714,7 +718,8 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
         return pfsph__json_fail(&ctx, "$", "invalid JSON at line %d, column %d, near \"%s\"", line, col, near);
     }
     parser p = {s, ctx};
-    int rc = parse_root(&p, root);
+    int rc = pfsph__json_check_strings(root, &ctx);
+    if (!rc) rc = parse_root(&p, root);
     cJSON_Delete(root);
     if (rc == PFSPH_OK) {
         memcpy(out, s, sizeof *s);
