@@ -535,7 +535,47 @@ static int check_end(const pfsph_scene *s, double end, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* An end time asked for on the command line (--end) lands on a frame: the run stops at the
+ * last frame at or before it, so 0.15 s at 50 fps stopped at 0.14 s while run.json said 0.15
+ * (issue 33). A scene's own time.end keeps that rounding down (shipped scenes have 1.5 s at
+ * 25 fps). */
+static int check_end_on_frame(const pfsph_scene *s, double end, pfsph_error *err)
+{
+    const double x = end * s->fps, n = floor(x + 1e-9);
+    if (x - n <= 1e-6) return PFSPH_OK;
+    return pfsph_fail(err, PFSPH_EINPUT,
+                      "end time %.9g s: not a whole number of frames at %g fps ($.time.fps of %s); the run "
+                      "would stop at %.9g s: give %.9g or %.9g",
+                      end, s->fps, s->source, n / s->fps, n / s->fps, (n + 1) / s->fps);
+}
+
 static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0, pfsph_error *err);
+
+/* A stop asked for (Ctrl-C): the stash of the last finished frame becomes its checkpoint when
+ * checkpoints are on and it is newer than the last one (a rename: no encoding on the way out),
+ * and err says where the run stopped and how to go on. */
+static void interrupted(const char *dir, const pfsph_scene *s, const pfsph_sim *sim, const char *stash, int good_frame,
+                        int last_ckpt, pfsph_error *err)
+{
+    char cp[PFSPH_PATH_LEN + 64], path[PFSPH_PATH_LEN + 64];
+    pfsph_error e;
+    int kept = last_ckpt;
+    if (stash && s->output.checkpoint_interval > 0 && good_frame > last_ckpt) {
+        pfsph_checkpoint_path(cp, sizeof cp, dir, good_frame);
+        snprintf(path, sizeof path, "%s/checkpoints", dir);
+        if (pfsph_mkdirs(path, &e) == PFSPH_OK && pfsph_checkpoint_keep(stash, cp, &e) == PFSPH_OK) kept = good_frame;
+    }
+    if (s->output.checkpoint_interval > 0 && kept >= 0)
+        pfsph_fail(err, PFSPH_EINTR,
+                   "interrupted at t = %.6g s; the run continues from its checkpoint of frame %d (t = %.6g s) "
+                   "with: pfsph run --resume %s",
+                   pfsph_sim_time(sim), kept, kept / s->fps, dir);
+    else
+        pfsph_fail(err, PFSPH_EINTR,
+                   "interrupted at t = %.6g s; no checkpoint to resume from (output.checkpoint_interval is 0): "
+                   "run it again with --force",
+                   pfsph_sim_time(sim));
+}
 
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
 {
@@ -545,7 +585,9 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     double w0 = omp_get_wtime();
     int rc;
     /* refused before anything is written */
-    if (o && o->end_time >= 0 && (rc = check_end(s, o->end_time, err))) return rc;
+    if (o && o->end_time >= 0 &&
+        ((rc = check_end(s, o->end_time, err)) || (rc = check_end_on_frame(s, o->end_time, err))))
+        return rc;
     if (!(o && o->end_time >= 0) && (rc = check_end(s, s->end_time, err))) return rc;
     /* a directory that cannot be made or written is bad input (exit status 2), as is one that
      * another run holds */
@@ -741,6 +783,10 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
          * a frame (at most 4 times a second); advance then only lands the clock on the frame */
         const double tf = frame / s->fps;
         while (!rc && o && o->progress && pfsph_sim_time(sim) < tf - 1e-12 * fmax(1.0, fabs(tf))) {
+            if (o->stop && *o->stop) {
+                rc = PFSPH_EINTR;
+                break;
+            }
             rc = pfsph_sim_step(sim, tf, err);
             double now = omp_get_wtime();
             if (!rc && now - last_report >= 0.25) {
@@ -759,7 +805,12 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
                 o->progress(&p, o->user);
             }
         }
+        if (!rc && o && o->stop && *o->stop) rc = PFSPH_EINTR;
         if (!rc) rc = pfsph_sim_advance(sim, tf, err);
+        if (rc == PFSPH_EINTR) {
+            interrupted(dir, s, sim, good ? stash : NULL, good_frame, ckpt_frame >= 0 ? ckpt_frame : resume ? frame0 : -1, err);
+            good = good && access(stash, F_OK) == 0;
+        }
         if (rc == PFSPH_EUNSTABLE && good) {
             char cp[PFSPH_PATH_LEN + 64];
             pfsph_error e3;
@@ -822,7 +873,10 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         rc = pfsph_fail(err, PFSPH_EIO, "%s: close failed: %s", bcsv_path, strerror(errno));
     if (good) unlink(stash);
     pfsph_error e2;
-    const char *status = rc == PFSPH_OK ? "finished" : rc == PFSPH_EUNSTABLE ? "unstable" : "failed";
+    const char *status = rc == PFSPH_OK ? "finished"
+        : rc == PFSPH_EUNSTABLE         ? "unstable"
+        : rc == PFSPH_EINTR             ? "interrupted"
+                                        : "failed";
     run_info info = {resume ? frame0 : -1, ckpt_frame, ckpt_bytes, ckpt_s};
     int rc2 = write_summary(dir, s, sim, written, omp_get_wtime() - w0, status, rc ? err->msg : NULL, &info, &e2);
     if (!rc && s->diffuse.enabled) {
