@@ -808,7 +808,11 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (!rc && o && o->stop && *o->stop) rc = PFSPH_EINTR;
         if (!rc) rc = pfsph_sim_advance(sim, tf, err);
         if (rc == PFSPH_EINTR) {
-            interrupted(dir, s, sim, good ? stash : NULL, good_frame, ckpt_frame >= 0 ? ckpt_frame : resume ? frame0 : -1, err);
+            interrupted(dir, s, sim, good ? stash : NULL, good_frame,
+                        ckpt_frame >= 0 ? ckpt_frame
+                            : resume    ? frame0
+                                        : -1,
+                        err);
             good = good && access(stash, F_OK) == 0;
         }
         if (rc == PFSPH_EUNSTABLE && good) {
