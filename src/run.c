@@ -24,6 +24,7 @@
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
 #include "pfsph/thermostat.h"
+#include "run_control.h"
 
 /* ---- the run directory: lock, what is pfsph's, temporaries, the run's own end ---- */
 
@@ -413,15 +414,6 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
     fflush(f);
 }
 
-/* The rows so far reached stats.csv or bodies.csv (flushed), else PFSPH_EIO naming the file:
- * a full disk must not cut the statistics silently. */
-static int csv_flushed(FILE *f, const char *path, pfsph_error *err)
-{
-    int bad = fflush(f) != 0 || ferror(f) || pfsph__write_fault(path);
-    int e = errno;
-    return bad ? pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", path, strerror(e ? e : EIO)) : PFSPH_OK;
-}
-
 typedef struct run_info {
     int resumed_from; /* checkpoint frame, -1: fresh run */
     int ckpt_frame;   /* last checkpoint written by this process, -1: none */
@@ -535,47 +527,7 @@ static int check_end(const pfsph_scene *s, double end, pfsph_error *err)
     return PFSPH_OK;
 }
 
-/* An end time asked for on the command line (--end) lands on a frame: the run stops at the
- * last frame at or before it, so 0.15 s at 50 fps stopped at 0.14 s while run.json said 0.15
- * (issue 33). A scene's own time.end keeps that rounding down (shipped scenes have 1.5 s at
- * 25 fps). */
-static int check_end_on_frame(const pfsph_scene *s, double end, pfsph_error *err)
-{
-    const double x = end * s->fps, n = floor(x + 1e-9);
-    if (x - n <= 1e-6) return PFSPH_OK;
-    return pfsph_fail(err, PFSPH_EINPUT,
-                      "end time %.9g s: not a whole number of frames at %g fps ($.time.fps of %s); the run "
-                      "would stop at %.9g s: give %.9g or %.9g",
-                      end, s->fps, s->source, n / s->fps, n / s->fps, (n + 1) / s->fps);
-}
-
 static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char *dir, double w0, pfsph_error *err);
-
-/* A stop asked for (Ctrl-C): the stash of the last finished frame becomes its checkpoint when
- * checkpoints are on and it is newer than the last one (a rename: no encoding on the way out),
- * and err says where the run stopped and how to go on. */
-static void interrupted(const char *dir, const pfsph_scene *s, const pfsph_sim *sim, const char *stash, int good_frame,
-                        int last_ckpt, pfsph_error *err)
-{
-    char cp[PFSPH_PATH_LEN + 64], path[PFSPH_PATH_LEN + 64];
-    pfsph_error e;
-    int kept = last_ckpt;
-    if (stash && s->output.checkpoint_interval > 0 && good_frame > last_ckpt) {
-        pfsph_checkpoint_path(cp, sizeof cp, dir, good_frame);
-        snprintf(path, sizeof path, "%s/checkpoints", dir);
-        if (pfsph_mkdirs(path, &e) == PFSPH_OK && pfsph_checkpoint_keep(stash, cp, &e) == PFSPH_OK) kept = good_frame;
-    }
-    if (s->output.checkpoint_interval > 0 && kept >= 0)
-        pfsph_fail(err, PFSPH_EINTR,
-                   "interrupted at t = %.6g s; the run continues from its checkpoint of frame %d (t = %.6g s) "
-                   "with: pfsph run --resume %s",
-                   pfsph_sim_time(sim), kept, kept / s->fps, dir);
-    else
-        pfsph_fail(err, PFSPH_EINTR,
-                   "interrupted at t = %.6g s; no checkpoint to resume from (output.checkpoint_interval is 0): "
-                   "run it again with --force",
-                   pfsph_sim_time(sim));
-}
 
 int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
 {
@@ -586,7 +538,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     int rc;
     /* refused before anything is written */
     if (o && o->end_time >= 0 &&
-        ((rc = check_end(s, o->end_time, err)) || (rc = check_end_on_frame(s, o->end_time, err))))
+        ((rc = check_end(s, o->end_time, err)) || (rc = pfsph__run_end_on_frame(s, o->end_time, err))))
         return rc;
     if (!(o && o->end_time >= 0) && (rc = check_end(s, s->end_time, err))) return rc;
     /* a directory that cannot be made or written is bad input (exit status 2), as is one that
@@ -752,8 +704,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (!rc) written++;
         csv_row(csv, 0, sim);
         if (bcsv) bodies_rows(bcsv, 0, sim);
-        if (!rc) rc = csv_flushed(csv, csv_path, err);
-        if (!rc && bcsv) rc = csv_flushed(bcsv, bcsv_path, err);
+        if (!rc) rc = pfsph__csv_flushed(csv, csv_path, err);
+        if (!rc && bcsv) rc = pfsph__csv_flushed(bcsv, bcsv_path, err);
     } else {
         written = frame0 / fi + 1; /* on disk from before */
     }
@@ -808,11 +760,11 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (!rc && o && o->stop && *o->stop) rc = PFSPH_EINTR;
         if (!rc) rc = pfsph_sim_advance(sim, tf, err);
         if (rc == PFSPH_EINTR) {
-            interrupted(dir, s, sim, good ? stash : NULL, good_frame,
-                        ckpt_frame >= 0 ? ckpt_frame
-                            : resume    ? frame0
-                                        : -1,
-                        err);
+            pfsph__run_interrupted(dir, s, sim, good ? stash : NULL, good_frame,
+                                   ckpt_frame >= 0 ? ckpt_frame
+                                       : resume    ? frame0
+                                                   : -1,
+                                   err);
             good = good && access(stash, F_OK) == 0;
         }
         if (rc == PFSPH_EUNSTABLE && good) {
@@ -835,8 +787,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         }
         csv_row(csv, frame, sim);
         if (bcsv) bodies_rows(bcsv, frame, sim);
-        if (!rc) rc = csv_flushed(csv, csv_path, err);
-        if (!rc && bcsv) rc = csv_flushed(bcsv, bcsv_path, err);
+        if (!rc) rc = pfsph__csv_flushed(csv, csv_path, err);
+        if (!rc && bcsv) rc = pfsph__csv_flushed(bcsv, bcsv_path, err);
         /* every ci frames, and at the last one (so that --end can extend the run from there) */
         if (!rc && ci > 0 && (frame % ci == 0 || frame == nframes)) {
             double c0 = omp_get_wtime();
