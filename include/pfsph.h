@@ -23,6 +23,7 @@ extern "C" {
     X(OK, 0, "success")                                              \
     X(EINPUT, -2, "invalid input (scene, file content or argument)") \
     X(EUNSTABLE, -3, "the simulation became unstable")               \
+    X(EINTR, -4, "interrupted (a stop was asked for)")               \
     X(EIO, -5, "file system error")                                  \
     X(ENOMEM, -12, "out of memory")
 

@@ -25,6 +25,7 @@
 #include "pfsph/sim.h"
 #include "pfsph/solid_mesh.h"
 #include "pfsph/thermostat.h"
+#include "run_control.h"
 
 /* ---- the run directory: lock, what is pfsph's, temporaries, the run's own end ---- */
 
@@ -196,18 +197,23 @@ static int dir_entries(const char *dir, char *buf, size_t cap)
 }
 
 /* RUN/run.json: what the run itself was asked for (the end time), so that a resume without
- * an end time continues to the same end. */
-static int write_run_json(const char *dir, double end, double fps, pfsph_error *err)
+ * an end time continues to the same end; and the frame interval its files are numbered by,
+ * which a resume must keep (docs/checkpoints.md). */
+static int write_run_json(const char *dir, double end, double fps, int frame_interval, pfsph_error *err)
 {
     char text[256], path[PFSPH_PATH_LEN + 64];
-    snprintf(text, sizeof text, "{\n\t\"end_time\":\t%.17g,\n\t\"fps\":\t%.17g\n}\n", end, fps);
+    snprintf(text, sizeof text, "{\n\t\"end_time\":\t%.17g,\n\t\"fps\":\t%.17g,\n\t\"frame_interval\":\t%d\n}\n", end,
+             fps, frame_interval);
     snprintf(path, sizeof path, "%s/" RUN_JSON, dir);
     return pfsph_write_file_atomic(path, text, strlen(text), err);
 }
 
-/* The end time recorded in RUN/run.json; *end unchanged (and PFSPH_OK) when there is none. */
-static int read_run_end(const char *dir, double *end, pfsph_error *err)
+/* The end time recorded in RUN/run.json (end NULL: not wanted) and its frame interval (*fi
+ * 0 when it has none: written before it was recorded); *end unchanged (and PFSPH_OK) when
+ * there is no file. */
+static int read_run_json(const char *dir, double *end, int *fi, pfsph_error *err)
 {
+    *fi = 0;
     char path[PFSPH_PATH_LEN + 64];
     snprintf(path, sizeof path, "%s/" RUN_JSON, dir);
     unsigned char *data;
@@ -220,7 +226,13 @@ static int read_run_end(const char *dir, double *end, pfsph_error *err)
     if (rc) return rc;
     cJSON *j = cJSON_ParseWithLength((const char *)data, len);
     free(data);
+    const cJSON *fj = cJSON_GetObjectItemCaseSensitive(j, "frame_interval");
+    if (cJSON_IsNumber(fj) && fj->valuedouble >= 1 && fj->valuedouble <= 1e6) *fi = (int)fj->valuedouble;
     const cJSON *e = cJSON_GetObjectItemCaseSensitive(j, "end_time");
+    if (!end) {
+        cJSON_Delete(j);
+        return PFSPH_OK;
+    }
     if (!cJSON_IsNumber(e) || !(e->valuedouble >= 0) || !isfinite(e->valuedouble)) {
         cJSON_Delete(j);
         return pfsph_fail(err, PFSPH_EINPUT,
@@ -531,7 +543,9 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err)
     double w0 = omp_get_wtime();
     int rc;
     /* refused before anything is written */
-    if (o && o->end_time >= 0 && (rc = check_end(s, o->end_time, err))) return rc;
+    if (o && o->end_time >= 0 &&
+        ((rc = check_end(s, o->end_time, err)) || (rc = pfsph__run_end_on_frame(s, o->end_time, err))))
+        return rc;
     if (!(o && o->end_time >= 0) && (rc = check_end(s, s->end_time, err))) return rc;
     /* a directory that cannot be made or written is bad input (exit status 2), as is one that
      * another run holds */
@@ -553,9 +567,19 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     char path[PFSPH_PATH_LEN + 64];
     int rc;
     bool resume = o && o->resume;
-    if (resume && o->end_time < 0) {
+    if (resume) {
         /* the run's own end, which may have been given on its command line */
-        if ((rc = read_run_end(dir, &end, err)) || (rc = check_end(s, end, err))) return rc;
+        int run_fi = 0;
+        if ((rc = read_run_json(dir, o->end_time < 0 ? &end : NULL, &run_fi, err)) || (rc = check_end(s, end, err)))
+            return rc;
+        /* the files on disk are numbered frame / frame_interval and the .pvd collections give
+         * them index * frame_interval / fps: another interval would relabel them (issue 33) */
+        if (run_fi && run_fi != s->output.frame_interval)
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: $.output.frame_interval: %d, but the run's frames were written every %d frames "
+                              "(%s/" RUN_JSON "): a resume keeps the interval its files are numbered by; set it "
+                              "back to %d, or run afresh with --force",
+                              s->source, s->output.frame_interval, run_fi, dir, run_fi);
     }
     if (!resume) {
         char names[256];
@@ -575,7 +599,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         snprintf(path, sizeof path, "%s/scene.json", dir);
         if ((rc = pfsph_write_file_atomic(path, o->scene_text, strlen(o->scene_text), err))) return rc;
     }
-    if ((!resume || o->end_time >= 0) && (rc = write_run_json(dir, end, s->fps, err))) return rc;
+    if ((!resume || o->end_time >= 0) && (rc = write_run_json(dir, end, s->fps, s->output.frame_interval, err)))
+        return rc;
     pfsph_sim *sim = NULL;
     if ((rc = pfsph_sim_create(&sim, s, err))) return rc;
 
@@ -628,6 +653,9 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
              "frame,time,dt,steps,n_fluid,removed,vmax,density_err_avg,density_err_max,ekin,iterations%s%s\n",
              s->diffuse.enabled ? ",n_spray,n_foam,n_bubble" : "",
              pfsph_thermostat_kT(pfsph_sim_ctx(sim)) > 0 ? ",kT,kT_set" : "");
+    char csv_path[PFSPH_PATH_LEN + 64], bcsv_path[PFSPH_PATH_LEN + 64];
+    snprintf(csv_path, sizeof csv_path, "%s/stats.csv", dir);
+    snprintf(bcsv_path, sizeof bcsv_path, "%s/bodies.csv", dir);
     snprintf(path, sizeof path, "%s/stats.csv", dir);
     long kept = -1;
     if (resume && (rc = truncate_csv(path, header, frame0, &kept, err))) {
@@ -682,6 +710,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (!rc) written++;
         csv_row(csv, 0, sim);
         if (bcsv) bodies_rows(bcsv, 0, sim);
+        if (!rc) rc = pfsph__csv_flushed(csv, csv_path, err);
+        if (!rc && bcsv) rc = pfsph__csv_flushed(bcsv, bcsv_path, err);
     } else {
         written = frame0 / fi + 1; /* on disk from before */
     }
@@ -696,8 +726,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     snprintf(stash, sizeof stash, "%s/.last_good.bin", dir);
     int good = 0;
     int good_frame = frame0;
-    pfsph_error enc_err;
-    if (pfsph_checkpoint_stash(stash, sim, frame0, &enc_err) == PFSPH_OK) good = 1;
+    if (!rc && (rc = pfsph_checkpoint_stash(stash, sim, frame0, err)) == PFSPH_OK) good = 1;
     const double time0 = pfsph_sim_time(sim);
     double last_report = omp_get_wtime();
     if (o && o->progress) { /* at once, before the first step */
@@ -712,6 +741,10 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
          * a frame (at most 4 times a second); advance then only lands the clock on the frame */
         const double tf = frame / s->fps;
         while (!rc && o && o->progress && pfsph_sim_time(sim) < tf - 1e-12 * fmax(1.0, fabs(tf))) {
+            if (o->stop && *o->stop) {
+                rc = PFSPH_EINTR;
+                break;
+            }
             rc = pfsph_sim_step(sim, tf, err);
             double now = omp_get_wtime();
             if (!rc && now - last_report >= 0.25) {
@@ -730,7 +763,16 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
                 o->progress(&p, o->user);
             }
         }
+        if (!rc && o && o->stop && *o->stop) rc = PFSPH_EINTR;
         if (!rc) rc = pfsph_sim_advance(sim, tf, err);
+        if (rc == PFSPH_EINTR) {
+            pfsph__run_interrupted(dir, s, sim, good ? stash : NULL, good_frame,
+                                   ckpt_frame >= 0 ? ckpt_frame
+                                       : resume    ? frame0
+                                                   : -1,
+                                   err);
+            good = good && access(stash, F_OK) == 0;
+        }
         if (rc == PFSPH_EUNSTABLE && good) {
             char cp[PFSPH_PATH_LEN + 64];
             pfsph_error e3;
@@ -751,16 +793,22 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         }
         csv_row(csv, frame, sim);
         if (bcsv) bodies_rows(bcsv, frame, sim);
+        if (!rc) rc = pfsph__csv_flushed(csv, csv_path, err);
+        if (!rc && bcsv) rc = pfsph__csv_flushed(bcsv, bcsv_path, err);
         /* every ci frames, and at the last one (so that --end can extend the run from there) */
         if (!rc && ci > 0 && (frame % ci == 0 || frame == nframes)) {
             double c0 = omp_get_wtime();
-            rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &ckpt_bytes, err);
-            ckpt_s = omp_get_wtime() - c0;
-            ckpt_frame = frame;
+            size_t bytes = 0;
+            rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &bytes, err);
+            if (!rc) { /* only a checkpoint on disk, renamed into place, goes into summary.json */
+                ckpt_s = omp_get_wtime() - c0;
+                ckpt_frame = frame;
+                ckpt_bytes = bytes;
+            }
         }
         /* written beside the old stash and renamed over it: should this fail (a full disk), the
-         * previous frame's state stays the last good one */
-        if (!rc && pfsph_checkpoint_stash(stash, sim, frame, &enc_err) == PFSPH_OK) {
+         * previous frame's state stays the last good one, and the run stops with the error */
+        if (!rc && (rc = pfsph_checkpoint_stash(stash, sim, frame, err)) == PFSPH_OK) {
             good = 1;
             good_frame = frame;
         }
@@ -781,11 +829,16 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
             o->progress(&p, o->user);
         }
     }
-    fclose(csv);
-    if (bcsv) fclose(bcsv);
+    /* the last rows' close is checked too; the first error is the one reported */
+    if (fclose(csv) != 0 && !rc) rc = pfsph_fail(err, PFSPH_EIO, "%s: close failed: %s", csv_path, strerror(errno));
+    if (bcsv && fclose(bcsv) != 0 && !rc)
+        rc = pfsph_fail(err, PFSPH_EIO, "%s: close failed: %s", bcsv_path, strerror(errno));
     if (good) unlink(stash);
     pfsph_error e2;
-    const char *status = rc == PFSPH_OK ? "finished" : rc == PFSPH_EUNSTABLE ? "unstable" : "failed";
+    const char *status = rc == PFSPH_OK ? "finished"
+        : rc == PFSPH_EUNSTABLE         ? "unstable"
+        : rc == PFSPH_EINTR             ? "interrupted"
+                                        : "failed";
     run_info info = {resume ? frame0 : -1, ckpt_frame, ckpt_bytes, ckpt_s};
     int rc2 = write_summary(dir, s, sim, written, omp_get_wtime() - w0, status, rc ? err->msg : NULL, &info, &e2);
     if (!rc && s->diffuse.enabled) {
@@ -798,6 +851,9 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     if (!rc && rc2) {
         *err = e2;
         rc = rc2;
+    } else if (rc && rc2) { /* both lost: say so, the first error first */
+        size_t len = strlen(err->msg);
+        snprintf(err->msg + len, sizeof err->msg - len, "; and %s", e2.msg);
     }
     return rc;
 }

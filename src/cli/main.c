@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <math.h>
 #include <omp.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -144,10 +145,22 @@ static const char *HELP_EXPORT =
 
 static int is_help(const char *a) { return !strcmp(a, "--help") || !strcmp(a, "-h"); }
 
+/* The signal that asked a run to stop (SIGINT, SIGTERM), 0 for none: the run stops at its next
+ * step, keeps a checkpoint and the program exits with 128 + the signal, the shell's status for a
+ * process killed by it. A second signal ends the program at once (the default action). */
+static volatile sig_atomic_t g_stop;
+
+static void on_stop_signal(int sig)
+{
+    g_stop = sig;
+    signal(sig, SIG_DFL);
+}
+
 static int exit_code(int rc)
 {
     switch (rc) {
     case PFSPH_OK: return 0;
+    case PFSPH_EINTR: return 128 + (g_stop ? (int)g_stop : SIGINT);
     case PFSPH_EINPUT: return 2;
     case PFSPH_EUNSTABLE: return 3;
     default: return 1;
@@ -191,51 +204,6 @@ static void print_error(const char *prefix, const char *msg)
     fputc('\n', stderr);
 }
 
-/* The whole file as a C string; NULL with errno set (EISDIR for a directory, EILSEQ for a
- * NUL byte, which no scene file holds). */
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    struct stat sb;
-    if (fstat(fileno(f), &sb) == 0 && S_ISDIR(sb.st_mode)) {
-        fclose(f);
-        errno = EISDIR;
-        return NULL;
-    }
-    size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    while (buf) {
-        size_t r = fread(buf + n, 1, cap - n - 1, f);
-        n += r;
-        if (r == 0) break;
-        if (n + 1 == cap) {
-            char *nb = realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                break;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-    }
-    int rerr = ferror(f) ? errno : 0;
-    fclose(f);
-    if (buf && rerr) {
-        free(buf);
-        errno = rerr;
-        return NULL;
-    }
-    if (buf) buf[n] = 0;
-    if (buf && memchr(buf, 0, n)) {
-        free(buf);
-        errno = EILSEQ;
-        return NULL;
-    }
-    return buf;
-}
-
 /* Loads SCENE (or the default when path is NULL); prints the error. */
 static int load_scene(const char *path, pfsph_scene *s, char **text)
 {
@@ -245,15 +213,11 @@ static int load_scene(const char *path, pfsph_scene *s, char **text)
         *text = strdup(pfsph_scene_default_json());
         rc = pfsph_scene_parse(s, *text, "<default scene>", &err);
     } else {
-        *text = read_text(path);
-        if (!*text) {
-            char msg[PFSPH_PATH_LEN + 128];
-            if (errno == EISDIR) snprintf(msg, sizeof msg, "%s: is a directory, not a scene file", path);
-            else if (errno == EILSEQ)
-                snprintf(msg, sizeof msg, "%s: not a scene file (it holds a NUL byte; scenes are JSON text)", path);
-            else snprintf(msg, sizeof msg, "%s: cannot read: %s", path, strerror(errno));
-            print_error(NULL, msg);
-            return errno == ENOMEM ? 1 : 2;
+        /* the library's reader, with its 16 MiB cap (/dev/zero grew to 1 GB: issue 33) */
+        rc = pfsph_scene_read_text(path, text, &err);
+        if (rc) {
+            print_error(NULL, err.msg);
+            return rc == PFSPH_ENOMEM ? 1 : 2; /* a scene that cannot be read is bad input */
         }
         rc = pfsph_scene_parse(s, *text, path, &err);
     }
@@ -331,8 +295,9 @@ static void show_progress(const pfsph_progress *p, void *user)
         bar[30] = 0;
         fprintf(stderr, "\r[%s] frame %d/%d  t=%.4g/%.4g s  %.0f steps/s  ", bar, p->frame, p->nframes, p->time,
                 p->end_time, p->steps_per_s);
-        if (frac > 0) fprintf(stderr, "ETA %02d:%02d  ", (int)eta / 60, (int)eta % 60);
-        else fprintf(stderr, "ETA --:--  ");
+        if (frac > 0) fprintf(stderr, "ETA %02d:%02d", (int)eta / 60, (int)eta % 60);
+        else fprintf(stderr, "ETA --:--");
+        fputs("\033[K", stderr); /* the rest of a longer earlier line goes (it left "ETA 00:00 0") */
         if (!p->partial && p->frame == p->nframes) fputc('\n', stderr);
     } else {
         /* a log: a line per frame, and within long frames one every 10 s */
@@ -351,7 +316,7 @@ static void show_render_progress(int done, int total, const char *path, void *us
 {
     progress_state *ps = user;
     if (ps->quiet || !ps->tty) return;
-    fprintf(stderr, "\rrender: frame %d/%d  %s", done, total, path ? path : "");
+    fprintf(stderr, "\rrender: frame %d/%d  %s\033[K", done, total, path ? path : "");
     if (done == total) fputc('\n', stderr);
     fflush(stderr);
 }
@@ -447,13 +412,25 @@ static int cmd_run(int argc, char **argv)
                         .user = &ps,
                         .resume = resume != NULL,
                         .message = show_message,
-                        .force = force};
+                        .force = force,
+                        .stop = &g_stop};
     const char *dir = out ? out : s.output.dir;
     if (!quiet)
         fprintf(stderr, "pfsph %s: %s -> %s (%d threads)%s\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads(),
                 resume ? ", resuming" : "");
     pfsph_error err = {0};
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    struct sigaction old_int, old_term; /* a signal ignored at the start (nohup, a background job) stays so */
+    sigaction(SIGINT, NULL, &old_int);
+    sigaction(SIGTERM, NULL, &old_term);
+    if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, NULL);
+    if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &sa, NULL);
     rc = pfsph_run(&s, &o, &err);
+    sigaction(SIGINT, &old_int, NULL);
+    sigaction(SIGTERM, &old_term, NULL);
     free(text);
     if (rc) {
         if (ps.tty && !quiet) fputc('\n', stderr);

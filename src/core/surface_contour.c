@@ -64,7 +64,8 @@ static int kernels2_build(const double *x, size_t n, const pfsph_surface_opts *o
     const double d = o->spacing, r = o->pca_radius * d, h = o->support * d;
     const double ks = 1.0 / (lattice_sigma2(o->pca_radius) * d * d);
     const int n_eps = o->n_eps > 0 ? o->n_eps : (lattice_count2(o->pca_radius) + 2) / 5;
-    int32_t *cell = malloc(3 * (n ? n : 1) * sizeof *cell);
+    /* cleared: gcc 12 at -O1 cannot see that n = 0 leaves nothing to read (-Wmaybe-uninitialized) */
+    int32_t *cell = calloc(3 * (n ? n : 1), sizeof *cell);
     if (!cell) return PFSPH_ENOMEM;
     for (size_t i = 0; i < n; i++) {
         cell[3 * i] = (int32_t)floor(x[3 * i] / r);

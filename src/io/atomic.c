@@ -29,6 +29,24 @@ static void afile_release(pfsph__afile *a)
     a->f = NULL;
 }
 
+int pfsph__write_fault(const char *path)
+{
+    static _Atomic int hits;
+    const char *spec = getenv("PFSPH_FAULT_WRITE");
+    if (!spec || !*spec || !path) return 0;
+    char text[256];
+    snprintf(text, sizeof text, "%s", spec);
+    char *colon = strrchr(text, ':');
+    long nth = 1;
+    if (colon) {
+        nth = strtol(colon + 1, NULL, 10);
+        *colon = 0;
+    }
+    if (!strstr(path, text) || ++hits < nth) return 0;
+    errno = ENOSPC;
+    return 1;
+}
+
 int pfsph__afile_open(pfsph__afile *a, const char *path, pfsph_error *err)
 {
     memset(a, 0, sizeof *a);
@@ -61,7 +79,7 @@ int pfsph__afile_open(pfsph__afile *a, const char *path, pfsph_error *err)
 int pfsph__afile_write(pfsph__afile *a, const void *data, size_t len, pfsph_error *err)
 {
     if (!a->f) return pfsph_fail(err, PFSPH_EIO, "%s: write after failure", a->path ? a->path : "?");
-    if (len && fwrite(data, 1, len, a->f) != len) {
+    if ((len && fwrite(data, 1, len, a->f) != len) || pfsph__write_fault(a->path)) {
         int e = errno;
         return pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", a->path, strerror(e ? e : EIO));
     }
@@ -105,7 +123,7 @@ int pfsph__afile_finish(pfsph__afile *a, int durable, pfsph_error *err)
     }
     const char *what = NULL;
     int e = 0;
-    if (fflush(a->f) != 0) what = "write failed", e = errno;
+    if (fflush(a->f) != 0 || pfsph__write_fault(a->path)) what = "write failed", e = errno;
     else if (durable && fsync(fileno(a->f)) != 0) what = "fsync failed", e = errno;
     int rc = fclose(a->f);
     a->f = NULL;
@@ -158,6 +176,13 @@ int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_
     if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
         fclose(f);
         return pfsph_fail(err, PFSPH_EIO, "%s: not a regular file", path);
+    }
+    /* frames and checkpoints are read whole: a cap far above any this program writes keeps a
+     * wrong file (a disk image named like a frame) from taking the machine's memory */
+    if ((unsigned long long)st.st_size > PFSPH__READ_MAX_BYTES) {
+        fclose(f);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: %.3g GiB, larger than the %llu GiB pfsph reads; not one of its files",
+                          path, (double)st.st_size / 1073741824.0, PFSPH__READ_MAX_BYTES >> 30);
     }
     size_t n = (size_t)st.st_size;
     unsigned char *buf = malloc(n + 1);

@@ -30,8 +30,16 @@ int pfsph__afile_finish(pfsph__afile *a, int durable, pfsph_error *err);
 int pfsph__rename_durable(const char *src, const char *dest, pfsph_error *err);
 /* Close and remove the temporary file; safe to call twice. */
 void pfsph__afile_abort(pfsph__afile *a);
+/* The test hook for a full disk (docs/robustness.md): with PFSPH_FAULT_WRITE="TEXT" or
+ * "TEXT:N" in the environment, the N-th (default the first) and every later checked write to
+ * a file whose path contains TEXT fails as on a full disk: returns 1 and sets errno to ENOSPC.
+ * 0 otherwise (always, without the variable). Every writer calls it where it checks a write. */
+int pfsph__write_fault(const char *path);
 
-/* Read a whole file into a malloc'ed buffer with one extra NUL byte after the data. */
+/* Read a whole file into a malloc'ed buffer with one extra NUL byte after the data: a regular
+ * file of at most PFSPH__READ_MAX_BYTES (PFSPH_EINPUT otherwise, naming it). Frames read back by
+ * render, mesh, export and view, and checkpoints, come through here (docs/robustness.md). */
+#define PFSPH__READ_MAX_BYTES (8ull << 30)
 int pfsph__read_file(const char *path, unsigned char **data, size_t *len, pfsph_error *err);
 
 /* The start of every frame reader (PLY, VTP, surface PLY): out (out_size bytes) cleared, so

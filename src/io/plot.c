@@ -8,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "io/io_internal.h"
 #include "pfsph/io.h"
 
 enum { W = 900, H = 540, ML = 80, MR = 30, MT = 40, MB = 60 };
@@ -117,7 +118,7 @@ static int write_png(const char *path, img *im, pfsph_error *err)
     for (int y = 0; y < H; y++) png_write_row(png, im->px + (size_t)y * W * 3);
     png_write_end(png, NULL);
     png_destroy_write_struct(&png, &info);
-    int bad = fflush(fp) != 0 || fsync(fileno(fp)) != 0;
+    int bad = fflush(fp) != 0 || pfsph__write_fault(path) || fsync(fileno(fp)) != 0;
     bad |= fclose(fp) != 0;
     if (bad || rename(tmp, path) != 0) {
         int e = errno;

@@ -3,6 +3,7 @@
 #ifndef PFSPH_RUN_H
 #define PFSPH_RUN_H
 
+#include <signal.h>
 #include <stdbool.h>
 
 #include "pfsph/checkpoint.h"
@@ -36,6 +37,10 @@ typedef struct pfsph_run_opts {
      * checkpoints, PNGs, scene.json, stats and summary; nothing else) and run. Without it such
      * a run is refused (PFSPH_EINPUT). */
     bool force;
+    /* Set nonzero (from a signal handler) to stop the run at its next step: it ends with
+     * PFSPH_EINTR, keeps the last finished frame's state as a checkpoint when checkpoints are on
+     * (a rename of the stash, no encoding) and says in err how to resume. NULL: never. */
+    const volatile sig_atomic_t *stop;
 } pfsph_run_opts;
 
 /* Run the scene, writing a checkpoint every scene->output.checkpoint_interval frames into

@@ -103,6 +103,11 @@ typedef struct pfsph_body_def {
     pfsph_keyframe keys[PFSPH_MAX_KEYFRAMES];
 } pfsph_body_def;
 
+/* A body's density (mass > 0: mass / volume, else density) within the range of rigid bodies
+ * (0.1..1e5 kg/m^3): 0; else 1 with the reason in msg. The scene parser checks bodies of
+ * known volume, pfsph_bodies_create mesh bodies once their volume is known. */
+int pfsph__body_density_check(double density, double mass, double volume, char *msg, size_t cap);
+
 /* output.surface: liquid surface meshes while running (docs/surfaces.md) */
 typedef struct pfsph_surface_output {
     bool on;
@@ -183,8 +188,14 @@ void pfsph_scene_defaults(pfsph_scene *s);
  * returns PFSPH_EINPUT and err->msg reads "<source>: <json path>: <reason>". */
 int pfsph_scene_parse(pfsph_scene *s, const char *json, const char *source, pfsph_error *err);
 
-/* Read a file and parse it. */
+/* Read a file and parse it (pfsph_scene_read_text, then pfsph_scene_parse). */
 int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err);
+/* The whole scene file as a C string (*text, free()): at most PFSPH_SCENE_MAX_BYTES, no NUL
+ * byte, a regular file or a pipe; PFSPH_EINPUT naming the file otherwise (a directory, a frame
+ * file, /dev/zero), PFSPH_EIO when it cannot be opened or read. The one reader of scene files:
+ * the library and the pfsph program (docs/robustness.md). */
+#define PFSPH_SCENE_MAX_BYTES ((size_t)16 << 20)
+int pfsph_scene_read_text(const char *path, char **text, pfsph_error *err);
 
 /* The embedded default scene (a small 3D dam break against an obstacle), as JSON text. */
 const char *pfsph_scene_default_json(void);

@@ -52,6 +52,26 @@ static int body_mesh(const pfsph_scene *s, body *bd, pfsph_error *err)
     return PFSPH_OK;
 }
 
+/* A mesh body once its file is read (the scene parser checks the other shapes): every extent
+ * of its scaled bounding box at least the spacing, its density in range. */
+static int mesh_body_check(const pfsph_scene *s, int i, const body *bd, double spacing, pfsph_error *err)
+{
+    const pfsph_body_def *d = &bd->def;
+    for (int a = 0; a < 3; a++)
+        if (!(bd->hi[a] - bd->lo[a] >= spacing))
+            return pfsph_fail(err, PFSPH_EINPUT,
+                              "%s: $.bodies[%d].scale (body \"%s\", %s): the scaled mesh is %g m across, less "
+                              "than the particle spacing %g m: it would hold no particle the fluid can feel",
+                              s->source, i, d->name, d->mesh, bd->hi[a] - bd->lo[a], spacing);
+    double vol, com[3], I[9];
+    char why[256];
+    pfsph_mesh_mass_properties(&bd->mesh, &vol, com, I);
+    if (pfsph__body_density_check(d->density, d->mass, vol, why, sizeof why))
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: $.bodies[%d].%s (body \"%s\"): %s", s->source, i,
+                          d->mass > 0 ? "mass" : "density", d->name, why);
+    return PFSPH_OK;
+}
+
 /* Surface particles of a body in its own frame, d/2 inside the surface as for static solids
  * (their layer then continues the fluid's lattice, and the fluid's particle centres stop d/2
  * outside the surface: displaced volumes come out right). */
@@ -206,10 +226,21 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
         bd->def = s->bodies[i];
         if ((rc = body_mesh(s, bd, err))) goto fail;
         pfsph_mesh_bounds(&bd->mesh, bd->lo, bd->hi); /* body_mesh validated it */
+        if (bd->def.shape == PFSPH_BODY_MESH && (rc = mesh_body_check(s, i, bd, spacing, err))) goto fail;
         tmp.n = 0;
-        if ((rc = body_particles(s, bd, spacing, &tmp, err))) goto fail;
+        if ((rc = body_particles(s, bd, spacing, &tmp, err))) {
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg);
+            if (rc == PFSPH_EINPUT) /* the mesh's sampling: name the file and the key */
+                pfsph_fail(err, rc, "%s: $.bodies[%d].%s (body \"%s\"%s%s): %s", s->source, i,
+                           bd->def.shape == PFSPH_BODY_MESH ? "scale" : "shape", bd->def.name,
+                           bd->def.shape == PFSPH_BODY_MESH ? ", " : "",
+                           bd->def.shape == PFSPH_BODY_MESH ? bd->def.mesh : "", msg);
+            goto fail;
+        }
         if (tmp.n == 0) {
-            rc = pfsph_fail(err, PFSPH_EINPUT, "%s: body \"%s\" is too small for the particle spacing %g m", s->source,
+            rc = pfsph_fail(err, PFSPH_EINPUT,
+                            "%s: $.bodies[%d]: body \"%s\" is too small for the particle spacing %g m", s->source, i,
                             bd->def.name, spacing);
             goto fail;
         }
@@ -249,7 +280,14 @@ int pfsph_bodies_create(pfsph_bodies **out, const pfsph_scene *s, double spacing
         free(vol);
         B->np += (uint32_t)tmp.n;
 
-        pfsph__bodies_world_add(B, bd, s->dim);
+        if (pfsph__bodies_world_add(B, bd, s->dim)) {
+            rc = pfsph_fail(err, PFSPH_EINPUT,
+                            "%s: $.bodies[%d] (body \"%s\"): its mass %g kg and moments of inertia are not "
+                            "those of a rigid body (zero, negative or not finite); check \"mass\", \"density\" "
+                            "and \"inertia\"",
+                            s->source, i, bd->def.name, bd->mass);
+            goto fail;
+        }
     }
     pfsph_particles_free(&tmp);
     B->fp = calloc(3 * (size_t)(B->np ? B->np : 1), sizeof(double));

@@ -53,8 +53,9 @@ void pfsph__bodies_key_pose(const pfsph_body_def *d, double t, double x[3], doub
 /* The ODE world of the scene (gravity, contact tuning) with its static solids as fixed
  * colliders; PFSPH_ENOMEM. */
 int pfsph__bodies_world_create(pfsph_bodies *B, const pfsph_scene *s, double spacing);
-/* bd's ODE body: mass, collision geometry, initial pose and velocities (keyframed: kinematic) */
-void pfsph__bodies_world_add(pfsph_bodies *B, body *bd, int dim);
+/* bd's ODE body: mass, collision geometry, initial pose and velocities (keyframed: kinematic);
+ * -1 (nothing given to ODE) for a mass or inertia ODE would abort on. */
+int pfsph__bodies_world_add(pfsph_bodies *B, body *bd, int dim);
 /* Move every body particle to its body's pose (one pass over the boundary set). */
 void pfsph__bodies_place_all(pfsph_bodies *B, pfsph_particles *bs);
 /* A body's quaternion as ODE stores it once renormalised (bit-exact resume). */

@@ -123,7 +123,17 @@ static int add_statics(pfsph_bodies *B, const pfsph_scene *s)
     return PFSPH_OK;
 }
 
-static void set_mass(body *bd, int dim)
+/* A mass ODE takes: dBodySetMass aborts the program (an assertion) on a mass <= 0 or an
+ * inertia that is not positive definite, which underflow makes of tiny bodies. */
+static int mass_ok(const dMass *m)
+{
+    const dReal *I = m->I; /* 3 x 4, row major */
+    double a = I[0], b = I[1], c = I[2], e = I[5], f = I[6], i = I[10];
+    double m2 = a * e - b * b, m3 = a * (e * i - f * f) - b * (b * i - f * c) + c * (b * f - e * c);
+    return m->mass > 0 && isfinite(m->mass) && a > 0 && m2 > 0 && m3 > 0 && isfinite(m3) && dMassCheck(m);
+}
+
+static int set_mass(body *bd, int dim)
 {
     const pfsph_body_def *d = &bd->def;
     dMass m;
@@ -165,7 +175,9 @@ static void set_mass(body *bd, int dim)
         if (dim == 2) I[0] = I[1] = I[2];
         dMassSetParameters(&m, bd->mass, 0, 0, 0, I[0], I[1], I[2], 0, 0, 0);
     }
+    if (!mass_ok(&m)) return -1;
     dBodySetMass(bd->id, &m);
+    return 0;
 }
 
 static void make_geom(pfsph_bodies *B, body *bd, int dim)
@@ -221,10 +233,10 @@ int pfsph__bodies_world_create(pfsph_bodies *B, const pfsph_scene *s, double spa
     return add_statics(B, s);
 }
 
-void pfsph__bodies_world_add(pfsph_bodies *B, body *bd, int dim)
+int pfsph__bodies_world_add(pfsph_bodies *B, body *bd, int dim)
 {
     bd->id = dBodyCreate(B->world);
-    set_mass(bd, dim);
+    if (set_mass(bd, dim)) return -1;
     make_geom(B, bd, dim);
     double q[4];
     pfsph__bodies_euler_quat(bd->def.rotation, q);
@@ -245,6 +257,7 @@ void pfsph__bodies_world_add(pfsph_bodies *B, body *bd, int dim)
         dJointAttach(j, bd->id, 0);
     }
     dBodySetGyroscopicMode(bd->id, dim == 3);
+    return 0;
 }
 
 void pfsph_bodies_destroy(pfsph_bodies *B)

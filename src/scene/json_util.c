@@ -207,3 +207,77 @@ int pfsph__json_vec(const cJSON *obj, const char *path, const char *key, int n, 
     memcpy(out, tmp, (size_t)n * sizeof *out);
     return PFSPH_OK;
 }
+
+int pfsph__json_check_nul_escapes(const char *json, pfsph_jctx *ctx)
+{
+    int in_str = 0, line = 1;
+    const char *line0 = json;
+    for (const char *c = json; *c; c++) {
+        if (*c == '\n') line++, line0 = c + 1;
+        if (!in_str) {
+            in_str = *c == '"';
+            continue;
+        }
+        if (*c == '"') in_str = 0;
+        else if (*c == '\\' && c[1]) {
+            if (c[1] == 'u' && c[2] == '0' && c[3] == '0' && c[4] == '0' && c[5] == '0')
+                return pfsph__json_fail(ctx, "$",
+                                        "\"\\u0000\" (a NUL character) in a string at line %d, column %d: names "
+                                        "and text cannot hold one",
+                                        line, (int)(c - line0) + 1);
+            c++; /* the escaped character */
+        }
+    }
+    return PFSPH_OK;
+}
+
+/* Length of the valid UTF-8 sequence at p (1..4), 0 if it is not one. */
+static int utf8_len(const unsigned char *p)
+{
+    if (p[0] < 0x80) return 1;
+    int n = p[0] >= 0xc2 && p[0] <= 0xdf ? 2 : p[0] >= 0xe0 && p[0] <= 0xef ? 3 : p[0] >= 0xf0 && p[0] <= 0xf4 ? 4 : 0;
+    for (int k = 1; k < n; k++)
+        if ((p[k] & 0xc0) != 0x80) return 0;
+    if ((p[0] == 0xe0 && p[1] < 0xa0) || (p[0] == 0xed && p[1] >= 0xa0) || (p[0] == 0xf0 && p[1] < 0x90) ||
+        (p[0] == 0xf4 && p[1] >= 0x90))
+        return 0; /* overlong, a surrogate, past U+10FFFF */
+    return n;
+}
+
+static int check_text(const char *t, const char *path, const char *what, pfsph_jctx *ctx)
+{
+    size_t n = strlen(t);
+    if (n > PFSPH_JSON_MAX_STRING)
+        return pfsph__json_fail(ctx, path, "%s of %zu bytes, more than the %d a scene holds", what, n,
+                                PFSPH_JSON_MAX_STRING);
+    for (const unsigned char *p = (const unsigned char *)t; *p;) {
+        int len = utf8_len(p);
+        if (!len)
+            return pfsph__json_fail(ctx, path, "%s is not valid UTF-8 (byte 0x%02x at offset %zu)", what, *p,
+                                    (size_t)(p - (const unsigned char *)t));
+        p += len;
+    }
+    return PFSPH_OK;
+}
+
+static int check_tree(const cJSON *v, char *path, size_t len, size_t cap, pfsph_jctx *ctx)
+{
+    int rc;
+    if (cJSON_IsString(v) && v->valuestring && (rc = check_text(v->valuestring, path, "the string", ctx))) return rc;
+    int i = 0;
+    for (const cJSON *c = v->child; c; c = c->next, i++) {
+        if (cJSON_IsObject(v) && c->string) {
+            snprintf(path + len, cap - len, ".%.64s", c->string);
+            if ((rc = check_text(c->string, path, "the key", ctx))) return rc;
+        } else snprintf(path + len, cap - len, "[%d]", i);
+        if ((rc = check_tree(c, path, strlen(path), cap, ctx))) return rc;
+        path[len] = 0;
+    }
+    return PFSPH_OK;
+}
+
+int pfsph__json_check_strings(const cJSON *root, pfsph_jctx *ctx)
+{
+    char path[1024] = "$";
+    return check_tree(root, path, 1, sizeof path, ctx);
+}

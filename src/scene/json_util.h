@@ -27,6 +27,13 @@ int pfsph__json_string(const cJSON *obj, const char *path, const char *key, char
 /* An array of exactly n numbers, each in [lo, hi]. */
 int pfsph__json_vec(const cJSON *obj, const char *path, const char *key, int n, double lo, double hi, double *out,
                     pfsph_jctx *ctx);
+/* The text of a scene before its keys are read (issue 33): no "\u0000" escape in a string
+ * (cJSON would cut the string there), and then every key and string value of the tree valid
+ * UTF-8 (no overlong forms, surrogates or code points past U+10FFFF) and at most
+ * PFSPH_JSON_MAX_STRING bytes; the error names the JSON path (the line and column for \u0000). */
+#define PFSPH_JSON_MAX_STRING 65536
+int pfsph__json_check_nul_escapes(const char *json, pfsph_jctx *ctx);
+int pfsph__json_check_strings(const cJSON *root, pfsph_jctx *ctx);
 /* Error "<source>: <path>: <reason>" (printf-style reason); returns PFSPH_EINPUT. */
 int pfsph__json_fail(pfsph_jctx *ctx, const char *path, const char *fmt, ...)
 #if defined(__GNUC__)

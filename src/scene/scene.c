@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "physics/solver.h"
 #include "scene/json_util.h"
@@ -681,6 +682,10 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
         free(s);
         return pfsph__json_fail(&ctx, "$", "invalid JSON: the text is empty");
     }
+    if (pfsph__json_check_nul_escapes(json, &ctx)) {
+        free(s);
+        return PFSPH_EINPUT;
+    }
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithOpts(json, &end, 1);
     if (!root) {
@@ -722,7 +727,8 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
         return pfsph__json_fail(&ctx, "$", "invalid JSON at line %d, column %d, near \"%s\"", line, col, near);
     }
     parser p = {s, ctx};
-    int rc = parse_root(&p, root);
+    int rc = pfsph__json_check_strings(root, &ctx);
+    if (!rc) rc = parse_root(&p, root);
     cJSON_Delete(root);
     if (rc == PFSPH_OK) {
         memcpy(out, s, sizeof *s);
@@ -735,13 +741,19 @@ int pfsph_scene_parse(pfsph_scene *out, const char *json, const char *source, pf
     return rc;
 }
 
-int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err)
+int pfsph_scene_read_text(const char *path, char **text, pfsph_error *err)
 {
+    *text = NULL;
     if (!path) return pfsph_fail(err, PFSPH_EIO, "no scene file given");
     FILE *f = fopen(path, "rb");
     if (!f) return pfsph_fail(err, PFSPH_EIO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        fclose(f);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: is a directory, not a scene file", path);
+    }
     /* Scenes are small; a limit keeps a wrong argument (a frame file, /dev/zero) harmless. */
-    const size_t cap = (size_t)16 << 20;
+    const size_t cap = PFSPH_SCENE_MAX_BYTES;
     size_t n = 0, size = 4096;
     char *buf = malloc(size);
     if (!buf) {
@@ -769,18 +781,28 @@ int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err)
         n += r;
         if (r == 0) break;
     }
-    int bad = ferror(f);
+    int bad = ferror(f), e = errno;
     fclose(f);
     if (bad) {
         free(buf);
-        return pfsph_fail(err, PFSPH_EIO, "%s: read error", path);
+        return pfsph_fail(err, PFSPH_EIO, "%s: cannot read: %s", path, strerror(e));
     }
     buf[n] = 0;
     if (strlen(buf) != n) {
         free(buf);
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: $: file contains a NUL byte; not a JSON scene", path);
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: $: not a scene file (it holds a NUL byte; scenes are JSON text)",
+                          path);
     }
-    int rc = pfsph_scene_parse(s, buf, path, err);
+    *text = buf;
+    return PFSPH_OK;
+}
+
+int pfsph_scene_load(pfsph_scene *s, const char *path, pfsph_error *err)
+{
+    char *buf;
+    int rc = pfsph_scene_read_text(path, &buf, err);
+    if (rc) return rc;
+    rc = pfsph_scene_parse(s, buf, path, err);
     free(buf);
     return rc;
 }

@@ -9,6 +9,11 @@
 #include "scene/json_util.h"
 
 #define COORD_MAX 1e6
+/* A body's density, given or from its mass and volume (kg/m^3): lighter than the lightest
+ * aerogels or heavier than ten times osmium is a typing error, and at the far ends the
+ * masses and moments ODE is given underflow (it aborts on a zero inertia: issue 33). */
+#define DENSITY_MIN 0.1
+#define DENSITY_MAX 1e5
 
 static const char *const shape_names[] = {"box", "sphere", "cylinder", "mesh", NULL};
 static const char *const axis_names[] = {"x", "y", "z", NULL};
@@ -87,11 +92,66 @@ static int resolve_mesh(const pfsph_scene *s, const char *P, const char *file, c
     snprintf(kp, sizeof kp, "%s.file", P);
     if (!file[0]) return pfsph__json_fail(ctx, kp, "must not be empty");
     const char *slash = strrchr(s->source, '/');
+    /* built in a buffer of its own: out lies in the scene, like s->source, and gcc 12 cannot
+     * tell that they do not overlap (-Wrestrict) */
+    char buf[2 * PFSPH_PATH_LEN];
     int w;
-    if (file[0] == '/' || !slash || s->source[0] == '<') w = snprintf(out, cap, "%s", file);
-    else w = snprintf(out, cap, "%.*s/%s", (int)(slash - s->source), s->source, file);
+    if (file[0] == '/' || !slash || s->source[0] == '<') w = snprintf(buf, sizeof buf, "%s", file);
+    else w = snprintf(buf, sizeof buf, "%.*s/%s", (int)(slash - s->source), s->source, file);
     if (w < 0 || (size_t)w >= cap) return pfsph__json_fail(ctx, kp, "path too long");
+    memcpy(out, buf, (size_t)w + 1);
     return PFSPH_OK;
+}
+
+/* Every extent of the body (box edges, diameters, a cylinder's height) at least the particle
+ * spacing d = 2 particle_radius: a smaller body holds no particle of its own or one the fluid
+ * cannot resolve (a radius of 1e-20 ran and never felt the water). A mesh body is checked when
+ * its file is read (pfsph_bodies_create). */
+static int check_extents(const pfsph_body_def *b, const char *P, const pfsph_scene *s, pfsph_jctx *ctx)
+{
+    const double d = 2 * s->particle_radius;
+    const char *key = NULL;
+    double ext = 0;
+    if (b->shape == PFSPH_BODY_BOX) {
+        for (int k = 0; k < s->dim; k++)
+            if (!key || 2 * b->half[k] < ext) key = "half_extents", ext = 2 * b->half[k];
+    } else if (b->shape != PFSPH_BODY_MESH) {
+        key = "radius", ext = 2 * b->radius;
+        if (b->shape == PFSPH_BODY_CYLINDER && s->dim == 3 && b->height < ext) key = "height", ext = b->height;
+    }
+    if (!key || ext >= d) return PFSPH_OK;
+    char kp[192];
+    snprintf(kp, sizeof kp, "%s.%s", P, key);
+    return pfsph__json_fail(ctx, kp,
+                            "the body is %g m across there, less than the particle spacing %g m (2 x "
+                            "particle_radius): it would hold no particle the fluid can feel; make it at least %g m",
+                            ext, d, d);
+}
+
+/* The body's volume (2D: per metre of depth); 0 for a mesh (known once its file is read). */
+static double body_volume(const pfsph_body_def *b, int dim)
+{
+    const double pi = 3.14159265358979323846;
+    switch (b->shape) {
+    case PFSPH_BODY_BOX: return 8 * b->half[0] * b->half[1] * (dim == 2 ? 0.5 : b->half[2]);
+    case PFSPH_BODY_SPHERE:
+        return dim == 2 ? pi * b->radius * b->radius : 4.0 / 3.0 * pi * b->radius * b->radius * b->radius;
+    case PFSPH_BODY_CYLINDER: return pi * b->radius * b->radius * (dim == 2 ? 1.0 : b->height);
+    default: return 0;
+    }
+}
+
+int pfsph__body_density_check(double density, double mass, double volume, char *msg, size_t cap)
+{
+    const double rho = mass > 0 ? mass / volume : density;
+    if (rho >= DENSITY_MIN && rho <= DENSITY_MAX) return 0;
+    if (mass > 0)
+        snprintf(msg, cap,
+                 "%g kg in the body's %g m^3 is a density of %g kg/m^3, outside the %g..%g a rigid body can "
+                 "have",
+                 mass, volume, rho, DENSITY_MIN, DENSITY_MAX);
+    else snprintf(msg, cap, "%g kg/m^3 is outside the %g..%g a rigid body can have", rho, DENSITY_MIN, DENSITY_MAX);
+    return 1;
 }
 
 static int parse_keys(const cJSON *arr, const char *P, const pfsph_scene *s, pfsph_body_def *b, pfsph_jctx *ctx)
@@ -280,6 +340,17 @@ int pfsph__scene_parse_bodies(const cJSON *arr, const char *path, pfsph_scene *s
         if (!(b->density > 0) && !(b->mass > 0))
             return pfsph__json_fail(ctx, P, "give \"density\" or \"mass\" (phase \"%s\" has no rest_density)",
                                     s->phases[b->phase].name);
+        if ((rc = check_extents(b, P, s, ctx))) return rc;
+        char why[256];
+        const double volume = body_volume(b, s->dim);
+        if ((b->mass > 0 ? volume > 0 : 1) && pfsph__body_density_check(b->density, b->mass, volume, why, sizeof why)) {
+            const char *key = b->mass > 0                        ? "mass"
+                : cJSON_GetObjectItemCaseSensitive(e, "density") ? "density"
+                                                                 : "phase";
+            snprintf(kp, sizeof kp, "%s.%s", P, key);
+            return pfsph__json_fail(ctx, kp, "%s%s", why,
+                                    key[0] == 'p' ? " (the phase's rest_density; give the body a \"density\")" : "");
+        }
         const cJSON *kf = cJSON_GetObjectItemCaseSensitive(e, "keyframes");
         if (kf) {
             if (!b->kinematic) {

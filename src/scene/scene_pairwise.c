@@ -272,7 +272,11 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
     double f = pfsph_pairwise_sigma_factor(s->dim, theta);
     for (int it = 0; it < 16; it++) {
         int rc = convert_targets(s, f * lam, theta, rho, err);
-        if (rc) return rc;
+        if (rc) { /* "pairwise: ..." names the phases: add the file and the block's path */
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
+            return pfsph_fail(err, rc, "%s: $.pairwise: %s", s->source, msg);
+        }
         tp->sigma_ref = 0;
         tp->rho_ref = 0;
         for (int a = 0; a < np; a++)

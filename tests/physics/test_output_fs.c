@@ -84,6 +84,58 @@ static void test_full_fs(void **state)
     assert_true(complete > 0);
 }
 
+/* Issue 33, item 1: a disk with a few free pages, no frames, only stats.csv, the stash of the
+ * last good state and summary.json (the stash failed silently and, deleted before the
+ * summary, made room for a "finished" with rows missing). For every number of free pages the
+ * run either finishes with every row, or exits 1 naming the file, with no "finished". */
+static void test_full_stats(void **state)
+{
+    (void)state;
+    if (mount_tmpfs("size=1m") != 0) tu_skip("cannot mount a tmpfs here (needs root)");
+    char scene[600], cmd[2400], out[4096], run[600], path[700];
+    snprintf(scene, sizeof scene, "%s/stats.json", tu_tmpdir());
+    /* 400 fps: 121 rows, three pages of stats.csv */
+    char text[2048];
+    const char *fps = strstr(SCENE, "\"fps\": 100"), *outk = strstr(SCENE, "\"output\"");
+    snprintf(text, sizeof text, "%.*s\"fps\": 400%.*s\"output\": {\"formats\": [], \"checkpoint_interval\": 0}}",
+             (int)(fps - SCENE), SCENE, (int)(outk - fps - 10), fps + 10);
+    assert_int_equal(tu_write_file(scene, text), 0);
+    snprintf(run, sizeof run, "%s/run", g_mnt);
+    int failed = 0, finished = 0;
+    for (int pages = 2; pages <= 24; pages += pages < 12 ? 1 : 4) {
+        snprintf(cmd, sizeof cmd,
+                 "rm -rf '%s'/* && avail=$(df -B4096 --output=avail '%s' | tail -1) && "
+                 "dd if=/dev/zero of='%s/fill' bs=4096 count=$((avail - %d)) 2>/dev/null; true",
+                 g_mnt, g_mnt, g_mnt, pages);
+        assert_int_equal(tu_run(cmd, out, sizeof out), 0);
+        snprintf(cmd, sizeof cmd, "'%s' run '%s' -o '%s' --quiet --end 0.3 2>&1", tu_pfsph_bin(), scene, run);
+        int st = tu_run(cmd, out, sizeof out);
+        snprintf(path, sizeof path, "%s/stats.csv", run);
+        FILE *f = fopen(path, "r");
+        int lines = 0, c;
+        while (f && (c = fgetc(f)) != EOF) lines += c == '\n';
+        if (f) fclose(f);
+        snprintf(path, sizeof path, "%s/summary.json", run);
+        f = fopen(path, "r");
+        char sum[4096] = "";
+        if (f) sum[fread(sum, 1, sizeof sum - 1, f)] = 0, fclose(f);
+        printf("%2d free pages: exit %d, %d lines in stats.csv, %s", pages, st, lines, out[0] ? out : "\n");
+        if (st == 0) {
+            finished++;
+            assert_int_equal(lines, 1 + 121); /* the header, frames 0..120 */
+            assert_non_null(strstr(sum, "\"finished\""));
+        } else {
+            failed++;
+            assert_int_equal(st, 1);
+            assert_non_null(strstr(out, "No space left on device"));
+            assert_non_null(strstr(out, run));
+            assert_null(strstr(sum, "\"finished\""));
+        }
+    }
+    printf("%d runs finished whole, %d failed with the file named\n", finished, failed);
+    assert_true(failed > 0);
+}
+
 static void test_readonly_fs(void **state)
 {
     (void)state;
@@ -103,6 +155,7 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {cmocka_unit_test_teardown(test_full_fs, teardown),
-                                       cmocka_unit_test_teardown(test_readonly_fs, teardown)};
+                                       cmocka_unit_test_teardown(test_readonly_fs, teardown),
+                                       cmocka_unit_test_teardown(test_full_stats, teardown)};
     return tu_run_group(tests, NULL, NULL);
 }

@@ -210,7 +210,7 @@ static void test_resume_end(void **state)
     assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet", dir), 0);
     assert_int_equal(last_row(dir, &rows), 7);
     /* an end before the newest checkpoint: refused, nothing changed */
-    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.1", dir), 2);
+    assert_int_equal(tu_pfsph("OMP_NUM_THREADS=1", out, sizeof out, "run --resume '%s' --quiet --end 0.08", dir), 2);
     assert_non_null(strstr(out, "before the newest checkpoint"));
     assert_int_equal(last_frame(dir), 7);
     assert_int_equal(last_row(dir, &rows), 7);

@@ -157,7 +157,7 @@ static void test_blender_load(void **state)
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     const char *j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
-    printf("meshed: %.700s\n", j);
+    printf("meshed: %.700s\n", j ? j : "");
     assert_non_null(strstr(j, "\"frame_end\": 2, \"frame_start\": 0"));
     /* 3 liquid frames and the tank (RUN/solids.ply, issue 33 item 10), the liquid with velocities
      * (item 12); no factory cube, camera or light: the scene's own stage (item 9) */
@@ -190,7 +190,7 @@ static void test_blender_load(void **state)
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
-    printf("points: %.400s\n", j);
+    printf("points: %.400s\n", j ? j : "");
     assert_non_null(strstr(j, "\"fluid points\": 6"));
     assert_non_null(strstr(j, "\"objects\": 8")); /* and the tank */
     /* a rigid body: its own object, keyed every frame, falling (Blender's z is pfsph's y) */
@@ -199,7 +199,7 @@ static void test_blender_load(void **state)
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     j = json_after(out, "pfsph_load: ");
     assert_non_null(j);
-    printf("bodies: %.600s\n", j);
+    printf("bodies: %.600s\n", j ? j : "");
     assert_non_null(strstr(j, "\"objects\": 5")); /* 3 liquid frames, the ball, the tank */
     const char *b = strstr(j, "\"body ball\": {");
     assert_non_null(b);

@@ -38,7 +38,7 @@ static pfsph_sim *make(void)
 static void test_strerror(void **state)
 {
     (void)state;
-    const int codes[] = {PFSPH_OK, PFSPH_EINPUT, PFSPH_EUNSTABLE, PFSPH_EIO, PFSPH_ENOMEM};
+    const int codes[] = {PFSPH_OK, PFSPH_EINPUT, PFSPH_EUNSTABLE, PFSPH_EINTR, PFSPH_EIO, PFSPH_ENOMEM};
     const int n = (int)(sizeof codes / sizeof codes[0]);
     for (int i = 0; i < n; i++) {
         const char *t = pfsph_strerror(codes[i]);
@@ -50,7 +50,7 @@ static void test_strerror(void **state)
     assert_string_equal(pfsph_strerror(PFSPH_OK), "success");
     assert_string_equal(pfsph_strerror(PFSPH_ENOMEM), "out of memory");
     assert_string_equal(pfsph_strerror(1), "unknown error");
-    assert_string_equal(pfsph_strerror(-4), "unknown error");
+    assert_string_equal(pfsph_strerror(-6), "unknown error");
     assert_string_equal(pfsph_version(), PFSPH_VERSION);
     assert_int_equal(pfsph_real_type(), PFSPH_REAL_TYPE);
     assert_int_equal(sizeof(pfsph_real), PFSPH_REAL_TYPE == PFSPH_FLOAT64 ? 8 : 4);

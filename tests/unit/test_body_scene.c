@@ -146,6 +146,70 @@ static void test_bad_obj_cli(void **st)
     assert_int_equal(rc, 0);
 }
 
+/* Tiny or absurdly light bodies (issue 33, item 3): a body's extents below the particle
+ * spacing (0.04 m here) and densities outside 0.1..1e5 kg/m^3 are refused with the JSON path,
+ * and a mass ODE would abort on (SIGABRT, "assertion dMassCheck(mass) failed") never reaches
+ * it: each case is exit status 2, never a crash. */
+static void test_tiny_bodies(void **st)
+{
+    (void)st;
+    expect_error(3, "{\"shape\": \"sphere\", \"radius\": 1e-300, \"position\": [0.5, 0.5, 0.5]}", "$.bodies[0].radius",
+                 "particle spacing");
+    expect_error(2, "{\"shape\": \"cylinder\", \"radius\": 1e-20, \"position\": [0.5, 0.5]}", "$.bodies[0].radius",
+                 "particle spacing");
+    expect_error(3, "{\"shape\": \"cylinder\", \"radius\": 1e-300, \"height\": 0.2, \"position\": [0.5, 0.5, 0.5]}",
+                 "$.bodies[0].radius", "particle spacing");
+    expect_error(3, "{\"shape\": \"cylinder\", \"radius\": 0.1, \"height\": 1e-20, \"position\": [0.5, 0.5, 0.5]}",
+                 "$.bodies[0].height", "particle spacing");
+    expect_error(2, "{\"shape\": \"box\", \"half_extents\": [0.1, 0.019], \"position\": [0.5, 0.5]}",
+                 "$.bodies[0].half_extents", "particle spacing");
+    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5], \"density\": 1e-300}",
+                 "$.bodies[0].density", "outside");
+    expect_error(
+        3, "{\"shape\": \"box\", \"half_extents\": [0.1, 0.1, 0.1], \"position\": [0.5, 0.5, 0.5], \"mass\": 1e-300}",
+        "$.bodies[0].mass", "density of");
+    expect_error(2, "{\"shape\": \"sphere\", \"radius\": 0.02, \"position\": [0.5, 0.5], \"mass\": 1e6}",
+                 "$.bodies[0].mass", "density of");
+    /* given moments of inertia that underflow: refused when the simulation is built */
+    static pfsph_scene s;
+    pfsph_error err;
+    assert_int_equal(
+        parse(3,
+              "{\"name\": \"speck\", \"shape\": \"sphere\", \"radius\": 0.1, \"position\": [0.5, 0.5, 0.5],"
+              " \"inertia\": [1e-300, 1e-300, 1e-300]}",
+              &s, &err),
+        PFSPH_OK);
+    pfsph_sim *sim = NULL;
+    int rc = pfsph_sim_create(&sim, &s, &err);
+    printf("inertia 1e-300: %s\n", err.msg);
+    assert_int_equal(rc, PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "$.bodies[0]"));
+    assert_non_null(strstr(err.msg, "speck"));
+    /* mesh bodies, checked once the file is read: through `pfsph check` (it aborted) */
+    static const char *const mesh[][3] = {{"\"scale\": 1e-300", "$.bodies[0].scale", "icosphere.obj"},
+                                          {"\"scale\": 1e-20", "$.bodies[0].scale", "icosphere.obj"},
+                                          {"\"scale\": 1000", "$.bodies[0].scale", "icosphere.obj"},
+                                          {"\"scale\": 0.1, \"mass\": 1e-300", "$.bodies[0].mass", "density of"},
+                                          {"\"scale\": 0.1, \"density\": 1e-300", "$.bodies[0].density", "outside"}};
+    for (size_t i = 0; i < sizeof mesh / sizeof mesh[0]; i++) {
+        char body[2048], json[8192], scene[1100], cmd[2400], out[4096];
+        snprintf(body, sizeof body,
+                 "{\"name\": \"ball\", \"shape\": \"mesh\", \"file\": \"%s/tests/data/meshes/icosphere.obj\","
+                 " %s, \"position\": [0.5, 0.5, 0.5]}",
+                 tu_source_dir(), mesh[i][0]);
+        snprintf(json, sizeof json, BASE, 3, ", 0", ", -0.1", ", 1.1", ", 0", ", 0.1", ", 0", ", 1", body);
+        snprintf(scene, sizeof scene, "%s/tiny_%zu.json", tu_tmpdir(), i);
+        assert_int_equal(tu_write_file(scene, json), 0);
+        snprintf(cmd, sizeof cmd, "%s check %s", tu_pfsph_bin(), scene);
+        rc = tu_run(cmd, out, sizeof out);
+        printf("%s: exit %d: %s", mesh[i][0], rc, out);
+        assert_int_equal(rc, 2);
+        assert_non_null(strstr(out, scene));
+        assert_non_null(strstr(out, mesh[i][1]));
+        assert_non_null(strstr(out, mesh[i][2]));
+    }
+}
+
 /* A kinematic body is where its keyframes put it: linear in position, slerp in rotation, the
  * last key held; its particles move with it at the keyed velocity. */
 /* Overlapping bodies are refused with both JSON paths (issue 15 item 15: they were pushed
@@ -246,7 +310,7 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse_ok),  cmocka_unit_test(test_parse_errors), cmocka_unit_test(test_bad_obj_cli),
-        cmocka_unit_test(test_keyframes), cmocka_unit_test(test_overlap),
+        cmocka_unit_test(test_keyframes), cmocka_unit_test(test_overlap),      cmocka_unit_test(test_tiny_bodies),
     };
     return tu_run_group(tests, NULL, NULL);
 }

@@ -627,6 +627,40 @@ static char *make_many(const char *key, const char *item, int n)
     return t;
 }
 
+/* Issue 33, item 6: text that is not a name (invalid UTF-8, a NUL, 10 MB) is refused with the
+ * JSON path before it can reach summary.json or bodies.csv; valid UTF-8 passes. */
+static void test_text_limits(void **state)
+{
+    (void)state;
+    static const char *const bad[][2] = {
+        {SCENE3(",\"name\":\"dam\xff\xfe\""), "$.name: the string is not valid UTF-8 (byte 0xff"},
+        {SCENE3(",\"phases\":[{\"name\":\"wa\xc0\x80ter\"}]"), "$.phases[0].name: the string is not valid UTF-8"},
+        {SCENE3(",\"name\":\"a\xed\xa0\x80\""), "$.name: the string is not valid UTF-8 (byte 0xed"},
+        {SCENE3(",\"name\":\"a\xf4\x90\x80\x80\""), "$.name: the string is not valid UTF-8"},
+        {SCENE3(",\"name\":\"a\\u0000b\""), "$: \"\\u0000\" (a NUL character) in a string at line 1"},
+        {SCENE3(",\"comment\":{\"x\xff\":1}"), "$.comment.x\xff: the key is not valid UTF-8"},
+    };
+    pfsph_error err;
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        int rc = parse(bad[k][0], &err);
+        if (rc != PFSPH_EINPUT || !strstr(err.msg, bad[k][1]))
+            fail_msg("case %zu: rc %d, \"%s\"; expected \"%s\"", k, rc, err.msg, bad[k][1]);
+        assert_non_null(strstr(err.msg, "dir/bad.json"));
+    }
+    /* a 10 MB comment */
+    const size_t n = 10u << 20;
+    char *big = malloc(n + 512);
+    assert_non_null(big);
+    int len = snprintf(big, 512, "{\"particle_radius\":0.01," DOM3 "," FLUID3 ",\"comment\":\"");
+    memset(big + len, 'x', n);
+    strcpy(big + len + n, "\"}");
+    assert_int_equal(parse(big, &err), PFSPH_EINPUT);
+    assert_non_null(strstr(err.msg, "$.comment: the string of 10485760 bytes, more than the 65536"));
+    free(big);
+    /* valid UTF-8 and an escaped backslash before u0000 are fine */
+    expect_ok(SCENE3(",\"name\":\"D\xc3\xa4mm \xe2\x9c\x93 \xf0\x9f\x98\x80\",\"comment\":\"a\\\\u0000b\""));
+}
+
 static void test_bad(void **state)
 {
     const bad_case *c = *state;
@@ -672,6 +706,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_default_scene),
         cmocka_unit_test(test_load_file),
         cmocka_unit_test(test_shipped_scenes),
+        cmocka_unit_test(test_text_limits),
     };
     enum { NFIXED = sizeof fixed / sizeof fixed[0] };
     struct CMUnitTest tests[NFIXED + NBAD];

@@ -254,6 +254,59 @@ static void test_messages(void **state)
 }
 
 /* Issue 15 item 12: "output": {"boundary": false} writes no boundary frame. */
+/* Issue 33, item 4: every file is read through the library's capped readers. `pfsph check
+ * /dev/zero` grew to 1 GB in 10 s, a 30 MB scene took 12 s and 816 MB: now 16 MiB at most
+ * (refused, exit status 2, at once); a frame larger than 8 GiB (a sparse file here) is refused
+ * by render before anything is allocated. The commands run under a 1 GB address-space limit
+ * (not in sanitizer builds, whose shadow memory needs more) and a 60 s timeout. */
+static void test_read_caps(void **state)
+{
+    (void)state;
+#ifdef PFSPH_SANITIZED
+    const char *limit = "";
+#else
+    const char *limit = "ulimit -v 1000000; ";
+#endif
+    char cmd[4096], out[8192], path[600], run[600];
+    snprintf(cmd, sizeof cmd, "%stimeout 60 '%s' check /dev/zero", limit, tu_pfsph_bin());
+    int st = tu_run(cmd, out, sizeof out);
+    printf("check /dev/zero: exit %d: %s", st, out);
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(out, "/dev/zero: $: file is larger than 16 MiB"));
+    snprintf(cmd, sizeof cmd, "%stimeout 60 '%s' run /dev/zero -o '%s/zero_run'", limit, tu_pfsph_bin(), tu_tmpdir());
+    st = tu_run(cmd, out, sizeof out);
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(out, "larger than 16 MiB"));
+    /* a 17 MiB scene of blanks around {} */
+    snprintf(path, sizeof path, "%s/huge.json", tu_tmpdir());
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputc('{', f);
+    for (int k = 0; k < 17 * 1024; k++) fprintf(f, "%1023s\n", "");
+    fputc('}', f);
+    assert_int_equal(fclose(f), 0);
+    snprintf(cmd, sizeof cmd, "%stimeout 60 '%s' check '%s'", limit, tu_pfsph_bin(), path);
+    st = tu_run(cmd, out, sizeof out);
+    printf("check huge.json: exit %d: %s", st, out);
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(out, "huge.json: $: file is larger than 16 MiB"));
+    /* a frame of 9 GiB (sparse: no space taken) */
+    snprintf(run, sizeof run, "%s/bigframe", tu_tmpdir());
+    snprintf(cmd, sizeof cmd,
+             "mkdir -p '%s/frames' && printf '{\"dimension\":2,\"domain\":{\"min\":[0,0],\"max\":[1,1]},"
+             "\"fluid\":[{\"shape\":\"box\",\"min\":[0,0],\"max\":[0.2,0.2]}]}' > '%s/scene.json' && "
+             "truncate -s 9G '%s/frames/fluid_00000.vtp'",
+             run, run, run);
+    assert_int_equal(tu_run(cmd, out, sizeof out), 0);
+    snprintf(cmd, sizeof cmd, "%stimeout 60 '%s' render '%s'", limit, tu_pfsph_bin(), run);
+    st = tu_run(cmd, out, sizeof out);
+    printf("render of a 9 GiB frame: exit %d: %s", st, out);
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(out, "fluid_00000.vtp: 9 GiB, larger than the 8 GiB"));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", run);
+    tu_run(cmd, out, sizeof out);
+}
+
 static void test_no_boundary(void **state)
 {
     (void)state;
@@ -358,15 +411,11 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_check_bad),
-        cmocka_unit_test(test_check_thermostat),
-        cmocka_unit_test(test_check_missing_file),
-        cmocka_unit_test(test_run_bad_writes_nothing),
-        cmocka_unit_test(test_run_end_overflow),
-        cmocka_unit_test(test_messages),
-        cmocka_unit_test(test_no_boundary),
-        cmocka_unit_test(test_no_boundary_bodies),
-        cmocka_unit_test(test_help),
+        cmocka_unit_test(test_check_bad),          cmocka_unit_test(test_check_thermostat),
+        cmocka_unit_test(test_check_missing_file), cmocka_unit_test(test_run_bad_writes_nothing),
+        cmocka_unit_test(test_run_end_overflow),   cmocka_unit_test(test_messages),
+        cmocka_unit_test(test_read_caps),          cmocka_unit_test(test_no_boundary),
+        cmocka_unit_test(test_no_boundary_bodies), cmocka_unit_test(test_help),
         cmocka_unit_test(test_check_good),
     };
     return tu_run_group(tests, NULL, NULL);
