@@ -228,7 +228,10 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary + nd_max * per_diffuse;
     if (n_fluid) *n_fluid = (size_t)nf;
     if (n_boundary) *n_boundary = (size_t)nb;
-    if (bytes) *bytes = part_bytes + grid_bytes >= (double)SIZE_MAX ? SIZE_MAX : (size_t)(part_bytes + grid_bytes);
+    /* a run's fixed buffers: the frame writer's and the checkpoint encoder's (1 MiB each) */
+    const double fixed = 2.0 * 1048576;
+    const double total = part_bytes + grid_bytes + fixed;
+    if (bytes) *bytes = total >= (double)SIZE_MAX ? SIZE_MAX : (size_t)total;
     if (nf_max + nb > (long)UINT32_MAX)
         return pfsph_fail(err, PFSPH_EINPUT,
                           "%s: the scene makes %ld particles (%ld fluid), more than the %u one run "

@@ -9,7 +9,7 @@ library's memory, run directories read back. Guide: docs/python.md.
     run = pfsph.read_run("runs/dam_break_2d")
 """
 from ._ffi import ffi as _cffi, lib as _clib, library_path
-from .errors import (Error, InputError, SceneError, UnstableError, PfsphIOError, PfsphMemoryError)
+from .errors import (Error, InputError, SceneError, UnstableError, InterruptedRun, PfsphIOError, PfsphMemoryError)
 from .simulation import Simulation, ParticleSet, Body, set_threads, threads
 from .rundir import Run, Frame, read_run, read_frame
 
@@ -25,5 +25,5 @@ def default_scene():
 
 
 __all__ = ["Simulation", "ParticleSet", "Body", "Run", "Frame", "read_run", "read_frame", "set_threads", "threads",
-           "default_scene", "library_path", "Error", "InputError", "SceneError", "UnstableError", "PfsphIOError",
+           "default_scene", "library_path", "Error", "InputError", "SceneError", "UnstableError", "InterruptedRun", "PfsphIOError",
            "PfsphMemoryError", "real_dtype", "__version__"]

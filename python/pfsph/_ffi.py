@@ -7,7 +7,7 @@ from cffi import FFI
 # include/pfsph.h, less its macros (tests/test_api.py checks that every function of the header is
 # declared here).
 CDEF = """
-enum { PFSPH_OK = 0, PFSPH_EINPUT = -2, PFSPH_EUNSTABLE = -3, PFSPH_EIO = -5, PFSPH_ENOMEM = -12 };
+enum { PFSPH_OK = 0, PFSPH_EINPUT = -2, PFSPH_EUNSTABLE = -3, PFSPH_EINTR = -4, PFSPH_EIO = -5, PFSPH_ENOMEM = -12 };
 enum { PFSPH_FLOAT32 = 1, PFSPH_FLOAT64 = 2, PFSPH_UINT8 = 3, PFSPH_UINT32 = 4 };
 
 const char *pfsph_strerror(int code);

@@ -32,6 +32,10 @@ class UnstableError(Error, ArithmeticError):
     """The simulation blew up (PFSPH_EUNSTABLE); the message names the particle and the stage."""
 
 
+class InterruptedRun(Error):
+    """A stop was asked for (PFSPH_EINTR): the run ended at a step boundary, resumable."""
+
+
 class PfsphIOError(Error, OSError):
     """A file system error (PFSPH_EIO)."""
 
@@ -59,7 +63,7 @@ def _last_key(path):
     return path.rsplit(".", 1)[-1].split("[", 1)[0] or None
 
 
-_CODES = {-2: InputError, -3: UnstableError, -5: PfsphIOError, -12: PfsphMemoryError}
+_CODES = {-2: InputError, -3: UnstableError, -4: InterruptedRun, -5: PfsphIOError, -12: PfsphMemoryError}
 
 
 def from_code(code, message, scene=False):
