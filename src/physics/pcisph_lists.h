@@ -1,0 +1,26 @@
+/* PCISPH's correction walks over neighbour lists built once per step (the interactive mode,
+ * docs/interactive.md): the fluid and boundary neighbours within h at the step's positions, as
+ * Solenthaler & Pajarola 2009 search them once per step, and the density and pressure of the
+ * predicted positions summed over them. */
+#ifndef PFSPH_PCISPH_LISTS_H
+#define PFSPH_PCISPH_LISTS_H
+
+#include "core/nlist.h"
+#include "pfsph/ctx.h"
+
+/* Lists l (fluid, j != i) and lb (boundary) of the fluid's neighbours within h at its current
+ * positions, in one grid walk (two when a thread's region overflows). PFSPH_OK or
+ * PFSPH_ENOMEM. */
+int pfsph__pcisph_lists(const pfsph_ctx *ctx, pfsph_nlist *l, pfsph_nlist *lb);
+
+/* pfsph__number_density at the predicted positions (x, y, z), over the listed pairs that are
+ * still within h there (a pair entering h during the step is missed: its kernel is near 0). */
+void pfsph__pcisph_density(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb, const pfsph_real *x,
+                           const pfsph_real *y, const pfsph_real *z, pfsph_real *nd);
+
+/* pfsph__pressure_accel over the same pairs. */
+void pfsph__pcisph_pressure(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb, const pfsph_real *x,
+                            const pfsph_real *y, const pfsph_real *z, const pfsph_real *nd, const pfsph_real *p,
+                            pfsph_real *apx, pfsph_real *apy, pfsph_real *apz);
+
+#endif
