@@ -51,7 +51,7 @@ static double load_average(void)
 enum { L_DTMAX, L_CFL, L_FORCE, L_PCI, L_VISC, L_FRAME, NLIM };
 static const char *const lim_name[NLIM] = {"dt_max",
                                            "CFL (cfl d / vmax)",
-                                           "force (0.25 sqrt(d / a_np))",
+                                           "force (0.25 or 0.35 sqrt(d / a_np))",
                                            "PCISPH cap (0.2 sqrt(tol d / a_np))",
                                            "viscous (0.125 d^2 / nu_max)",
                                            "frame landing (shorter than all)"};
@@ -124,7 +124,7 @@ int main(int argc, char **argv)
                 const double vmax = st->stats.vmax, anp = st->amax_np;
                 v[L_DTMAX] = st->dt_max;
                 v[L_CFL] = vmax > 0 ? s.cfl * d / vmax : INFINITY;
-                v[L_FORCE] = pfsph__dt_force(d, anp);
+                v[L_FORCE] = pci && c->interactive ? pfsph__dt_force_interactive(d, anp) : pfsph__dt_force(d, anp);
                 v[L_PCI] = pci && !c->interactive && anp > 0 ? 0.2 * sqrt(tol * d / anp) : INFINITY;
                 v[L_VISC] = st->nu_max > 0 ? 0.125 * d * d / st->nu_max : INFINITY;
             }

@@ -7,6 +7,7 @@
 
 #include "core/reduce.h"
 #include "physics/density.h"
+#include "physics/pcisph_lists.h"
 #include "physics/pressure.h"
 #include "physics/solver.h"
 
@@ -29,6 +30,8 @@ typedef struct pcisph {
     double proto; /* |sum grad W|^2 + sum |grad W|^2 of a full lattice neighbourhood */
     double tol, c, cfl;
     int min_iter, max_iter;
+    /* the interactive mode's once-per-step neighbour lists (pcisph_lists.h) */
+    pfsph_nlist l, lb;
 } pcisph;
 
 /* PCISPH scaling: |sum grad W|^2 + sum |grad W|^2 over a full lattice neighbourhood. */
@@ -48,14 +51,24 @@ static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config 
     return PFSPH_OK;
 }
 
-static void destroy(void *state) { free(state); }
+static void destroy(void *state)
+{
+    pcisph *p = state;
+    if (!p) return;
+    pfsph_nlist_free(&p->l);
+    pfsph_nlist_free(&p->lb);
+    free(p);
+}
 
 static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsph_real *const *scr,
                   pfsph_solve_stats *out)
 {
-    const pcisph *P = state;
+    pcisph *P = state;
     pfsph_particles *f = c->fluid;
     const size_t n = f->n;
+    /* interactive: the neighbours once per step, as Solenthaler & Pajarola search them, instead
+     * of two grid walks per correction (docs/interactive.md); grid walks when out of memory */
+    const int lists = c->interactive && pfsph__pcisph_lists(c, &P->l, &P->lb) == PFSPH_OK;
     const double dt = c->dt;
     pfsph_real *apx = ap[0], *apy = ap[1], *apz = ap[2];
     pfsph_real *xp = scr[XP], *yp = scr[YP], *zp = scr[ZP], *ndp = scr[NDP], *er = scr[ERR];
@@ -83,7 +96,8 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
             yp[i] = f->y[i] + fdt * f->vy[i] + dt2 * (c->ay[i] + apy[i]);
             zp[i] = f->z[i] + fdt * f->vz[i] + dt2 * (c->az[i] + apz[i]);
         }
-        pfsph__number_density(c, xp, yp, zp, ndp);
+        if (lists) pfsph__pcisph_density(c, &P->l, &P->lb, xp, yp, zp, ndp);
+        else pfsph__number_density(c, xp, yp, zp, ndp);
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
             pfsph_real e = ndp[i] - nd0;
@@ -92,7 +106,8 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
             f->p[i] = pn > 0 ? pn : 0;
         }
         avg = n ? pfsph__sum(er, n) / (double)n : 0;
-        pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
+        if (lists) pfsph__pcisph_pressure(c, &P->l, &P->lb, xp, yp, zp, ndp, f->p, apx, apy, apz);
+        else pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
         it++;
         if (it >= P->min_iter && avg <= P->tol) break;
     }
@@ -114,7 +129,7 @@ static double dt_limit(const void *state, const pfsph_ctx *ctx, double vmax, dou
     const double d = ctx->spacing;
     double dt = INFINITY;
     if (vmax > 0) dt = P->cfl * d / vmax;
-    dt = fmin(dt, pfsph__dt_force(d, amax_np));
+    dt = fmin(dt, ctx->interactive ? pfsph__dt_force_interactive(d, amax_np) : pfsph__dt_force(d, amax_np));
     if (amax_np > 0 && !ctx->interactive) dt = fmin(dt, 0.2 * sqrt(P->tol * d / amax_np));
     return dt;
 }

@@ -44,6 +44,11 @@ double pfsph__speed_bound_one_step(double c, const pfsph_ctx *ctx)
 
 double pfsph__dt_force(double spacing, double a) { return a > 0 ? 0.25 * sqrt(spacing / a) : INFINITY; }
 
+double pfsph__dt_force_interactive(double spacing, double a)
+{
+    return a > 0 ? PFSPH_DT_FORCE_INTERACTIVE * sqrt(spacing / a) : INFINITY;
+}
+
 int pfsph__check_iterations(double min_iter, double max_iter, const char **key, char *msg, size_t len)
 {
     if (min_iter <= max_iter) return 0;

@@ -118,4 +118,10 @@ int pfsph__check_iterations(double min_iter, double max_iter, const char **key, 
  * = 0. */
 double pfsph__dt_force(double spacing, double a);
 
+/* The interactive mode's force criterion (PCISPH): 0.35 sqrt(d / a). Measured on the 3D
+ * interactive wetting and double-bubble scenes (docs/interactive.md): 0.35 runs 3 and 2 steps per
+ * frame stably; 0.5 blew up in the third step of the wetting scene (cube corners). */
+#define PFSPH_DT_FORCE_INTERACTIVE 0.35
+double pfsph__dt_force_interactive(double spacing, double a);
+
 #endif
