@@ -88,7 +88,7 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
     memset(apz, 0, n * sizeof(pfsph_real));
     memset(f->p, 0, n * sizeof(pfsph_real));
     int it = 0;
-    double avg = 0;
+    double avg = 0, prev = INFINITY;
     while (it < P->max_iter) {
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
@@ -110,6 +110,10 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
         else pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
         it++;
         if (it >= P->min_iter && avg <= P->tol) break;
+        /* interactive: an error that grows means the relaxed Jacobi diverges at this dt (a
+         * wall's edge under a large step): more corrections would only add to it */
+        if (lists && it >= P->min_iter && avg > prev) break;
+        prev = avg;
     }
     out->iterations = it;
     out->density_err_avg = avg;
