@@ -325,13 +325,13 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
         sim->boundary.rho[i] = (pfsph_real)s->phases[sim->boundary.phase[i]].rest_density;
     /* the schedule decides the step's arrays; it needs the model's objects, so until they
      * exist it is planned from the scene (what it will hold), and built at the end */
+    /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
+     * the estimate counts it (before the schedule: the interactive PCISPH's lists unfuse it) */
+    const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
+    sim->st.lists = pfsph__sim_lists(s, n_most);
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
     if ((rc = pfsph__sim_alloc_scratch(sim, sim->st.em ? sim->fluid.cap : sim->fluid.n))) goto nomem;
-    /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
-     * the estimate counts it */
-    const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
-    sim->st.lists = pfsph__sim_lists(s, n_most);
 
     auto_sound_speed(sim);
     pfsph_solver_config cfg_, *cfg = &cfg_; /* the solver keeps what it needs */
@@ -438,7 +438,7 @@ static void build_schedule(pfsph_sim *sim)
     const bool pw = s->pairwise.enabled, film = s->film.nbubbles > 0 && sim->fluid.n, bodies = s->nbodies > 0,
                df = s->diffuse.enabled, em = s->nemitters > 0;
     /* the density in the pair walk (one k h walk instead of an h walk and a k h walk) */
-    const bool fused = pw && !solver->neighbour_lists && !solver->pre_forces;
+    const bool fused = pw && !solver->neighbour_lists && !solver->pre_forces && !sim->st.lists;
     int n = 0;
 #define ADD(stage) sim->stages[n++] = (pfsph__sched){&(stage), NULL, 0}
     ADD(pfsph_stage_grid);

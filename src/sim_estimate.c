@@ -146,7 +146,10 @@ static double physical_memory(void)
 int pfsph__sim_lists(const pfsph_scene *s, double n_fluid)
 {
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
-    if (!ops || !ops->neighbour_lists) return 0;
+    /* the interactive mode's PCISPH walks them too: its corrections and the viscosity
+     * (docs/interactive.md); the physical mode's PCISPH walks the grid (the fused pair density) */
+    const int interactive_pci = ops && s->mode == PFSPH_MODE_INTERACTIVE && !strcmp(ops->name, "pcisph");
+    if (!ops || !(ops->neighbour_lists || interactive_pci)) return 0;
     const int k = pfsph_solver_key_index(ops, "neighbour_lists");
     const double v = k >= 0 ? s->solver_settings[k] : 0;
     if (v != 0) return v > 0;

@@ -68,7 +68,13 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
     const size_t n = f->n;
     /* interactive: the neighbours once per step, as Solenthaler & Pajarola search them, instead
      * of two grid walks per correction (docs/interactive.md); grid walks when out of memory */
-    const int lists = c->interactive && pfsph__pcisph_lists(c, &P->l, &P->lb) == PFSPH_OK;
+    const pfsph_nlist *L = c->nlist, *LB = c->nlist_b; /* the density stage's, when it built them */
+    if (c->interactive && !(L && LB)) {
+        L = &P->l;
+        LB = &P->lb;
+        if (pfsph__pcisph_lists(c, &P->l, &P->lb) != PFSPH_OK) L = LB = NULL;
+    }
+    const int lists = c->interactive && L && LB;
     const double dt = c->dt;
     pfsph_real *apx = ap[0], *apy = ap[1], *apz = ap[2];
     pfsph_real *xp = scr[XP], *yp = scr[YP], *zp = scr[ZP], *ndp = scr[NDP], *er = scr[ERR];
@@ -96,7 +102,7 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
             yp[i] = f->y[i] + fdt * f->vy[i] + dt2 * (c->ay[i] + apy[i]);
             zp[i] = f->z[i] + fdt * f->vz[i] + dt2 * (c->az[i] + apz[i]);
         }
-        if (lists) pfsph__pcisph_density(c, &P->l, &P->lb, xp, yp, zp, ndp);
+        if (lists) pfsph__pcisph_density(c, L, LB, xp, yp, zp, ndp);
         else pfsph__number_density(c, xp, yp, zp, ndp);
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
@@ -106,7 +112,7 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
             f->p[i] = pn > 0 ? pn : 0;
         }
         avg = n ? pfsph__sum(er, n) / (double)n : 0;
-        if (lists) pfsph__pcisph_pressure(c, &P->l, &P->lb, xp, yp, zp, ndp, f->p, apx, apy, apz);
+        if (lists) pfsph__pcisph_pressure(c, L, LB, xp, yp, zp, ndp, f->p, apx, apy, apz);
         else pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
         it++;
         if (it >= P->min_iter && avg <= P->tol) break;
