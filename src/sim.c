@@ -465,7 +465,8 @@ static void build_schedule(pfsph_sim *sim)
 #undef ADD
     sim->nstages = n;
     sim->nout = 0;
-    sim->out_stages[sim->nout++] = (pfsph__sched){&pfsph_stage_surface_layers, NULL, 0};
+    if (sim->scene.output.surface_layer)
+        sim->out_stages[sim->nout++] = (pfsph__sched){&pfsph_stage_surface_layers, NULL, 0};
     if (pw) sim->out_stages[sim->nout++] = (pfsph__sched){&pfsph_stage_mechanical_pressure, NULL, 0};
 }
 
@@ -610,11 +611,13 @@ int pfsph_sim_output(pfsph_sim *sim, pfsph_error *err)
 {
     const size_t n = sim->fluid.n ? sim->fluid.n : 1;
     if (n > sim->out_cap) {
-        uint8_t *l = realloc(sim->st.out_layer, n);
+        const bool lay = sim->scene.output.surface_layer;
+        uint8_t *l = lay ? realloc(sim->st.out_layer, n) : sim->st.out_layer;
         if (l) sim->st.out_layer = l;
         pfsph_real *m = sim->st.pw ? realloc(sim->st.out_mech_p, n * sizeof(pfsph_real)) : sim->st.out_mech_p;
         if (m) sim->st.out_mech_p = m;
-        if (!l || (sim->st.pw && !m)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for a frame's fields");
+        if ((lay && !l) || (sim->st.pw && !m))
+            return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for a frame's fields");
         sim->out_cap = n;
     }
     for (int k = 0; k < sim->nout; k++) {
