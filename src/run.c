@@ -245,6 +245,17 @@ static int read_run_json(const char *dir, double *end, int *fi, pfsph_error *err
     return PFSPH_OK;
 }
 
+/* The set-up's slow phases (a second or more: a scene of millions of particles) as messages, so
+ * that minutes of set-up show what they do. */
+static void setup_note(const char *done, double seconds, void *user)
+{
+    const pfsph_run_opts *o = user;
+    if (!o || !o->progress || !o->message || seconds < 1.0) return;
+    char msg[320];
+    snprintf(msg, sizeof msg, "set-up: %s (%.1f s)", done, seconds);
+    o->message(msg, o->user);
+}
+
 /* layer: the fluid's surface layers (NULL for other sets); film: bubbles' film fractions */
 static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name, int frame, const pfsph_particles *ps,
                         const char *aux, double time, const uint8_t *layer, bool film, pfsph_error *err)
@@ -602,7 +613,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     if ((!resume || o->end_time >= 0) && (rc = write_run_json(dir, end, s->fps, s->output.frame_interval, err)))
         return rc;
     pfsph_sim *sim = NULL;
-    if ((rc = pfsph_sim_create(&sim, s, err))) return rc;
+    if ((rc = pfsph_sim_create_ex(&sim, s, setup_note, (void *)o, err))) return rc;
 
     int frame0 = 0;
     int nframes = (int)floor(end * s->fps + 1e-9);
@@ -705,8 +716,12 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     int frame = frame0, written = 0;
     if (!resume) {
         fputs(header, csv);
+        double t0 = omp_get_wtime();
         pfsph_sim_prime_output(sim);
+        setup_note("sorted the fluid, its densities and pressures", omp_get_wtime() - t0, (void *)o);
+        t0 = omp_get_wtime();
         rc = write_frame(s, dir, 0, sim, err);
+        setup_note("wrote frame 0", omp_get_wtime() - t0, (void *)o);
         if (!rc) written++;
         csv_row(csv, 0, sim);
         if (bcsv) bodies_rows(bcsv, 0, sim);

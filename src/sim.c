@@ -5,6 +5,7 @@
 #include "pfsph/sim.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -224,8 +225,34 @@ void pfsph__sim_apply_viscosity(pfsph_ctx *c, const pfsph_scene *s)
                                                                             : s->phases[p].viscosity);
 }
 
+/* A phase of the set-up is over: tell the caller what it did and how long it took. */
+typedef struct setup_clock {
+    pfsph_setup_fn note;
+    void *user;
+    double t;
+} setup_clock;
+
+static void setup_done(setup_clock *k, const char *fmt, ...)
+{
+    if (!k->note) return;
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    const double t = now();
+    k->note(msg, t - k->t, k->user);
+    k->t = t;
+}
+
 int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err)
 {
+    return pfsph_sim_create_ex(out, scene, NULL, NULL, err);
+}
+
+int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_fn note, void *user, pfsph_error *err)
+{
+    setup_clock clk = {note, user, now()};
     *out = NULL;
     pfsph_sim *sim = calloc(1, sizeof(*sim));
     if (!sim) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
@@ -270,6 +297,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     uint8_t solid_wall[PFSPH_MAX_SOLIDS];
     wall_models(c, s, solid_wall);
     if ((rc = build_particles(s, d, solid_wall, &sim->fluid, &sim->boundary, &sim->st.bodies, err))) goto fail;
+    setup_done(&clk, "sampled %zu fluid and %zu boundary particles", sim->fluid.n, sim->boundary.n);
     /* Emitters: the fluid arrays (and below, the step's scratch) are reserved for the most they
      * can add by the scene's end, so that a step never allocates; a longer run (--end) grows
      * them geometrically (st_emit). */
@@ -323,6 +351,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     pfsph__boundary_volumes(&sim->boundary, &sim->bgrid, &c->kern);
     for (size_t i = 0; i < sim->boundary.n; i++)
         sim->boundary.rho[i] = (pfsph_real)s->phases[sim->boundary.phase[i]].rest_density;
+    setup_done(&clk, "sorted the boundary into %zu grid cells, its volumes", sim->bgrid.ncells);
     /* the schedule decides the step's arrays; it needs the model's objects, so until they
      * exist it is planned from the scene (what it will hold), and built at the end */
     build_schedule(sim);
@@ -378,6 +407,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     }
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
+    setup_done(&clk, "the solver's and stages' arrays");
     *out = sim;
     return PFSPH_OK;
 nomem:

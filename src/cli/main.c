@@ -329,7 +329,12 @@ static void show_render_message(const char *msg, void *user)
 
 static void show_message(const char *msg, void *user)
 {
-    (void)user;
+    /* the set-up's progress (src/run.c, setup_note) is news, not a warning */
+    if (!strncmp(msg, "set-up: ", 8)) {
+        const progress_state *ps = user;
+        if (!ps || !ps->quiet) fprintf(stderr, "pfsph: %s\n", msg);
+        return;
+    }
     fprintf(stderr, "pfsph: warning: %s\n", msg);
 }
 

@@ -86,6 +86,39 @@ static void surface_layer_output_is_optional(void **state)
     }
 }
 
+typedef struct notes {
+    int n;
+    double total;
+    char first[256];
+} notes;
+
+static void note(const char *done, double seconds, void *user)
+{
+    notes *k = user;
+    if (!k->n) snprintf(k->first, sizeof k->first, "%s", done);
+    k->n++;
+    assert_true(seconds >= 0);
+    k->total += seconds;
+}
+
+/* pfsph_sim_create_ex tells its caller each phase of the set-up (the program prints the slow
+ * ones: minutes at 1.9e8 particles): the sampling first, with the particle counts. */
+static void setup_reports_its_phases(void **state)
+{
+    (void)state;
+    pfsph_scene s;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(&s, PAIR_SCENE, "<notes>", &err), PFSPH_OK);
+    notes k = {0};
+    pfsph_sim *sim = NULL;
+    if (pfsph_sim_create_ex(&sim, &s, note, &k, &err)) fail_msg("%s", err.msg);
+    assert_int_equal(k.n, 3);
+    char want[64];
+    snprintf(want, sizeof want, "sampled %zu fluid and 0 boundary particles", pfsph_sim_ctx(sim)->fluid->n);
+    assert_string_equal(k.first, want);
+    pfsph_sim_destroy(sim);
+}
+
 static int index_of(const pfsph_sim *sim, const char *name)
 {
     for (int i = 0; i < pfsph_sim_stage_count(sim); i++)
@@ -149,8 +182,8 @@ static void hand_over_survives_an_ap_reader(void **state)
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
-    const struct CMUnitTest tests[] = {cmocka_unit_test(inserted_stage_runs_in_place),
-                                       cmocka_unit_test(hand_over_survives_an_ap_reader),
-                                       cmocka_unit_test(surface_layer_output_is_optional)};
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(inserted_stage_runs_in_place), cmocka_unit_test(hand_over_survives_an_ap_reader),
+        cmocka_unit_test(surface_layer_output_is_optional), cmocka_unit_test(setup_reports_its_phases)};
     return tu_run_group(tests, NULL, NULL);
 }
