@@ -247,13 +247,20 @@ static int read_run_json(const char *dir, double *end, int *fi, pfsph_error *err
 
 /* The set-up's slow phases (a second or more: a scene of millions of particles) as messages, so
  * that minutes of set-up show what they do. */
-static void setup_note(const char *done, double seconds, void *user)
+static void setup_note(const char *done, double wall_s, double cpu_s, void *user)
 {
     const pfsph_run_opts *o = user;
-    if (!o || !o->progress || !o->message || seconds < 1.0) return;
+    if (!o || !o->progress || !o->message || wall_s < 1.0) return;
     char msg[320];
-    snprintf(msg, sizeof msg, "set-up: %s (%.1f s)", done, seconds);
+    snprintf(msg, sizeof msg, "set-up: %s (%.1f s, CPU %.1f s)", done, wall_s, cpu_s);
     o->message(msg, o->user);
+}
+
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* layer: the fluid's surface layers (NULL for other sets); film: bubbles' film fractions */
@@ -716,12 +723,12 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     int frame = frame0, written = 0;
     if (!resume) {
         fputs(header, csv);
-        double t0 = omp_get_wtime();
+        double t0 = omp_get_wtime(), c0 = cpu_s();
         pfsph_sim_prime_output(sim);
-        setup_note("sorted the fluid, its densities and pressures", omp_get_wtime() - t0, (void *)o);
-        t0 = omp_get_wtime();
+        setup_note("sorted the fluid, its densities and pressures", omp_get_wtime() - t0, cpu_s() - c0, (void *)o);
+        t0 = omp_get_wtime(), c0 = cpu_s();
         rc = write_frame(s, dir, 0, sim, err);
-        setup_note("wrote frame 0", omp_get_wtime() - t0, (void *)o);
+        setup_note("wrote frame 0", omp_get_wtime() - t0, cpu_s() - c0, (void *)o);
         if (!rc) written++;
         csv_row(csv, 0, sim);
         if (bcsv) bodies_rows(bcsv, 0, sim);

@@ -88,15 +88,24 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
         /* drop fluid particles inside or too close to a solid or a body (their boundary
          * particles sit d/2 inside the surface; one nearer than 0.4 d would start compressed) */
-        size_t w = first;
+        /* the distances in parallel (a byte per particle while the block is built; minutes on
+         * one thread at 1.9e8 particles), the compaction in order */
+        const size_t nb = fluid->n - first;
+        uint8_t *keep = malloc(nb ? nb : 1);
+        if (!keep) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
+#pragma omp parallel for schedule(static)
         for (size_t j = first; j < fluid->n; j++) {
             double p[3] = {fluid->x[j], fluid->y[j], fluid->z[j]};
-            int keep = 1;
-            for (int k = 0; k < s->nsolids && keep; k++)
-                if (pfsph__solid_distance(&s->solids[k], s->dim, (double)d, p) < 0.4 * d) keep = 0;
-            for (int k = 0; k < s->nbodies && keep; k++)
-                if (pfsph_bodies_distance(*bodies, k, p) < 0.4 * d) keep = 0;
-            if (!keep) continue;
+            uint8_t k1 = 1;
+            for (int k = 0; k < s->nsolids && k1; k++)
+                if (pfsph__solid_distance(&s->solids[k], s->dim, (double)d, p) < 0.4 * d) k1 = 0;
+            for (int k = 0; k < s->nbodies && k1; k++)
+                if (pfsph_bodies_distance(*bodies, k, p) < 0.4 * d) k1 = 0;
+            keep[j - first] = k1;
+        }
+        size_t w = first;
+        for (size_t j = first; j < fluid->n; j++) {
+            if (!keep[j - first]) continue;
             if (w != j) {
                 for (int f = 0; f < PFSPH_NFIELDS; f++) fluid->f[f][w] = fluid->f[f][j];
                 fluid->phase[w] = fluid->phase[j];
@@ -105,6 +114,7 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
             fluid->id[w] = (uint32_t)w;
             w++;
         }
+        free(keep);
         fluid->n = w;
         fluid->next_id = (uint32_t)w;
     }
@@ -229,7 +239,7 @@ void pfsph__sim_apply_viscosity(pfsph_ctx *c, const pfsph_scene *s)
 typedef struct setup_clock {
     pfsph_setup_fn note;
     void *user;
-    double t;
+    double t, cpu;
 } setup_clock;
 
 static void setup_done(setup_clock *k, const char *fmt, ...)
@@ -240,9 +250,10 @@ static void setup_done(setup_clock *k, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    const double t = now();
-    k->note(msg, t - k->t, k->user);
+    const double t = now(), cpu = cpu_now();
+    k->note(msg, t - k->t, cpu - k->cpu, k->user);
     k->t = t;
+    k->cpu = cpu;
 }
 
 int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err)
@@ -252,7 +263,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
 
 int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_fn note, void *user, pfsph_error *err)
 {
-    setup_clock clk = {note, user, now()};
+    setup_clock clk = {note, user, now(), cpu_now()};
     *out = NULL;
     pfsph_sim *sim = calloc(1, sizeof(*sim));
     if (!sim) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");

@@ -92,13 +92,13 @@ typedef struct notes {
     char first[256];
 } notes;
 
-static void note(const char *done, double seconds, void *user)
+static void note(const char *done, double wall_s, double cpu_s, void *user)
 {
     notes *k = user;
     if (!k->n) snprintf(k->first, sizeof k->first, "%s", done);
     k->n++;
-    assert_true(seconds >= 0);
-    k->total += seconds;
+    assert_true(wall_s >= 0 && cpu_s >= 0);
+    k->total += wall_s;
 }
 
 /* pfsph_sim_create_ex tells its caller each phase of the set-up (the program prints the slow
