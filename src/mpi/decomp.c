@@ -8,6 +8,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <stdio.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include "core/reduce.h"
 #include "core/stage.h"
@@ -98,6 +101,31 @@ static void held_cells(const pfsph_decomp *D, int q, size_t *lo, size_t *hi)
     *hi = D->cut[q + 1] + D->off < D->ncells ? D->cut[q + 1] + D->off : D->ncells;
 }
 
+/* A rank other than the root holds its slice alone: the whole scene's arrays it was created with
+ * (every rank samples the scene) are cut down to the slice, so that its memory follows its share.
+ * They grow again through the step's reserve if its slice grows. */
+static int fit(pfsph_decomp *D, pfsph_particles *f, size_t n)
+{
+    if (D->rank == 0 || f->cap <= 2 * n + 4096) return PFSPH_OK;
+    const size_t cap = n + n / 4 + 1024;
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        void *q = realloc(f->f[k], cap * sizeof(pfsph_real));
+        if (!q) return PFSPH_ENOMEM;
+        f->f[k] = q;
+    }
+    void *q;
+    if (!(q = realloc(f->phase, cap))) return PFSPH_ENOMEM;
+    f->phase = q;
+    if (!(q = realloc(f->wall, cap))) return PFSPH_ENOMEM;
+    f->wall = q;
+    if (!(q = realloc(f->bubble, cap))) return PFSPH_ENOMEM;
+    f->bubble = q;
+    if (!(q = realloc(f->id, cap * sizeof(uint32_t)))) return PFSPH_ENOMEM;
+    f->id = q;
+    f->cap = cap;
+    return pfsph__sim_alloc_scratch(D->sim, cap);
+}
+
 /* The stage before the grid sort: the particles each rank owned (all on the root after a
  * frame) go to every rank that holds their new cell. Each rank sends its particles in its
  * order, the receivers take them in rank order, so the grid's stable sort then gives them the
@@ -174,6 +202,7 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
         return pfsph_fail(err, PFSPH_EIO, "exchange: rank %d received %zu particles for a slice of %llu", D->rank, n,
                           (unsigned long long)(D->lend[D->rank] - D->lofs[D->rank]));
     int rc = st->reserve(st, n, err);
+    if (!rc && fit(D, f, n)) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory fitting the slice's arrays");
     if (rc) return rc;
     for (size_t i = 0; i < n; i++) unpack(D->rbuf + i * REC, f, NULL, i);
     f->n = n;
@@ -419,11 +448,24 @@ void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c) { MPI_Bcast(c, sizeof *
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
 {
     if (D->root_all) return PFSPH_OK;
-    pfsph_mpi_fig mine = {D->steps,          D->d.own_hi - D->d.own_lo,
-                          D->own_min,        D->own_max,
-                          D->halo_particles, D->halo_calls,
-                          D->bytes_sent,     D->migr_bytes,
-                          D->messages};
+    pfsph_mpi_fig mine = {D->steps,
+                          D->d.own_hi - D->d.own_lo,
+                          D->own_min,
+                          D->own_max,
+                          D->halo_particles,
+                          D->halo_calls,
+                          D->bytes_sent,
+                          D->migr_bytes,
+                          D->messages,
+                          0,
+                          0};
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) == 0) mine.peak_rss_kb = (uint64_t)ru.ru_maxrss;
+    FILE *sm = fopen("/proc/self/statm", "r");
+    unsigned long pages_all, pages_res;
+    if (sm && fscanf(sm, "%lu %lu", &pages_all, &pages_res) == 2)
+        mine.rss_kb = (uint64_t)pages_res * (uint64_t)sysconf(_SC_PAGESIZE) / 1024;
+    if (sm) fclose(sm);
     MPI_Gather(&mine, sizeof mine, MPI_BYTE, D->fig, sizeof mine, MPI_BYTE, 0, D->comm);
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;

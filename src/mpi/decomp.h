@@ -21,6 +21,8 @@ typedef struct pfsph_mpi_cmd {
 /* One rank's figures, gathered by the root at every frame (summary.json). */
 typedef struct pfsph_mpi_fig {
     uint64_t steps, owned, own_min, own_max, halo_particles, halo_calls, bytes_sent, migr_bytes, messages;
+    uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
+    uint64_t rss_kb;      /* its resident memory at the frame */
 } pfsph_mpi_fig;
 
 typedef struct pfsph_decomp {

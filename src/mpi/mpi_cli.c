@@ -73,6 +73,8 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(r, "halo_bytes_sent_per_step", (double)f->bytes_sent / st);
         cJSON_AddNumberToObject(r, "exchange_bytes_sent_per_step", (double)f->migr_bytes / st);
         cJSON_AddNumberToObject(r, "messages_sent_per_step", (double)f->messages / st);
+        cJSON_AddNumberToObject(r, "rss_mib_at_last_frame", (double)f->rss_kb / 1024.0);
+        cJSON_AddNumberToObject(r, "peak_rss_mib", (double)f->peak_rss_kb / 1024.0);
         cJSON_AddItemToArray(ranks, r);
     }
 }
