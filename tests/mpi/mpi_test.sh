@@ -3,6 +3,8 @@
 #   mpi_test.sh compare SCENE END NP...   frames/ and stats.csv of -np NP equal the serial run's
 #   mpi_test.sh resume SCENE T1 T2 NP1 NP2 run to T1 on NP1 ranks, resume to T2 on NP2 ranks:
 #                                          the same bytes as an uninterrupted serial run to T2
+#   mpi_test.sh kill SCENE END NP1 NP2     kill -9 one rank of NP1 once checkpoints exist, resume on
+#                                          NP2 ranks: the same bytes as an uninterrupted serial run
 #   mpi_test.sh refuse SCENE NP            refused once (one message), exit status 2
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
 # Exit 77 (skipped) when the build has no MPI or mpirun is missing.
@@ -60,6 +62,29 @@ resume)
     mpi "$np2" run --resume "$TMP/r" --end "$t2" --quiet || { echo "FAIL: resume on -np $np2"; exit 1; }
     grep -q '"resumed_from_frame"' "$TMP/r/summary.json" || { echo "FAIL: not resumed"; exit 1; }
     same "$TMP/serial" "$TMP/r" || exit 1
+    ;;
+kill)
+    scene=$SRC/$1 end=$2 np1=$3 np2=$4
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    "$MPIRUN" $ROOTOPT --oversubscribe -np "$np1" "$BIN" run "$scene" -o "$TMP/k" --end "$end" --quiet \
+        >"$TMP/k.log" 2>&1 &
+    mpid=$!
+    i=0
+    while [ "$(ls "$TMP/k/checkpoints" 2>/dev/null | grep -c .)" -lt 2 ] && kill -0 $mpid 2>/dev/null; do
+        sleep 0.2
+        i=$((i + 1))
+        [ $i -lt 1500 ] || break
+    done
+    victim=$(pgrep -P $mpid | tail -n 1) # the last rank mpirun started (not rank 0, which writes)
+    [ -n "$victim" ] || { echo "FAIL: the run ended before it could be killed (make it longer)"; exit 1; }
+    kill -9 "$victim"
+    wait $mpid
+    rc=$?
+    [ "$rc" != 0 ] || { echo "FAIL: mpirun exited 0 after a rank was killed"; exit 1; }
+    echo "killed rank pid $victim; mpirun exited $rc; checkpoints: $(ls "$TMP/k/checkpoints" | tr '\n' ' ')"
+    mpi "$np2" run --resume "$TMP/k" --quiet || { echo "FAIL: resume on -np $np2"; exit 1; }
+    grep -q '"resumed_from_frame"' "$TMP/k/summary.json" || { echo "FAIL: not resumed"; exit 1; }
+    same "$TMP/serial" "$TMP/k" || exit 1
     ;;
 refuse)
     scene=$SRC/$1 np=$2
