@@ -5,7 +5,8 @@
 #                                          the same bytes as an uninterrupted serial run to T2
 #   mpi_test.sh kill SCENE END NP1 NP2     kill -9 one rank of NP1 once checkpoints exist, resume on
 #                                          NP2 ranks: the same bytes as an uninterrupted serial run
-#   mpi_test.sh refuse SCENE NP            refused once (one message), exit status 2
+#   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
+#                                          STATUS (default 2) from mpirun
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
 # Exit 77 (skipped) when the build has no MPI or mpirun is missing.
 set -u
@@ -87,13 +88,13 @@ kill)
     same "$TMP/serial" "$TMP/k" || exit 1
     ;;
 refuse)
-    scene=$SRC/$1 np=$2
-    mpi "$np" run "$scene" -o "$TMP/bad" --quiet 2>"$TMP/err"
+    scene=$SRC/$1 np=$2 want=${3:-2}
+    mpi "$np" run "$scene" -o "$TMP/bad" --end 0.04 --quiet 2>"$TMP/err"
     rc=$?
-    [ "$rc" = 2 ] || { echo "FAIL: exit status $rc, not 2"; cat "$TMP/err"; exit 1; }
+    [ "$rc" = "$want" ] || { echo "FAIL: exit status $rc, not $want"; cat "$TMP/err"; exit 1; }
     n=$(grep -c '^pfsph: ' "$TMP/err")
     [ "$n" = 1 ] || { echo "FAIL: $n messages, not 1:"; cat "$TMP/err"; exit 1; }
-    echo "ok: refused with exit status 2 and one message: $(grep '^pfsph: ' "$TMP/err")"
+    echo "ok: exit status $rc and one message: $(grep '^pfsph: ' "$TMP/err")"
     ;;
 *)
     echo "usage: mpi_test.sh compare|resume|refuse ..."
