@@ -508,6 +508,17 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     MPI_Comm_rank(comm, &D->rank);
     MPI_Comm_size(comm, &D->size);
     if (D->size > 64) return PFSPH_EINPUT;
+    const size_t P = (size_t)D->size;
+    D->cut = calloc(P + 1, sizeof(uint32_t));
+    D->gofs = calloc(P + 1, sizeof(uint64_t));
+    D->lofs = calloc(P, sizeof(uint64_t));
+    D->lend = calloc(P, sizeof(uint64_t));
+    D->scount = calloc(P, sizeof(int));
+    D->sdispl = calloc(P, sizeof(int));
+    D->rcount = calloc(P, sizeof(int));
+    D->rdispl = calloc(P, sizeof(int));
+    if (!D->cut || !D->gofs || !D->lofs || !D->lend || !D->scount || !D->sdispl || !D->rcount || !D->rdispl)
+        return PFSPH_ENOMEM;
     D->d.halo = halo;
     D->d.sum = sum;
     D->d.agree = agree;
@@ -534,21 +545,10 @@ static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err)
     const size_t R = (size_t)(g->reach_far > g->reach ? g->reach_far : g->reach) + 1;
     const size_t nx = (size_t)g->nc[0], ny = (size_t)g->nc[1];
     D->off = R * (1 + nx + (g->dim == 3 ? nx * ny : 0));
-    const size_t P = (size_t)D->size;
     D->hist = calloc(D->ncells + 1, sizeof(uint32_t));
     D->pre = calloc(D->ncells + 1, sizeof(uint64_t));
-    D->cut = calloc(P + 1, sizeof(uint32_t));
-    D->gofs = calloc(P + 1, sizeof(uint64_t));
-    D->lofs = calloc(P, sizeof(uint64_t));
-    D->lend = calloc(P, sizeof(uint64_t));
-    D->scount = calloc(P, sizeof(int));
-    D->sdispl = calloc(P, sizeof(int));
-    D->rcount = calloc(P, sizeof(int));
-    D->rdispl = calloc(P, sizeof(int));
     int rc = PFSPH_OK;
-    if (!D->hist || !D->pre || !D->cut || !D->gofs || !D->lofs || !D->lend || !D->scount || !D->sdispl || !D->rcount ||
-        !D->rdispl)
-        rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the decomposition");
+    if (!D->hist || !D->pre) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the decomposition");
     if (!rc) rc = pfsph_sim_insert_stage(sim, "grid", 0, &stage_exchange, D, err);
     if (!rc) rc = pfsph_sim_insert_stage(sim, "density", 1, &stage_halo_density, D, err);
     if (!rc) rc = pfsph_sim_insert_stage(sim, "integrate", 1, &stage_stats, D, err);
