@@ -77,6 +77,8 @@ static const char *HELP_RUN =
     "  -h, --help        this text\n"
     "\n"
     "A run holds a lock on its directory: a second run into it is refused (exit status 2).\n"
+    "Built with -DPFSPH_MPI=ON, `mpirun -np N pfsph run ...` spreads the run over N ranks, with\n"
+    "the same frames as one process (docs/cluster.md).\n"
     "Exit status: 0 finished, 2 bad input, 3 unstable (the last good state is kept as a\n"
     "checkpoint), 1 other errors.\n";
 

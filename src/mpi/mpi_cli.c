@@ -5,6 +5,7 @@
 
 #include <cjson/cJSON.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,6 +28,12 @@ void pfsph_mpi_start(int *argc, char ***argv)
     atexit(finish);
     MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
     MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+    /* one voice: rank 0 prints (usage errors, progress, the agreed error); PFSPH_MPI_VERBOSE=1
+     * keeps the others' output, for debugging */
+    if (g_rank > 0 && !getenv("PFSPH_MPI_VERBOSE")) {
+        if (!freopen("/dev/null", "w", stdout)) return;
+        if (!freopen("/dev/null", "w", stderr)) return;
+    }
 }
 
 int pfsph_mpi_rank(void) { return g_rank; }
