@@ -21,6 +21,7 @@
 
 #include "io/io_internal.h"
 #include "pfsph/checkpoint.h"
+#include "pfsph/dist.h"
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
 #include "pfsph/solid_mesh.h"
@@ -471,6 +472,7 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
         cJSON *st = cJSON_AddObjectToObject(j, "stage_seconds");
         const double *ss = pfsph_sim_stage_seconds(sim);
         for (int k = 0; k < PFSPH_NSTAGES; k++) cJSON_AddNumberToObject(st, pfsph_stage_names[k], ss[k]);
+        if (c->dist && c->dist->report) c->dist->report(c->dist, j); /* per-rank figures under MPI */
     }
     cJSON_AddNumberToObject(j, "frames", frames);
     if (info->resumed_from >= 0) cJSON_AddNumberToObject(j, "resumed_from_frame", info->resumed_from);

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "pfsph/dist.h"
 #include "pfsph/surface_detect.h"
 #include "physics/boundary.h"
 #include "physics/density.h"
@@ -419,6 +420,8 @@ int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_f
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
     setup_done(&clk, "the solver's and stages' arrays");
+    /* under mpirun the decomposition takes the simulation over (src/mpi/, docs/cluster.md) */
+    if (pfsph__dist_process && (rc = pfsph__dist_process->attach(pfsph__dist_process, sim, err))) goto fail;
     *out = sim;
     return PFSPH_OK;
 nomem:
@@ -598,6 +601,8 @@ pfsph_step *pfsph_sim_step_state(pfsph_sim *sim) { return &sim->st; }
 int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
 {
     sim->st.t_limit = t_limit;
+    pfsph_dist *dist = sim->ctx.dist;
+    if (dist) dist->step_begin(dist, t_limit);
     double t0 = now(), c0 = cpu_now();
     for (int k = 0; k < sim->nstages; k++) {
         const pfsph__sched *e = &sim->stages[k];
@@ -610,7 +615,8 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
         sim->stage_cpu[e->ops->slot] += c1 - c0;
         t0 = t1;
         c0 = c1;
-        if (rc == PFSPH_EUNSTABLE && bad.what[0]) return report_blowup(sim, e->ops->name, &bad, err);
+        if (rc == PFSPH_EUNSTABLE && bad.what[0]) rc = report_blowup(sim, e->ops->name, &bad, err);
+        if (dist) rc = dist->agree(dist, rc, err); /* every rank stops, with the one message */
         if (rc) return rc;
     }
     sim->st.time += sim->ctx.dt;
@@ -626,7 +632,8 @@ int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err)
         if (rc) return rc;
     }
     sim->st.time = fmax(sim->st.time, t);
-    return PFSPH_OK;
+    /* a distributed run: the root gathers the fluid for the frame and the checkpoint */
+    return sim->ctx.dist ? sim->ctx.dist->frame(sim->ctx.dist, err) : PFSPH_OK;
 }
 
 /* Frame 0's densities and pressures (issue 14): the grid sort and density summation a step
