@@ -21,6 +21,7 @@
 
 #include "io/io_internal.h"
 #include "pfsph/checkpoint.h"
+#include "pfsph/dist.h"
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
 #include "pfsph/solid_mesh.h"
@@ -245,6 +246,24 @@ static int read_run_json(const char *dir, double *end, int *fi, pfsph_error *err
     return PFSPH_OK;
 }
 
+/* The set-up's slow phases (a second or more: a scene of millions of particles) as messages, so
+ * that minutes of set-up show what they do. */
+static void setup_note(const char *done, double wall_s, double cpu_s, void *user)
+{
+    const pfsph_run_opts *o = user;
+    if (!o || !o->progress || !o->message || wall_s < 1.0) return;
+    char msg[320];
+    snprintf(msg, sizeof msg, "set-up: %s (%.1f s, CPU %.1f s)", done, wall_s, cpu_s);
+    o->message(msg, o->user);
+}
+
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 /* layer: the fluid's surface layers (NULL for other sets); film: bubbles' film fractions */
 static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name, int frame, const pfsph_particles *ps,
                         const char *aux, double time, const uint8_t *layer, bool film, pfsph_error *err)
@@ -453,6 +472,7 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
         cJSON *st = cJSON_AddObjectToObject(j, "stage_seconds");
         const double *ss = pfsph_sim_stage_seconds(sim);
         for (int k = 0; k < PFSPH_NSTAGES; k++) cJSON_AddNumberToObject(st, pfsph_stage_names[k], ss[k]);
+        if (c->dist && c->dist->report) c->dist->report(c->dist, j); /* per-rank figures under MPI */
     }
     cJSON_AddNumberToObject(j, "frames", frames);
     if (info->resumed_from >= 0) cJSON_AddNumberToObject(j, "resumed_from_frame", info->resumed_from);
@@ -602,7 +622,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     if ((!resume || o->end_time >= 0) && (rc = write_run_json(dir, end, s->fps, s->output.frame_interval, err)))
         return rc;
     pfsph_sim *sim = NULL;
-    if ((rc = pfsph_sim_create(&sim, s, err))) return rc;
+    if ((rc = pfsph_sim_create_ex(&sim, s, setup_note, (void *)o, err))) return rc;
 
     int frame0 = 0;
     int nframes = (int)floor(end * s->fps + 1e-9);
@@ -705,8 +725,12 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     int frame = frame0, written = 0;
     if (!resume) {
         fputs(header, csv);
+        double t0 = omp_get_wtime(), c0 = cpu_s();
         pfsph_sim_prime_output(sim);
+        setup_note("sorted the fluid, its densities and pressures", omp_get_wtime() - t0, cpu_s() - c0, (void *)o);
+        t0 = omp_get_wtime(), c0 = cpu_s();
         rc = write_frame(s, dir, 0, sim, err);
+        setup_note("wrote frame 0", omp_get_wtime() - t0, cpu_s() - c0, (void *)o);
         if (!rc) written++;
         csv_row(csv, 0, sim);
         if (bcsv) bodies_rows(bcsv, 0, sim);

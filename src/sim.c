@@ -5,12 +5,14 @@
 #include "pfsph/sim.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
+#include "pfsph/dist.h"
 #include "pfsph/surface_detect.h"
 #include "physics/boundary.h"
 #include "physics/density.h"
@@ -87,15 +89,24 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
             return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
         /* drop fluid particles inside or too close to a solid or a body (their boundary
          * particles sit d/2 inside the surface; one nearer than 0.4 d would start compressed) */
-        size_t w = first;
+        /* the distances in parallel (a byte per particle while the block is built; minutes on
+         * one thread at 1.9e8 particles), the compaction in order */
+        const size_t nb = fluid->n - first;
+        uint8_t *keep = malloc(nb ? nb : 1);
+        if (!keep) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sampling fluid");
+#pragma omp parallel for schedule(static)
         for (size_t j = first; j < fluid->n; j++) {
             double p[3] = {fluid->x[j], fluid->y[j], fluid->z[j]};
-            int keep = 1;
-            for (int k = 0; k < s->nsolids && keep; k++)
-                if (pfsph__solid_distance(&s->solids[k], s->dim, (double)d, p) < 0.4 * d) keep = 0;
-            for (int k = 0; k < s->nbodies && keep; k++)
-                if (pfsph_bodies_distance(*bodies, k, p) < 0.4 * d) keep = 0;
-            if (!keep) continue;
+            uint8_t k1 = 1;
+            for (int k = 0; k < s->nsolids && k1; k++)
+                if (pfsph__solid_distance(&s->solids[k], s->dim, (double)d, p) < 0.4 * d) k1 = 0;
+            for (int k = 0; k < s->nbodies && k1; k++)
+                if (pfsph_bodies_distance(*bodies, k, p) < 0.4 * d) k1 = 0;
+            keep[j - first] = k1;
+        }
+        size_t w = first;
+        for (size_t j = first; j < fluid->n; j++) {
+            if (!keep[j - first]) continue;
             if (w != j) {
                 for (int f = 0; f < PFSPH_NFIELDS; f++) fluid->f[f][w] = fluid->f[f][j];
                 fluid->phase[w] = fluid->phase[j];
@@ -104,6 +115,7 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
             fluid->id[w] = (uint32_t)w;
             w++;
         }
+        free(keep);
         fluid->n = w;
         fluid->next_id = (uint32_t)w;
     }
@@ -224,8 +236,35 @@ void pfsph__sim_apply_viscosity(pfsph_ctx *c, const pfsph_scene *s)
                                                                             : s->phases[p].viscosity);
 }
 
+/* A phase of the set-up is over: tell the caller what it did and how long it took. */
+typedef struct setup_clock {
+    pfsph_setup_fn note;
+    void *user;
+    double t, cpu;
+} setup_clock;
+
+static void setup_done(setup_clock *k, const char *fmt, ...)
+{
+    if (!k->note) return;
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    const double t = now(), cpu = cpu_now();
+    k->note(msg, t - k->t, cpu - k->cpu, k->user);
+    k->t = t;
+    k->cpu = cpu;
+}
+
 int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err)
 {
+    return pfsph_sim_create_ex(out, scene, NULL, NULL, err);
+}
+
+int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_fn note, void *user, pfsph_error *err)
+{
+    setup_clock clk = {note, user, now(), cpu_now()};
     *out = NULL;
     pfsph_sim *sim = calloc(1, sizeof(*sim));
     if (!sim) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
@@ -270,6 +309,7 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     uint8_t solid_wall[PFSPH_MAX_SOLIDS];
     wall_models(c, s, solid_wall);
     if ((rc = build_particles(s, d, solid_wall, &sim->fluid, &sim->boundary, &sim->st.bodies, err))) goto fail;
+    setup_done(&clk, "sampled %zu fluid and %zu boundary particles", sim->fluid.n, sim->boundary.n);
     /* Emitters: the fluid arrays (and below, the step's scratch) are reserved for the most they
      * can add by the scene's end, so that a step never allocates; a longer run (--end) grows
      * them geometrically (st_emit). */
@@ -323,12 +363,13 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     pfsph__boundary_volumes(&sim->boundary, &sim->bgrid, &c->kern);
     for (size_t i = 0; i < sim->boundary.n; i++)
         sim->boundary.rho[i] = (pfsph_real)s->phases[sim->boundary.phase[i]].rest_density;
-    /* the schedule decides the step's arrays; it needs the model's objects, so until they
-     * exist it is planned from the scene (what it will hold), and built at the end */
+    setup_done(&clk, "sorted the boundary into %zu grid cells, its volumes", sim->bgrid.ncells);
     /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
      * the estimate counts it (before the schedule: the interactive PCISPH's lists unfuse it) */
     const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
     sim->st.lists = pfsph__sim_lists(s, n_most);
+    /* the schedule decides the step's arrays; it needs the model's objects, so until they
+     * exist it is planned from the scene (what it will hold), and built at the end */
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
     if ((rc = pfsph__sim_alloc_scratch(sim, sim->st.em ? sim->fluid.cap : sim->fluid.n))) goto nomem;
@@ -378,6 +419,9 @@ int pfsph_sim_create(pfsph_sim **out, const pfsph_scene *scene, pfsph_error *err
     }
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
+    setup_done(&clk, "the solver's and stages' arrays");
+    /* under mpirun the decomposition takes the simulation over (src/mpi/, docs/cluster.md) */
+    if (pfsph__dist_process && (rc = pfsph__dist_process->attach(pfsph__dist_process, sim, err))) goto fail;
     *out = sim;
     return PFSPH_OK;
 nomem:
@@ -465,7 +509,8 @@ static void build_schedule(pfsph_sim *sim)
 #undef ADD
     sim->nstages = n;
     sim->nout = 0;
-    sim->out_stages[sim->nout++] = (pfsph__sched){&pfsph_stage_surface_layers, NULL, 0};
+    if (sim->scene.output.surface_layer)
+        sim->out_stages[sim->nout++] = (pfsph__sched){&pfsph_stage_surface_layers, NULL, 0};
     if (pw) sim->out_stages[sim->nout++] = (pfsph__sched){&pfsph_stage_mechanical_pressure, NULL, 0};
 }
 
@@ -556,6 +601,8 @@ pfsph_step *pfsph_sim_step_state(pfsph_sim *sim) { return &sim->st; }
 int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
 {
     sim->st.t_limit = t_limit;
+    pfsph_dist *dist = sim->ctx.dist;
+    if (dist) dist->step_begin(dist, t_limit);
     double t0 = now(), c0 = cpu_now();
     for (int k = 0; k < sim->nstages; k++) {
         const pfsph__sched *e = &sim->stages[k];
@@ -568,7 +615,8 @@ int pfsph_sim_step(pfsph_sim *sim, double t_limit, pfsph_error *err)
         sim->stage_cpu[e->ops->slot] += c1 - c0;
         t0 = t1;
         c0 = c1;
-        if (rc == PFSPH_EUNSTABLE && bad.what[0]) return report_blowup(sim, e->ops->name, &bad, err);
+        if (rc == PFSPH_EUNSTABLE && bad.what[0]) rc = report_blowup(sim, e->ops->name, &bad, err);
+        if (dist) rc = dist->agree(dist, rc, err); /* every rank stops, with the one message */
         if (rc) return rc;
     }
     sim->st.time += sim->ctx.dt;
@@ -584,7 +632,8 @@ int pfsph_sim_advance(pfsph_sim *sim, double t, pfsph_error *err)
         if (rc) return rc;
     }
     sim->st.time = fmax(sim->st.time, t);
-    return PFSPH_OK;
+    /* a distributed run: the root gathers the fluid for the frame and the checkpoint */
+    return sim->ctx.dist ? sim->ctx.dist->frame(sim->ctx.dist, err) : PFSPH_OK;
 }
 
 /* Frame 0's densities and pressures (issue 14): the grid sort and density summation a step
@@ -610,11 +659,13 @@ int pfsph_sim_output(pfsph_sim *sim, pfsph_error *err)
 {
     const size_t n = sim->fluid.n ? sim->fluid.n : 1;
     if (n > sim->out_cap) {
-        uint8_t *l = realloc(sim->st.out_layer, n);
+        const bool lay = sim->scene.output.surface_layer;
+        uint8_t *l = lay ? realloc(sim->st.out_layer, n) : sim->st.out_layer;
         if (l) sim->st.out_layer = l;
         pfsph_real *m = sim->st.pw ? realloc(sim->st.out_mech_p, n * sizeof(pfsph_real)) : sim->st.out_mech_p;
         if (m) sim->st.out_mech_p = m;
-        if (!l || (sim->st.pw && !m)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for a frame's fields");
+        if ((lay && !l) || (sim->st.pw && !m))
+            return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for a frame's fields");
         sim->out_cap = n;
     }
     for (int k = 0; k < sim->nout; k++) {

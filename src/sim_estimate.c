@@ -215,7 +215,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
         SCR_COMMON + nstage + (ops && !shared ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
     /* output: the surface layers of a frame (a byte each) and, with pair forces, the
      * mechanical pressure (src/sim.c, pfsph_sim_output); frames stream through a 1 MiB buffer */
-    const double out = 1 + (s->pairwise.enabled ? sizeof(pfsph_real) : 0);
+    const double out = (s->output.surface_layer ? 1 : 0) + (s->pairwise.enabled ? sizeof(pfsph_real) : 0);
     /* and 5 % for the allocator's and the pages' rounding: a 2D run of 160,000 particles held
      * 116 B per particle against 112 counted here (tests/unit/test_estimate.c) */
     const double per_fluid = 1.05 * (P + nscr * sizeof(pfsph_real) + nlist + out);

@@ -18,6 +18,7 @@
 #include "pfsph/pairwise.h"
 #include "pfsph/render.h"
 #include "pfsph/run.h"
+#include "mpi/mpi_cli.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 #include "physics/solver.h"
@@ -76,6 +77,8 @@ static const char *HELP_RUN =
     "  -h, --help        this text\n"
     "\n"
     "A run holds a lock on its directory: a second run into it is refused (exit status 2).\n"
+    "Built with -DPFSPH_MPI=ON, `mpirun -np N pfsph run ...` spreads the run over N ranks, with\n"
+    "the same frames as one process (docs/cluster.md).\n"
     "Exit status: 0 finished, 2 bad input, 3 unstable (the last good state is kept as a\n"
     "checkpoint), 1 other errors.\n";
 
@@ -329,7 +332,12 @@ static void show_render_message(const char *msg, void *user)
 
 static void show_message(const char *msg, void *user)
 {
-    (void)user;
+    /* the set-up's progress (src/run.c, setup_note) is news, not a warning */
+    if (!strncmp(msg, "set-up: ", 8)) {
+        const progress_state *ps = user;
+        if (!ps || !ps->quiet) fprintf(stderr, "pfsph: %s\n", msg);
+        return;
+    }
     fprintf(stderr, "pfsph: warning: %s\n", msg);
 }
 
@@ -375,6 +383,8 @@ static int cmd_run(int argc, char **argv)
             return usage_error("unexpected argument '%s'", a);
         }
     }
+    /* under mpirun the other ranks follow rank 0, which reads the scene and writes the run */
+    if (pfsph_mpi_size() > 1 && pfsph_mpi_rank() > 0) return pfsph_mpi_follow(threads, exit_code);
     char resume_scene[4096];
     if (resume) {
         if (scene_path) return usage_error("--resume takes the scene from RUN_DIR/scene.json, not '%s'", scene_path);
@@ -396,10 +406,17 @@ static int cmd_run(int argc, char **argv)
         rc = 2;
     }
     if (!rc) rc = check_memory(&s, 0);
+    pfsph_error merr = {0};
+    if (!rc && pfsph_mpi_check_scene(&s, &merr)) {
+        print_error(NULL, merr.msg);
+        rc = 2;
+    }
+    rc = pfsph_mpi_share_scene(rc, text, rc ? "" : s.source); /* one rank refuses, every rank exits */
     if (rc) {
         free(text);
         return rc;
     }
+    const int mpi = pfsph_mpi_size() > 1;
     if (!scene_path) render = 1;
     if (!scene_path && !out) force = 1; /* the embedded demo into its own directory: rerunnable */
     if (threads > 0) omp_set_num_threads(threads);
@@ -413,7 +430,7 @@ static int cmd_run(int argc, char **argv)
                         .resume = resume != NULL,
                         .message = show_message,
                         .force = force,
-                        .stop = &g_stop};
+                        .stop = mpi ? NULL : &g_stop}; /* under MPI a signal ends every rank */
     const char *dir = out ? out : s.output.dir;
     if (!quiet)
         fprintf(stderr, "pfsph %s: %s -> %s (%d threads)%s\n", PFSPH_VERSION, s.source, dir, omp_get_max_threads(),
@@ -426,9 +443,10 @@ static int cmd_run(int argc, char **argv)
     struct sigaction old_int, old_term; /* a signal ignored at the start (nohup, a background job) stays so */
     sigaction(SIGINT, NULL, &old_int);
     sigaction(SIGTERM, NULL, &old_term);
-    if (old_int.sa_handler != SIG_IGN) sigaction(SIGINT, &sa, NULL);
-    if (old_term.sa_handler != SIG_IGN) sigaction(SIGTERM, &sa, NULL);
+    if (old_int.sa_handler != SIG_IGN && !mpi) sigaction(SIGINT, &sa, NULL);
+    if (old_term.sa_handler != SIG_IGN && !mpi) sigaction(SIGTERM, &sa, NULL);
     rc = pfsph_run(&s, &o, &err);
+    pfsph_mpi_end(rc);
     sigaction(SIGINT, &old_int, NULL);
     sigaction(SIGTERM, &old_term, NULL);
     free(text);
@@ -728,6 +746,7 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *cmd = argv[1];
+    if (!strcmp(cmd, "run")) pfsph_mpi_start(&argc, &argv); /* a no-op without -DPFSPH_MPI=ON */
     if (!strcmp(cmd, "--version") || !strcmp(cmd, "version")) {
         printf("pfsph %s (%s precision, OpenMP %d threads)\n", PFSPH_VERSION, PFSPH_REAL_NAME, omp_get_max_threads());
         return 0;

@@ -51,6 +51,7 @@ typedef struct pfsph_ctx {
     const pfsph_film_params *film; /* bubbles in air; NULL or nbubbles 0: none */
     double time, dt;
     uint64_t step;
+    struct pfsph_dist *dist; /* a distributed run's decomposition (pfsph/dist.h); NULL: serial */
 } pfsph_ctx;
 
 #endif

@@ -2,6 +2,7 @@
  * time step and the blow-up check need (largest accelerations and speed, kinetic energy). */
 #include <math.h>
 
+#include "core/dist.h"
 #include "core/reduce.h"
 #include "pfsph/pairwise.h"
 #include "pfsph/thermostat.h"
@@ -14,7 +15,8 @@ static int integrate_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_e
     (void)err;
     pfsph_ctx *c = st->ctx;
     pfsph_particles *f = c->fluid;
-    const size_t n = f->n;
+    size_t lo, n; /* a distributed run integrates what it owns (its halo is sent afresh) */
+    pfsph__owned(c, &lo, &n);
     const pfsph_real *apx = st->ap[0], *apy = st->ap[1], *apz = st->ap[2];
     const double dt = c->dt;
     const pfsph_real fdt = (pfsph_real)dt;
@@ -28,7 +30,7 @@ static int integrate_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_e
     const pfsph_real *nx = noise ? st->noise[0] : NULL, *ny = noise ? st->noise[1] : NULL,
                      *nz = noise ? st->noise[2] : NULL;
 #pragma omp parallel for schedule(static) reduction(max : amax2, anp2, emax, v2max) reduction(| : bad_)
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = lo; i < n; i++) {
         pfsph_real bx = c->ax[i], by = c->ay[i], bz = c->az[i];
         if (noise) {
             bx -= nx[i];
@@ -57,7 +59,7 @@ static int integrate_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_e
     }
     st->amax = sqrt(amax2);
     st->amax_np = st->solver->np_cap_without_viscosity ? st->gmag + pfsph_pairwise_amax(st->pw) : sqrt(anp2);
-    st->stats.ekin = pfsph__sum(ek, n);
+    st->stats.ekin = pfsph__fluid_sum(c, ek);
     st->stats.density_err_max = emax;
     st->stats.dt = dt;
     double vmax = bad_ ? NAN : sqrt(v2max);

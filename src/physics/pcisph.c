@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "core/reduce.h"
 #include "physics/density.h"
 #include "physics/pcisph_lists.h"
@@ -102,6 +103,8 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
             yp[i] = f->y[i] + fdt * f->vy[i] + dt2 * (c->ay[i] + apy[i]);
             zp[i] = f->z[i] + fdt * f->vz[i] + dt2 * (c->az[i] + apz[i]);
         }
+        pfsph_real *const pred[3] = {xp, yp, zp};
+        pfsph__halo(c, pred, 3); /* a distributed run: the owners' predictions of halo particles */
         if (lists) pfsph__pcisph_density(c, L, LB, xp, yp, zp, ndp);
         else pfsph__number_density(c, xp, yp, zp, ndp);
 #pragma omp parallel for schedule(static)
@@ -111,7 +114,10 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
             pfsph_real pn = f->p[i] + (pfsph_real)(kfac * (double)c->mass[f->phase[i]]) * e;
             f->p[i] = pn > 0 ? pn : 0;
         }
-        avg = n ? pfsph__sum(er, n) / (double)n : 0;
+        pfsph_real *const dens[2] = {ndp, f->p};
+        pfsph__halo(c, dens, 2);
+        const size_t nall = pfsph__fluid_count(c);
+        avg = nall ? pfsph__fluid_sum(c, er) / (double)nall : 0; /* the serial sum on any rank count */
         if (lists) pfsph__pcisph_pressure(c, L, LB, xp, yp, zp, ndp, f->p, apx, apy, apz);
         else pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
         it++;

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "core/dist.h"
 #include "core/reduce.h"
 #include "physics/eos.h"
 #include "physics/pressure.h"
@@ -48,7 +49,8 @@ static void report(void *state, const pfsph_ctx *c, pfsph_real *const *scr, pfsp
         pfsph_real e = c->nd[i] / c->nd0 - 1;
         er[i] = e > 0 ? e : 0;
     }
-    out->density_err_avg = n ? pfsph__sum(er, n) / (double)n : 0;
+    const size_t nall = pfsph__fluid_count(c); /* the serial sum on any rank count */
+    out->density_err_avg = nall ? pfsph__fluid_sum(c, er) / (double)nall : 0;
     out->iterations = 0;
 }
 

@@ -541,6 +541,7 @@ void pfsph_scene_defaults(pfsph_scene *s)
     s->output.fields = 0;
     s->output.frame_interval = 1;
     s->output.checkpoint_interval = 10;
+    s->output.surface_layer = true;
     s->output.surface = (pfsph_surface_output){.on = false, .ply = true, .obj = false, .vtp = true};
     s->camera.set = false;
     s->camera.up[1] = 1.0;

@@ -60,14 +60,15 @@ int pfsph__scene_parse_output(parser *p, const cJSON *root)
     pfsph_output *o = &p->s->output;
     const cJSON *v = get(root, "output");
     if (!v) return PFSPH_OK;
-    static const char *const keys[] = {"directory",           "formats", "fields", "boundary", "frame_interval",
-                                       "checkpoint_interval", "surface", NULL};
+    static const char *const keys[] = {"directory",           "formats", "fields",        "boundary", "frame_interval",
+                                       "checkpoint_interval", "surface", "surface_layer", NULL};
     const char *P = "$.output";
     TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
     TRY(parse_surface(p, get(v, "surface")));
     TRY(pfsph__json_string(v, P, "directory", o->dir, sizeof o->dir, &p->ctx));
     if (get(v, "directory") && !o->dir[0]) return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
     TRY(pfsph__json_bool(v, P, "boundary", &o->write_boundary, &p->ctx));
+    TRY(pfsph__json_bool(v, P, "surface_layer", &o->surface_layer, &p->ctx));
     TRY(pfsph__json_int(v, P, "frame_interval", 1, 1000000, &o->frame_interval, &p->ctx));
     TRY(pfsph__json_int(v, P, "checkpoint_interval", 0, 1000000, &o->checkpoint_interval, &p->ctx));
     const cJSON *f = get(v, "formats");

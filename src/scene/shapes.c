@@ -161,6 +161,64 @@ static int ranges_meet(const long *a0, const long *a1, const long *b0, const lon
     return 1;
 }
 
+/* The sites of block b in one slab kz of its lattice range, less those the later blocks lb take:
+ * counted (ps NULL), or written from index at into ps, whose room exists, as
+ * pfsph_particles_push would write them. Returns the count. */
+typedef struct sites_of {
+    const pfsph_scene *s;
+    const pfsph_block *b;
+    uint32_t stream;
+    const pfsph_block *const *lb;
+    const long (*lr)[6];
+    int m;
+    double d;
+    long k0[3], k1[3];
+    size_t base; /* the set's first new index, with id id0 */
+    uint32_t id0;
+} sites_of;
+
+static long slab(const sites_of *L, long kz, pfsph_particles *ps, size_t at)
+{
+    const pfsph_block *b = L->b;
+    const int dim = L->s->dim;
+    const double d = L->d;
+    const long *k0 = L->k0, *k1 = L->k1;
+    const long n0 = k1[0] - k0[0], n1 = k1[1] - k0[1];
+    long count = 0, k[3];
+    k[2] = kz;
+    for (k[1] = k0[1]; k[1] < k1[1]; k[1]++)
+        for (k[0] = k0[0]; k[0] < k1[0]; k[0]++) {
+            if (!site_in(b, dim, d, k0, k1, k)) continue;
+            int taken = 0;
+            for (int q = 0; q < L->m && !taken; q++) taken = site_in(L->lb[q], dim, d, L->lr[q], L->lr[q] + 3, k);
+            if (taken) continue;
+            if (!ps) {
+                count++;
+                continue;
+            }
+            double p[3] = {lat_x(d, k[0]), lat_x(d, k[1]), dim == 3 ? lat_x(d, k[2]) : 0};
+            if (b->jitter > 0) { /* from the scene seed, the block and the lattice site */
+                double u[4];
+                long site = (k[0] - k0[0]) + n0 * ((k[1] - k0[1]) + n1 * (k[2] - k0[2]));
+                pfsph_rng_uniform4(L->s->seed, (uint32_t)site, 0, 0x4a170000u + L->stream, u);
+                for (int a = 0; a < dim; a++) p[a] += b->jitter * d * (2 * u[a] - 1);
+            }
+            const size_t i = at + (size_t)count++;
+            for (int f = 0; f < PFSPH_NFIELDS; f++) ps->f[f][i] = 0;
+            ps->x[i] = (pfsph_real)p[0];
+            ps->y[i] = (pfsph_real)p[1];
+            ps->z[i] = (pfsph_real)p[2];
+            ps->vx[i] = (pfsph_real)b->velocity[0];
+            ps->vy[i] = (pfsph_real)b->velocity[1];
+            ps->vz[i] = (pfsph_real)b->velocity[2];
+            ps->phase[i] = (uint8_t)b->phase;
+            ps->wall[i] = 0;
+            ps->bubble[i] = 0;
+            ps->id[i] = L->id0 + (uint32_t)(i - L->base);
+        }
+    return count;
+}
+
 /* Sample (ps) or count (ps NULL) the sites of b, less those of the `nlater` blocks `later`
  * (blocks listed after b take the sites they contain). `stream` keys the jitter. */
 static long sample(const pfsph_scene *s, const pfsph_block *b, uint32_t stream, const pfsph_block *const *later,
@@ -228,28 +286,34 @@ static long sample(const pfsph_scene *s, const pfsph_block *b, uint32_t stream, 
         free(lb);
         return clamp_count((double)count_block(b, dim, d, k0, k1) - removed);
     }
-    const long n0 = k1[0] - k0[0], n1 = k1[1] - k0[1];
-    long k[3];
-    for (k[2] = k0[2]; k[2] < k1[2]; k[2]++)
-        for (k[1] = k0[1]; k[1] < k1[1]; k[1]++)
-            for (k[0] = k0[0]; k[0] < k1[0]; k[0]++) {
-                if (!site_in(b, dim, d, k0, k1, k)) continue;
-                int taken = 0;
-                for (int q = 0; q < m && !taken; q++) taken = site_in(lb[q], dim, d, lr[q], lr[q] + 3, k);
-                if (taken) continue;
-                double p[3] = {lat_x(d, k[0]), lat_x(d, k[1]), dim == 3 ? lat_x(d, k[2]) : 0};
-                if (b->jitter > 0) { /* from the scene seed, the block and the lattice site */
-                    double u[4];
-                    long site = (k[0] - k0[0]) + n0 * ((k[1] - k0[1]) + n1 * (k[2] - k0[2]));
-                    pfsph_rng_uniform4(s->seed, (uint32_t)site, 0, 0x4a170000u + stream, u);
-                    for (int a = 0; a < dim; a++) p[a] += b->jitter * d * (2 * u[a] - 1);
-                }
-                if (emit(ps, &count, p[0], p[1], p[2], b->velocity, b->phase)) {
-                    count = -1;
-                    goto done;
-                }
-            }
-done:
+    /* Slab by slab of the lattice (z = k[2]), in parallel: each slab's sites counted, then
+     * written at their place in the set, so that the particles and their order are those of one
+     * pass on any thread count (1.9e8 particles took minutes on one thread) */
+    const long nz = k1[2] - k0[2];
+    long *off = malloc((size_t)(nz + 1) * sizeof *off);
+    if (!off) {
+        free(lr);
+        free(lb);
+        return -1;
+    }
+    sites_of L = {s, b, stream, lb, (const long(*)[6])lr, m, d, {k0[0], k0[1], k0[2]}, {k1[0], k1[1], k1[2]}, 0, 0};
+    off[0] = 0;
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long z = 0; z < nz; z++) off[z + 1] = slab(&L, k0[2] + z, NULL, 0);
+    for (long z = 0; z < nz; z++) off[z + 1] += off[z];
+    const size_t base = ps->n;
+    L.base = base;
+    L.id0 = ps->next_id;
+    if (pfsph_particles_reserve(ps, base + (size_t)off[nz]) != PFSPH_OK) {
+        count = -1;
+    } else {
+        ps->n = base + (size_t)off[nz];
+#pragma omp parallel for schedule(dynamic, 1)
+        for (long z = 0; z < nz; z++) slab(&L, k0[2] + z, ps, base + (size_t)off[z]);
+        ps->next_id += (uint32_t)off[nz];
+        count = off[nz];
+    }
+    free(off);
     free(lr);
     free(lb);
     return count;

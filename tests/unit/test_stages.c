@@ -3,6 +3,7 @@
  * bad insertions are refused, and the explicit hand-over of the pair accelerations survives a
  * stage that touches the pressure accelerations in between (the schedule then gives the pair
  * accelerations their own arrays: the same bits as without it). */
+#include <stdio.h>
 #include <string.h>
 
 #include "pfsph/scene.h"
@@ -53,6 +54,69 @@ static pfsph_sim *make(pfsph_scene *s)
     pfsph_sim *sim = NULL;
     if (pfsph_sim_create(&sim, s, &err)) fail_msg("%s", err.msg);
     return sim;
+}
+
+/* "output": {"surface_layer": false} drops the output stage that peels the surface (20 min at
+ * frame 0 of the 1.9e8-particle table-1 scene) and its buffer; on by default, with an outer layer
+ * present and the interior unmarked. */
+static void surface_layer_output_is_optional(void **state)
+{
+    (void)state;
+    for (int on = 0; on < 2; on++) {
+        char json[2048];
+        snprintf(json, sizeof json, "%.*s, \"output\": {\"surface_layer\": %s}}", (int)strlen(PAIR_SCENE) - 1,
+                 PAIR_SCENE, on ? "true" : "false");
+        pfsph_sim *sim = tu_sim_from_json(json, "surface_layer");
+        pfsph_error err = {0};
+        if (pfsph_sim_output(sim, &err)) fail_msg("%s", err.msg);
+        const uint8_t *layer = pfsph_sim_output_surface_layer(sim);
+        if (!on) {
+            assert_null(layer);
+        } else {
+            assert_non_null(layer);
+            size_t outer = 0, inner = 0;
+            const size_t n = pfsph_sim_ctx(sim)->fluid->n;
+            for (size_t i = 0; i < n; i++) {
+                outer += layer[i] == 1;
+                inner += layer[i] == 0;
+            }
+            assert_true(outer > 0 && inner > 0);
+        }
+        pfsph_sim_destroy(sim);
+    }
+}
+
+typedef struct notes {
+    int n;
+    double total;
+    char first[256];
+} notes;
+
+static void note(const char *done, double wall_s, double cpu_s, void *user)
+{
+    notes *k = user;
+    if (!k->n) snprintf(k->first, sizeof k->first, "%s", done);
+    k->n++;
+    assert_true(wall_s >= 0 && cpu_s >= 0);
+    k->total += wall_s;
+}
+
+/* pfsph_sim_create_ex tells its caller each phase of the set-up (the program prints the slow
+ * ones: minutes at 1.9e8 particles): the sampling first, with the particle counts. */
+static void setup_reports_its_phases(void **state)
+{
+    (void)state;
+    pfsph_scene s;
+    pfsph_error err = {0};
+    assert_int_equal(pfsph_scene_parse(&s, PAIR_SCENE, "<notes>", &err), PFSPH_OK);
+    notes k = {0};
+    pfsph_sim *sim = NULL;
+    if (pfsph_sim_create_ex(&sim, &s, note, &k, &err)) fail_msg("%s", err.msg);
+    assert_int_equal(k.n, 3);
+    char want[64];
+    snprintf(want, sizeof want, "sampled %zu fluid and 0 boundary particles", pfsph_sim_ctx(sim)->fluid->n);
+    assert_string_equal(k.first, want);
+    pfsph_sim_destroy(sim);
 }
 
 static int index_of(const pfsph_sim *sim, const char *name)
@@ -118,7 +182,8 @@ static void hand_over_survives_an_ap_reader(void **state)
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
-    const struct CMUnitTest tests[] = {cmocka_unit_test(inserted_stage_runs_in_place),
-                                       cmocka_unit_test(hand_over_survives_an_ap_reader)};
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(inserted_stage_runs_in_place), cmocka_unit_test(hand_over_survives_an_ap_reader),
+        cmocka_unit_test(surface_layer_output_is_optional), cmocka_unit_test(setup_reports_its_phases)};
     return tu_run_group(tests, NULL, NULL);
 }

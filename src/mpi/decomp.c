@@ -1,0 +1,562 @@
+/* The domain decomposition: the fluid cut along the grid's cell order (row-major keys, the order
+ * the serial sort leaves the particles in) into one contiguous range of cells per rank, by
+ * particle count, re-cut every step; each rank holds its cells plus every cell a neighbour walk
+ * from them can reach (a key interval), so its particles are a contiguous slice of the serial
+ * order and every walk visits the same neighbours in the same order as a serial run. */
+#include "mpi/decomp.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <stdio.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "core/reduce.h"
+#include "core/stage.h"
+#include "sim_internal.h"
+
+/* One particle on the wire: the persistent fields, the density of the step (frames), id, phase,
+ * wall, bubble. A homogeneous cluster is assumed (the same byte order and pfsph_real). */
+#define REC (((PFSPH_NFIELDS + 1) * sizeof(pfsph_real) + 7 + 7) & ~(size_t)7)
+
+static int grow(char **buf, size_t *cap, size_t n)
+{
+    if (n <= *cap) return PFSPH_OK;
+    size_t c = n + n / 4 + 4096;
+    char *p = realloc(*buf, c);
+    if (!p) return PFSPH_ENOMEM;
+    *buf = p;
+    *cap = c;
+    return PFSPH_OK;
+}
+
+static void pack(char *o, const pfsph_particles *f, const pfsph_real *nd, size_t i)
+{
+    for (int k = 0; k < PFSPH_NFIELDS; k++) memcpy(o + k * sizeof(pfsph_real), &f->f[k][i], sizeof(pfsph_real));
+    pfsph_real v = nd ? nd[i] : 0;
+    memcpy(o + PFSPH_NFIELDS * sizeof(pfsph_real), &v, sizeof v);
+    char *t = o + (PFSPH_NFIELDS + 1) * sizeof(pfsph_real);
+    memcpy(t, &f->id[i], 4);
+    t[4] = (char)f->phase[i];
+    t[5] = (char)f->wall[i];
+    t[6] = (char)f->bubble[i];
+}
+
+static void unpack(const char *o, pfsph_particles *f, pfsph_real *nd, size_t i)
+{
+    for (int k = 0; k < PFSPH_NFIELDS; k++) memcpy(&f->f[k][i], o + k * sizeof(pfsph_real), sizeof(pfsph_real));
+    if (nd) memcpy(&nd[i], o + PFSPH_NFIELDS * sizeof(pfsph_real), sizeof(pfsph_real));
+    const char *t = o + (PFSPH_NFIELDS + 1) * sizeof(pfsph_real);
+    memcpy(&f->id[i], t, 4);
+    f->phase[i] = (uint8_t)t[4];
+    f->wall[i] = (uint8_t)t[5];
+    f->bubble[i] = (uint8_t)t[6];
+}
+
+/* The cell key of the serial sort (pfsph_grid_sort_in), UINT32_MAX for a particle it removes. */
+static uint32_t cell_key(const pfsph_grid *g, const pfsph_particles *f, size_t i)
+{
+    const pfsph_real *pos[3] = {f->x, f->y, f->z};
+    size_t lin = 0, stride = 1;
+    for (int a = 0; a < g->dim; a++) {
+        pfsph_real v = pos[a][i];
+        if (!(v >= g->keep_lo[a] && v <= g->keep_hi[a] && v >= g->lo[a] && v <= g->hi[a])) return UINT32_MAX;
+        int c = (int)((v - g->lo[a]) * g->inv_cell);
+        if (c >= g->nc[a]) c = g->nc[a] - 1;
+        lin += (size_t)c * stride;
+        stride *= (size_t)g->nc[a];
+    }
+    return (uint32_t)lin;
+}
+
+/* What the root's state says after a start, a frame or a resume, for every rank. */
+typedef struct clock_state {
+    double time, amax, amax_np, vbound, dt, ctime;
+    uint64_t step, cstep, removed;
+    pfsph_step_stats stats;
+} clock_state;
+
+static void share_clock(pfsph_decomp *D, pfsph_step *st)
+{
+    clock_state s = {st->time,      st->amax, st->amax_np,   st->vbound,  st->ctx->dt,
+                     st->ctx->time, st->step, st->ctx->step, st->removed, st->stats};
+    MPI_Bcast(&s, sizeof s, MPI_BYTE, 0, D->comm);
+    st->time = s.time;
+    st->amax = s.amax;
+    st->amax_np = s.amax_np;
+    st->vbound = s.vbound;
+    st->ctx->dt = s.dt;
+    st->ctx->time = s.ctime;
+    st->step = s.step;
+    st->ctx->step = s.cstep;
+    st->removed = (size_t)s.removed;
+    st->stats = s.stats;
+}
+
+/* Cells [lo, hi) rank q holds: its own and those within a walk's reach of them. */
+static void held_cells(const pfsph_decomp *D, int q, size_t *lo, size_t *hi)
+{
+    *lo = D->cut[q] > D->off ? D->cut[q] - D->off : 0;
+    *hi = D->cut[q + 1] + D->off < D->ncells ? D->cut[q + 1] + D->off : D->ncells;
+}
+
+/* A rank other than the root holds its slice alone: the whole scene's arrays it was created with
+ * (every rank samples the scene) are cut down to the slice, so that its memory follows its share.
+ * They grow again through the step's reserve if its slice grows. */
+static int fit(pfsph_decomp *D, pfsph_particles *f, size_t n)
+{
+    if (D->rank == 0 || f->cap <= 2 * n + 4096) return PFSPH_OK;
+    const size_t cap = n + n / 4 + 1024;
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        void *q = realloc(f->f[k], cap * sizeof(pfsph_real));
+        if (!q) return PFSPH_ENOMEM;
+        f->f[k] = q;
+    }
+    void *q;
+    if (!(q = realloc(f->phase, cap))) return PFSPH_ENOMEM;
+    f->phase = q;
+    if (!(q = realloc(f->wall, cap))) return PFSPH_ENOMEM;
+    f->wall = q;
+    if (!(q = realloc(f->bubble, cap))) return PFSPH_ENOMEM;
+    f->bubble = q;
+    if (!(q = realloc(f->id, cap * sizeof(uint32_t)))) return PFSPH_ENOMEM;
+    f->id = q;
+    f->cap = cap;
+    return pfsph__sim_alloc_scratch(D->sim, cap);
+}
+
+/* The stage before the grid sort: the particles each rank owned (all on the root after a
+ * frame) go to every rank that holds their new cell. Each rank sends its particles in its
+ * order, the receivers take them in rank order, so the grid's stable sort then gives them the
+ * serial order: by cell, ties by the previous step's order. */
+static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)bad;
+    pfsph_decomp *D = state;
+    pfsph_ctx *c = st->ctx;
+    pfsph_particles *f = c->fluid;
+    const pfsph_grid *g = c->grid;
+    if (D->root_all) share_clock(D, st);
+    size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
+    const size_t m = hi - lo, nc = D->ncells;
+    uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
+    if (!key) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange's keys");
+    D->key = key;
+    memset(D->hist, 0, (nc + 1) * sizeof(uint32_t));
+    for (size_t i = 0; i < m; i++) {
+        key[i] = cell_key(g, f, lo + i);
+        if (key[i] == UINT32_MAX) D->hist[nc]++;
+        else D->hist[key[i]]++;
+    }
+    MPI_Allreduce(MPI_IN_PLACE, D->hist, (int)(nc + 1), MPI_UINT32_T, MPI_SUM, D->comm);
+    D->pre[0] = 0;
+    for (size_t k = 0; k < nc; k++) D->pre[k + 1] = D->pre[k] + D->hist[k];
+    const uint64_t total = D->pre[nc], P = (uint64_t)D->size;
+    /* the cut: rank q's first cell is the first with q / size of the particles before it */
+    D->cut[0] = 0;
+    int q = 1;
+    for (size_t k = 0; k <= nc && q < D->size; k++)
+        while (q < D->size && D->pre[k] * P >= (uint64_t)q * total) D->cut[q++] = (uint32_t)k;
+    D->cut[D->size] = (uint32_t)nc;
+    for (q = 0; q < D->size; q++) {
+        size_t a, b;
+        held_cells(D, q, &a, &b);
+        D->gofs[q] = D->pre[D->cut[q]];
+        D->lofs[q] = D->pre[a];
+        D->lend[q] = D->pre[b];
+    }
+    D->gofs[D->size] = total;
+    /* pack, rank by rank, each in this rank's order */
+    size_t bytes = 0;
+    for (q = 0; q < D->size; q++) {
+        size_t a, b, cnt = 0;
+        held_cells(D, q, &a, &b);
+        for (size_t i = 0; i < m; i++) cnt += key[i] >= a && key[i] < b;
+        D->scount[q] = (int)(cnt * REC);
+        D->sdispl[q] = (int)bytes;
+        bytes += cnt * REC;
+    }
+    if (bytes > (size_t)INT32_MAX || grow(&D->sbuf, &D->scap, bytes))
+        return pfsph_fail(err, PFSPH_ENOMEM, "exchange: %zu bytes to send (at most 2 GiB a step)", bytes);
+    for (q = 0; q < D->size; q++) {
+        size_t a, b;
+        held_cells(D, q, &a, &b);
+        char *o = D->sbuf + D->sdispl[q];
+        for (size_t i = 0; i < m; i++)
+            if (key[i] >= a && key[i] < b) {
+                pack(o, f, NULL, lo + i);
+                o += REC;
+            }
+    }
+    MPI_Alltoall(D->scount, 1, MPI_INT, D->rcount, 1, MPI_INT, D->comm);
+    size_t rbytes = 0;
+    for (q = 0; q < D->size; q++) {
+        D->rdispl[q] = (int)rbytes;
+        rbytes += (size_t)D->rcount[q];
+    }
+    if (grow(&D->rbuf, &D->rcap, rbytes)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange");
+    MPI_Alltoallv(D->sbuf, D->scount, D->sdispl, MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, D->comm);
+    const size_t n = rbytes / REC;
+    if (n != D->lend[D->rank] - D->lofs[D->rank])
+        return pfsph_fail(err, PFSPH_EIO, "exchange: rank %d received %zu particles for a slice of %llu", D->rank, n,
+                          (unsigned long long)(D->lend[D->rank] - D->lofs[D->rank]));
+    int rc = st->reserve(st, n, err);
+    if (!rc && fit(D, f, n)) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory fitting the slice's arrays");
+    if (rc) return rc;
+    for (size_t i = 0; i < n; i++) unpack(D->rbuf + i * REC, f, NULL, i);
+    f->n = n;
+    /* particles that left the domain: counted once, and the speed the next step's CFL needs is
+     * then the largest of those that stay (the serial grid and timestep stages) */
+    if (D->hist[nc]) {
+        st->removed += D->hist[nc];
+        size_t worst;
+        double v = n ? pfsph__max_speed(f, &worst) : 0;
+        MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, D->comm);
+        st->stats.vmax = v;
+    }
+    D->d.own_lo = (size_t)(D->gofs[D->rank] - D->lofs[D->rank]);
+    D->d.own_hi = (size_t)(D->gofs[D->rank + 1] - D->lofs[D->rank]);
+    D->d.nglobal = (size_t)total;
+    D->root_all = 0;
+    /* figures */
+    const size_t own = D->d.own_hi - D->d.own_lo;
+    if (!D->steps || own < D->own_min) D->own_min = own;
+    if (own > D->own_max) D->own_max = own;
+    D->steps++;
+    D->halo_particles += n - own;
+    for (q = 0; q < D->size; q++)
+        if (q != D->rank && D->scount[q]) {
+            D->migr_bytes += (uint64_t)D->scount[q];
+            D->messages++;
+        }
+    return PFSPH_OK;
+}
+
+static const pfsph_stage_ops stage_exchange = {.name = "mpi_exchange",
+                                               .slot = PFSPH_STAGE_GRID,
+                                               .reads = PFSPH_D_POS | PFSPH_D_VEL,
+                                               .writes = PFSPH_D_ORDER | PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_STATS,
+                                               .run = exchange_run};
+
+/* The halo copies of n arrays refreshed from their owners: rank q sends what it owns of the
+ * slice rank r holds, a contiguous range of the serial order on both sides. */
+static void halo(pfsph_dist *d, pfsph_real *const *a, int k)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    const int r = D->rank;
+    const size_t rs = sizeof(pfsph_real);
+    size_t bytes = 0, rbytes = 0;
+    uint64_t s_lo[64], r_lo[64];
+    for (int q = 0; q < D->size; q++) {
+        uint64_t s = D->gofs[r] > D->lofs[q] ? D->gofs[r] : D->lofs[q];
+        uint64_t e = D->gofs[r + 1] < D->lend[q] ? D->gofs[r + 1] : D->lend[q];
+        uint64_t s2 = D->gofs[q] > D->lofs[r] ? D->gofs[q] : D->lofs[r];
+        uint64_t e2 = D->gofs[q + 1] < D->lend[r] ? D->gofs[q + 1] : D->lend[r];
+        size_t ns = q != r && e > s ? (size_t)(e - s) : 0, nr = q != r && e2 > s2 ? (size_t)(e2 - s2) : 0;
+        s_lo[q] = s - D->lofs[r];
+        r_lo[q] = s2 - D->lofs[r];
+        D->scount[q] = (int)(ns * (size_t)k * rs);
+        D->sdispl[q] = (int)bytes;
+        D->rcount[q] = (int)(nr * (size_t)k * rs);
+        D->rdispl[q] = (int)rbytes;
+        bytes += (size_t)D->scount[q];
+        rbytes += (size_t)D->rcount[q];
+    }
+    if (grow(&D->sbuf, &D->scap, bytes) || grow(&D->rbuf, &D->rcap, rbytes)) MPI_Abort(D->comm, 1);
+    for (int q = 0; q < D->size; q++) {
+        const size_t ns = (size_t)D->scount[q] / ((size_t)k * rs);
+        for (int j = 0; j < k; j++) memcpy(D->sbuf + D->sdispl[q] + (size_t)j * ns * rs, a[j] + s_lo[q], ns * rs);
+        if (q != r && ns) {
+            D->messages++;
+            D->bytes_sent += (uint64_t)D->scount[q];
+        }
+    }
+    MPI_Alltoallv(D->sbuf, D->scount, D->sdispl, MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, D->comm);
+    for (int q = 0; q < D->size; q++) {
+        const size_t nr = (size_t)D->rcount[q] / ((size_t)k * rs);
+        for (int j = 0; j < k; j++) memcpy(a[j] + r_lo[q], D->rbuf + D->rdispl[q] + (size_t)j * nr * rs, nr * rs);
+    }
+    D->halo_calls++;
+}
+
+/* ---- the serial pfsph__sum on any rank count ----
+ * pfsph__sum adds blocks of PFSPH_SUM_BLOCK values from 0 in index order, then the blocks'
+ * sums in order. A rank sends, for each block its owned range touches, the block's sum when it
+ * holds all of it and its values otherwise; the root adds them exactly as the serial code. */
+static size_t sum_msg(const pfsph_real *a, uint64_t G, uint64_t m, uint64_t N, double *out)
+{
+    const uint64_t B = PFSPH_SUM_BLOCK;
+    size_t k = 0;
+    if (!m) return 0;
+    for (uint64_t b = G / B; b * B < G + m; b++) {
+        uint64_t blo = b * B, bhi = blo + B < N ? blo + B : N, lo = G > blo ? G : blo, hi = G + m < bhi ? G + m : bhi;
+        if (lo == blo && hi == bhi) {
+            if (out) {
+                double s = 0;
+                for (uint64_t i = lo; i < hi; i++) s += (double)a[i - G];
+                out[k] = s;
+            }
+            k++;
+        } else {
+            for (uint64_t i = lo; i < hi; i++, k++)
+                if (out) out[k] = (double)a[i - G];
+        }
+    }
+    return k;
+}
+
+static double sum(pfsph_dist *d, const pfsph_real *a)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    const uint64_t N = D->d.nglobal, B = PFSPH_SUM_BLOCK;
+    const int r = D->rank;
+    size_t tot = 0;
+    for (int q = 0; q < D->size; q++) {
+        size_t len = sum_msg(NULL, D->gofs[q], D->gofs[q + 1] - D->gofs[q], N, NULL);
+        D->rcount[q] = (int)len;
+        D->rdispl[q] = (int)tot;
+        tot += len;
+    }
+    if (grow(&D->sbuf, &D->scap, (size_t)D->rcount[r] * sizeof(double)) ||
+        (r == 0 && grow(&D->rbuf, &D->rcap, tot * sizeof(double))))
+        MPI_Abort(D->comm, 1);
+    double *mine = (double *)(void *)D->sbuf, *all = (double *)(void *)D->rbuf;
+    sum_msg(a + D->d.own_lo, D->gofs[r], D->gofs[r + 1] - D->gofs[r], N, mine);
+    MPI_Gatherv(mine, D->rcount[r], MPI_DOUBLE, all, D->rcount, D->rdispl, MPI_DOUBLE, 0, D->comm);
+    double total = 0;
+    if (r == 0) {
+        size_t pos[64];
+        for (int q = 0; q < D->size; q++) pos[q] = (size_t)D->rdispl[q];
+        for (uint64_t b = 0; b * B < N; b++) {
+            const uint64_t blo = b * B, bhi = blo + B < N ? blo + B : N;
+            double s = 0;
+            for (int q = 0; q < D->size; q++) {
+                const uint64_t G = D->gofs[q], E = D->gofs[q + 1];
+                const uint64_t lo = G > blo ? G : blo, hi = E < bhi ? E : bhi;
+                if (lo >= hi) continue;
+                if (lo == blo && hi == bhi) s += all[pos[q]++];
+                else
+                    for (uint64_t i = lo; i < hi; i++) s += all[pos[q]++];
+            }
+            total += s;
+        }
+    }
+    MPI_Bcast(&total, 1, MPI_DOUBLE, 0, D->comm);
+    return total;
+}
+
+/* ---- the stages between the physics' own ---- */
+
+static int halo_pos_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_particles *f = st->ctx->fluid;
+    pfsph_real *const a[3] = {f->x, f->y, f->z};
+    halo(st->ctx->dist, a, 3);
+    return PFSPH_OK;
+}
+
+static const pfsph_stage_ops stage_halo_pos = {.name = "mpi_halo_positions",
+                                               .slot = PFSPH_STAGE_GRID,
+                                               .reads = PFSPH_D_POS,
+                                               .writes = PFSPH_D_POS,
+                                               .run = halo_pos_run};
+
+static int halo_density_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    (void)bad;
+    (void)err;
+    pfsph_real *const a[1] = {st->ctx->nd};
+    halo(st->ctx->dist, a, 1);
+    return PFSPH_OK;
+}
+
+static const pfsph_stage_ops stage_halo_density = {.name = "mpi_halo_density",
+                                                   .slot = PFSPH_STAGE_DENSITY,
+                                                   .reads = PFSPH_D_DENSITY,
+                                                   .writes = PFSPH_D_DENSITY,
+                                                   .run = halo_density_run};
+
+/* the integration measured its own particles: the bounds the next step's time step needs */
+static int stats_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)bad;
+    (void)err;
+    pfsph_decomp *D = state;
+    double v[4] = {st->amax, st->amax_np, st->stats.density_err_max, st->stats.vmax};
+    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, D->comm);
+    st->amax = v[0];
+    st->amax_np = v[1];
+    st->stats.density_err_max = v[2];
+    st->stats.vmax = v[3];
+    return PFSPH_OK;
+}
+
+static const pfsph_stage_ops stage_stats = {.name = "mpi_stats",
+                                            .slot = PFSPH_STAGE_INTEGRATE,
+                                            .reads = PFSPH_D_STATS,
+                                            .writes = PFSPH_D_STATS,
+                                            .run = stats_run};
+
+/* ---- the hooks the simulation calls ---- */
+
+static int agree(pfsph_dist *d, int rc, pfsph_error *err)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    int mine = rc ? D->rank : D->size, first;
+    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, D->comm);
+    if (first == D->size) return PFSPH_OK;
+    struct {
+        int rc;
+        pfsph_error e;
+    } m;
+    memset(&m, 0, sizeof m);
+    if (D->rank == first) {
+        m.rc = rc;
+        if (err) m.e = *err;
+    }
+    MPI_Bcast(&m, sizeof m, MPI_BYTE, first, D->comm);
+    if (err) *err = m.e;
+    D->failed = 1;
+    return m.rc;
+}
+
+static void step_begin(pfsph_dist *d, double t_limit)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    if (D->rank != 0) return; /* the others are in their command loop */
+    pfsph_mpi_cmd c = {PFSPH_MPI_STEP, 0, t_limit};
+    pfsph_decomp_cmd(D, &c);
+}
+
+static int frame(pfsph_dist *d, pfsph_error *err)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    if (D->rank == 0) {
+        pfsph_mpi_cmd c = {PFSPH_MPI_FRAME, 0, 0};
+        pfsph_decomp_cmd(D, &c);
+    }
+    return pfsph_decomp_gather(D, err);
+}
+
+void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c) { MPI_Bcast(c, sizeof *c, MPI_BYTE, 0, D->comm); }
+
+int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
+{
+    if (D->root_all) return PFSPH_OK;
+    pfsph_mpi_fig mine = {D->steps,
+                          D->d.own_hi - D->d.own_lo,
+                          D->own_min,
+                          D->own_max,
+                          D->halo_particles,
+                          D->halo_calls,
+                          D->bytes_sent,
+                          D->migr_bytes,
+                          D->messages,
+                          0,
+                          0};
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) == 0) mine.peak_rss_kb = (uint64_t)ru.ru_maxrss;
+    FILE *sm = fopen("/proc/self/statm", "r");
+    unsigned long pages_all, pages_res;
+    if (sm && fscanf(sm, "%lu %lu", &pages_all, &pages_res) == 2)
+        mine.rss_kb = (uint64_t)pages_res * (uint64_t)sysconf(_SC_PAGESIZE) / 1024;
+    if (sm) fclose(sm);
+    MPI_Gather(&mine, sizeof mine, MPI_BYTE, D->fig, sizeof mine, MPI_BYTE, 0, D->comm);
+    pfsph_sim *sim = D->sim;
+    pfsph_ctx *c = &sim->ctx;
+    pfsph_particles *f = c->fluid;
+    const size_t lo = D->d.own_lo, m = D->d.own_hi - D->d.own_lo, N = D->d.nglobal;
+    if (grow(&D->sbuf, &D->scap, m * REC)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the gather");
+    for (size_t i = 0; i < m; i++) pack(D->sbuf + i * REC, f, c->nd, lo + i);
+    size_t tot = 0;
+    for (int q = 0; q < D->size; q++) {
+        D->rcount[q] = (int)((D->gofs[q + 1] - D->gofs[q]) * REC);
+        D->rdispl[q] = (int)tot;
+        tot += (size_t)D->rcount[q];
+    }
+    if (D->rank == 0 && (tot > (size_t)INT32_MAX || grow(&D->rbuf, &D->rcap, tot)))
+        MPI_Abort(D->comm, 1); /* the others wait in the gather: no clean way out */
+    MPI_Gatherv(D->sbuf, (int)(m * REC), MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, 0, D->comm);
+    if (D->rank == 0) {
+        int rc = sim->st.reserve(&sim->st, N, err);
+        if (rc) MPI_Abort(D->comm, 1);
+        for (size_t i = 0; i < N; i++) unpack(D->rbuf + i * REC, f, c->nd, i);
+        f->n = N;
+        /* the grid of this step's sort, for the frame's walks (surface layers, pressures) */
+        for (size_t k = 0; k <= D->ncells; k++) c->grid->start[k] = (uint32_t)D->pre[k];
+        D->d.own_lo = 0;
+        D->d.own_hi = N;
+    } else {
+        f->n = 0;
+        D->d.own_lo = D->d.own_hi = 0;
+    }
+    D->root_all = 1;
+    return PFSPH_OK;
+}
+
+static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err);
+
+int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
+{
+    memset(D, 0, sizeof *D);
+    D->comm = comm;
+    MPI_Comm_rank(comm, &D->rank);
+    MPI_Comm_size(comm, &D->size);
+    if (D->size > 64) return PFSPH_EINPUT;
+    const size_t P = (size_t)D->size;
+    D->cut = calloc(P + 1, sizeof(uint32_t));
+    D->gofs = calloc(P + 1, sizeof(uint64_t));
+    D->lofs = calloc(P, sizeof(uint64_t));
+    D->lend = calloc(P, sizeof(uint64_t));
+    D->scount = calloc(P, sizeof(int));
+    D->sdispl = calloc(P, sizeof(int));
+    D->rcount = calloc(P, sizeof(int));
+    D->rdispl = calloc(P, sizeof(int));
+    if (!D->cut || !D->gofs || !D->lofs || !D->lend || !D->scount || !D->sdispl || !D->rcount || !D->rdispl)
+        return PFSPH_ENOMEM;
+    D->d.halo = halo;
+    D->d.sum = sum;
+    D->d.agree = agree;
+    D->d.step_begin = step_begin;
+    D->d.frame = frame;
+    D->d.attach = attach;
+    return PFSPH_OK;
+}
+
+/* Take the simulation over: the stages, the cut's arrays; the root holds every particle. */
+static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    if (D->rank == 0) { /* the others create theirs from the same scene */
+        pfsph_mpi_cmd c = {PFSPH_MPI_CREATE, 0, 0};
+        pfsph_decomp_cmd(D, &c);
+    }
+    D->sim = sim;
+    sim->ctx.dist = d;
+    const pfsph_grid *g = &sim->grid;
+    D->ncells = g->ncells;
+    /* a walk from a particle moved since the sort (shifting, PCISPH's predicted positions) may
+     * start one cell away: reach + 1 cells each way */
+    const size_t R = (size_t)(g->reach_far > g->reach ? g->reach_far : g->reach) + 1;
+    const size_t nx = (size_t)g->nc[0], ny = (size_t)g->nc[1];
+    D->off = R * (1 + nx + (g->dim == 3 ? nx * ny : 0));
+    D->hist = calloc(D->ncells + 1, sizeof(uint32_t));
+    D->pre = calloc(D->ncells + 1, sizeof(uint64_t));
+    int rc = PFSPH_OK;
+    if (!D->hist || !D->pre) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the decomposition");
+    if (!rc) rc = pfsph_sim_insert_stage(sim, "grid", 0, &stage_exchange, D, err);
+    if (!rc) rc = pfsph_sim_insert_stage(sim, "density", 1, &stage_halo_density, D, err);
+    if (!rc) rc = pfsph_sim_insert_stage(sim, "integrate", 1, &stage_stats, D, err);
+    if (!rc && sim->st.pw) rc = pfsph_sim_insert_stage(sim, "shift", 1, &stage_halo_pos, D, err);
+    D->root_all = 1;
+    D->d.own_lo = 0;
+    D->d.own_hi = D->rank == 0 ? sim->fluid.n : 0;
+    D->d.nglobal = sim->fluid.n;
+    /* every rank built the simulation, or none goes on */
+    return agree(d, rc, err);
+}

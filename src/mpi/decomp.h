@@ -1,0 +1,59 @@
+/* The domain decomposition over MPI ranks (docs/cluster.md): the process's pfsph_dist, the
+ * stages it inserts into the step, the halo refresh, the serial-order sum and the frame gather.
+ * Program code: compiled only with -DPFSPH_MPI=ON, never part of the library. */
+#ifndef PFSPH_MPI_DECOMP_H
+#define PFSPH_MPI_DECOMP_H
+
+#include <mpi.h>
+#include <stdint.h>
+
+#include "pfsph/dist.h"
+#include "pfsph/sim.h"
+
+/* Commands the root broadcasts to the other ranks, which follow them (src/mpi/mpi_cli.c). */
+enum { PFSPH_MPI_CREATE = 1, PFSPH_MPI_STEP, PFSPH_MPI_FRAME, PFSPH_MPI_END };
+
+typedef struct pfsph_mpi_cmd {
+    int cmd, rc;
+    double t;
+} pfsph_mpi_cmd;
+
+/* One rank's figures, gathered by the root at every frame (summary.json). */
+typedef struct pfsph_mpi_fig {
+    uint64_t steps, owned, own_min, own_max, halo_particles, halo_calls, bytes_sent, migr_bytes, messages;
+    uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
+    uint64_t rss_kb;      /* its resident memory at the frame */
+} pfsph_mpi_fig;
+
+typedef struct pfsph_decomp {
+    pfsph_dist d; /* first: the hooks the step calls */
+    MPI_Comm comm;
+    int rank, size;
+    pfsph_sim *sim;
+    int root_all; /* the root holds every particle (the start, after a frame gather, a resume) */
+    int failed;   /* a stage failed on some rank: the other ranks left their command loop */
+    size_t ncells;
+    size_t off;                             /* cells of key distance that a walk of the grid's reach can span */
+    uint32_t *hist;                         /* ncells + 1: particles per cell of this step's sort, then removed */
+    uint64_t *pre;                          /* ncells + 1: particles in the cells before c (the serial grid start) */
+    uint32_t *key;                          /* per sent particle */
+    uint32_t *cut;                          /* size + 1: rank q owns cells [cut[q], cut[q + 1]) */
+    uint64_t *gofs;                         /* size + 1: rank q owns global indices [gofs[q], gofs[q + 1]) */
+    uint64_t *lofs, *lend;                  /* size: rank q holds global indices [lofs[q], lend[q]) (with its halo) */
+    int *scount, *sdispl, *rcount, *rdispl; /* size each, bytes */
+    char *sbuf, *rbuf;
+    size_t scap, rcap;
+    /* figures for summary.json */
+    uint64_t steps, halo_calls, bytes_sent, messages, migr_bytes, halo_particles;
+    size_t own_min, own_max; /* owned particles of this rank over the run */
+    pfsph_mpi_fig fig[64];   /* the root: every rank's, as of the last frame */
+} pfsph_decomp;
+
+/* The decomposition of the world communicator (not yet attached to a simulation). */
+int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm);
+/* The frame gather: every rank's owned particles to the root, in the serial order. */
+int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err);
+/* Broadcast a command from the root. */
+void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c);
+
+#endif

@@ -1,0 +1,38 @@
+/* Distributed runs: what the step asks of a domain decomposition (src/mpi/, docs/cluster.md).
+ * The library never includes MPI: a decomposition fills these hooks and the context points at
+ * them (ctx->dist); NULL in a serial run, where every helper below is the serial code. */
+#ifndef PFSPH_DIST_H
+#define PFSPH_DIST_H
+
+#include <stddef.h>
+
+#include "pfsph/types.h"
+
+struct pfsph_sim;
+
+typedef struct pfsph_dist pfsph_dist;
+struct pfsph_dist {
+    /* The local fluid is a contiguous slice of the serial (global, sorted) order: halo copies,
+     * then the particles this rank owns, [own_lo, own_hi), then halo copies again. */
+    size_t own_lo, own_hi;
+    size_t nglobal; /* fluid particles of all ranks */
+    /* refresh the halo copies of k per-fluid-particle arrays from their owners */
+    void (*halo)(pfsph_dist *d, pfsph_real *const *a, int k);
+    /* pfsph__sum of the global array whose owned part is a[own_lo, own_hi): the same bits */
+    double (*sum)(pfsph_dist *d, const pfsph_real *a);
+    /* every rank's status after a stage: the first failure (its message) on all ranks */
+    int (*agree)(pfsph_dist *d, int rc, pfsph_error *err);
+    /* a step begins (the root tells the other ranks to follow) */
+    void (*step_begin)(pfsph_dist *d, double t_limit);
+    /* a frame time reached: the root gathers the whole fluid in the serial order */
+    int (*frame)(pfsph_dist *d, pfsph_error *err);
+    /* the decomposition's figures into summary.json (a cJSON object) */
+    void (*report)(pfsph_dist *d, void *json);
+    /* a simulation was created: take it over (insert the stages, share the work) */
+    int (*attach)(pfsph_dist *d, struct pfsph_sim *sim, pfsph_error *err);
+};
+
+/* The process's decomposition (set by the program when it runs under mpirun), NULL: serial. */
+extern pfsph_dist *pfsph__dist_process;
+
+#endif

@@ -1,0 +1,104 @@
+#!/bin/sh
+# MPI runs against serial ones (docs/cluster.md), byte for byte. Usage:
+#   mpi_test.sh compare SCENE END NP...   frames/ and stats.csv of -np NP equal the serial run's
+#   mpi_test.sh resume SCENE T1 T2 NP1 NP2 run to T1 on NP1 ranks, resume to T2 on NP2 ranks:
+#                                          the same bytes as an uninterrupted serial run to T2
+#   mpi_test.sh kill SCENE END NP1 NP2     kill -9 one rank of NP1 once checkpoints exist, resume on
+#                                          NP2 ranks: the same bytes as an uninterrupted serial run
+#   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
+#                                          STATUS (default 2) from mpirun
+# Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
+# Exit 77 (skipped) when the build has no MPI or mpirun is missing.
+set -u
+[ "${PFSPH_MPI_BUILD:-OFF}" = ON ] || { echo "skipped: built without -DPFSPH_MPI=ON"; exit 77; }
+MPIRUN=${PFSPH_MPIRUN:-}
+[ -n "$MPIRUN" ] && [ -x "$MPIRUN" ] || { echo "skipped: no mpirun"; exit 77; }
+BIN=${PFSPH_BIN:?PFSPH_BIN}
+SRC=${PFSPH_SOURCE_DIR:?PFSPH_SOURCE_DIR}
+ROOTOPT=""
+[ "$(id -u)" = 0 ] && ROOTOPT="--allow-run-as-root"
+export OMP_NUM_THREADS=1 # ranks share the machine's cores
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/pfsph_mpi.XXXXXX")
+trap 'rm -rf "$TMP"' EXIT
+mode=$1
+shift
+
+mpi() { # NP args...
+    np=$1
+    shift
+    "$MPIRUN" $ROOTOPT --oversubscribe -np "$np" "$BIN" "$@"
+}
+
+same() { # DIR_A DIR_B: frames and stats.csv byte for byte
+    if ! diff -r "$1/frames" "$2/frames" >/dev/null; then
+        echo "FAIL: $1/frames and $2/frames differ:"
+        diff -rq "$1/frames" "$2/frames" | head -5
+        return 1
+    fi
+    if ! cmp -s "$1/stats.csv" "$2/stats.csv"; then
+        echo "FAIL: $1/stats.csv and $2/stats.csv differ:"
+        diff "$1/stats.csv" "$2/stats.csv" | head -6
+        return 1
+    fi
+    n=$(ls "$1/frames" | wc -l)
+    echo "ok: $2 equals $1 ($n frame files and stats.csv)"
+}
+
+case $mode in
+compare)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    for np in "$@"; do
+        mpi "$np" run "$scene" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        [ "$np" = 1 ] || grep -q '"ranks":' "$TMP/np$np/summary.json" ||
+            { echo "FAIL: no per-rank figures in summary.json"; exit 1; }
+    done
+    ;;
+resume)
+    scene=$SRC/$1 t1=$2 t2=$3 np1=$4 np2=$5
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$t2" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    mpi "$np1" run "$scene" -o "$TMP/r" --end "$t1" --quiet || { echo "FAIL: -np $np1 to $t1"; exit 1; }
+    ls "$TMP/r/checkpoints" | grep -q . || { echo "FAIL: no checkpoint"; exit 1; }
+    mpi "$np2" run --resume "$TMP/r" --end "$t2" --quiet || { echo "FAIL: resume on -np $np2"; exit 1; }
+    grep -q '"resumed_from_frame"' "$TMP/r/summary.json" || { echo "FAIL: not resumed"; exit 1; }
+    same "$TMP/serial" "$TMP/r" || exit 1
+    ;;
+kill)
+    scene=$SRC/$1 end=$2 np1=$3 np2=$4
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    "$MPIRUN" $ROOTOPT --oversubscribe -np "$np1" "$BIN" run "$scene" -o "$TMP/k" --end "$end" --quiet \
+        >"$TMP/k.log" 2>&1 &
+    mpid=$!
+    i=0
+    while [ "$(ls "$TMP/k/checkpoints" 2>/dev/null | grep -c .)" -lt 2 ] && kill -0 $mpid 2>/dev/null; do
+        sleep 0.2
+        i=$((i + 1))
+        [ $i -lt 1500 ] || break
+    done
+    victim=$(pgrep -P $mpid | tail -n 1) # the last rank mpirun started (not rank 0, which writes)
+    [ -n "$victim" ] || { echo "FAIL: the run ended before it could be killed (make it longer)"; exit 1; }
+    kill -9 "$victim"
+    wait $mpid
+    rc=$?
+    [ "$rc" != 0 ] || { echo "FAIL: mpirun exited 0 after a rank was killed"; exit 1; }
+    echo "killed rank pid $victim; mpirun exited $rc; checkpoints: $(ls "$TMP/k/checkpoints" | tr '\n' ' ')"
+    mpi "$np2" run --resume "$TMP/k" --quiet || { echo "FAIL: resume on -np $np2"; exit 1; }
+    grep -q '"resumed_from_frame"' "$TMP/k/summary.json" || { echo "FAIL: not resumed"; exit 1; }
+    same "$TMP/serial" "$TMP/k" || exit 1
+    ;;
+refuse)
+    scene=$SRC/$1 np=$2 want=${3:-2}
+    mpi "$np" run "$scene" -o "$TMP/bad" --end 0.04 --quiet 2>"$TMP/err"
+    rc=$?
+    [ "$rc" = "$want" ] || { echo "FAIL: exit status $rc, not $want"; cat "$TMP/err"; exit 1; }
+    n=$(grep -c '^pfsph: ' "$TMP/err")
+    [ "$n" = 1 ] || { echo "FAIL: $n messages, not 1:"; cat "$TMP/err"; exit 1; }
+    echo "ok: exit status $rc and one message: $(grep '^pfsph: ' "$TMP/err")"
+    ;;
+*)
+    echo "usage: mpi_test.sh compare|resume|refuse ..."
+    exit 2
+    ;;
+esac
