@@ -89,13 +89,14 @@ static void fit(const double *t, const double *s, size_t n, double w0, double *w
     *w = bw, *g = bg;
 }
 
-int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
+/* one realisation (thermostat seed `seed`): its deformation added to r->s, its start to *s0 and
+ * *s0rate (allocates r's arrays on the first call) */
+static int one_drop(const pfm_osc *cfg, int seed, pfm_osc_result *r, double *s0sum, double *ratesum)
 {
-    memset(r, 0, sizeof *r);
     const int D = cfg->dim;
     const double R = cfg->R, d = cfg->d, L = 4 * R, rho = 1000;
     char json[2048];
-    const char *pw = tu_env("PF_PW", ""); /* study knob: extra pairwise keys, each followed by a comma */
+    const char *pw = tu_env("PF_PW", cfg->pw ? cfg->pw : ""); /* extra pairwise keys, each followed by a comma */
     if (D == 2)
         snprintf(
             json, sizeof json,
@@ -105,7 +106,7 @@ int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
             " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": %.10g}],"
             " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0], \"radius\": %.10g}],"
             " \"pairwise\": {\"k\": 1.7, %s \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %g}]}}",
-            cfg->seed, 0.5 * d, -L, -L, L, L, cfg->nu, R, pw, cfg->sigma);
+            seed, 0.5 * d, -L, -L, L, L, cfg->nu, R, pw, cfg->sigma);
     else
         snprintf(json, sizeof json,
                  "{\"dimension\": 3, \"seed\": %d, \"particle_radius\": %.10g, \"gravity\": [0, 0, 0],"
@@ -114,7 +115,7 @@ int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
                  " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": %.10g}],"
                  " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0, 0], \"radius\": %.10g}],"
                  " \"pairwise\": {%s \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %g}]}}",
-                 cfg->seed, 0.5 * d, -L, -L, -L, L, L, L, cfg->nu, R, pw, cfg->sigma);
+                 seed, 0.5 * d, -L, -L, -L, L, L, L, cfg->nu, R, pw, cfg->sigma);
     pfsph_sim *sim = tu_sim_from_json(json, "drop.json");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     pfsph_particles *f = c->fluid;
@@ -128,7 +129,6 @@ int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
     const double wd2 = r->omega0 * r->omega0 - r->gamma_lamb * r->gamma_lamb;
     r->T_damped = wd2 > 0 ? 2 * PI / sqrt(wd2) : INFINITY;
     pfsph_error err = {0};
-    const clock_t c0 = clock();
     if (cfg->t_melt > 0 && pfsph_sim_advance(sim, cfg->t_melt, &err) != PFSPH_OK) {
         fprintf(stderr, "drop: %s\n", err.msg);
         pfsph_sim_destroy(sim);
@@ -151,17 +151,20 @@ int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
     }
     double s0rate;
     const double s0 = deformation(c, &s0rate);
+    *s0sum += s0, *ratesum += s0rate;
     const double dts = r->T0 / 40;
     const size_t ns = (size_t)lround(cfg->periods * 40);
-    r->ns = ns + 1;
-    r->t = malloc(r->ns * sizeof(double));
-    r->s = malloc(r->ns * sizeof(double));
-    r->s_theory = malloc(r->ns * sizeof(double));
-    if (!r->t || !r->s || !r->s_theory) {
-        pfsph_sim_destroy(sim);
-        return -1;
+    if (!r->t) {
+        r->ns = ns + 1;
+        r->t = malloc(r->ns * sizeof(double));
+        r->s = calloc(r->ns, sizeof(double));
+        r->s_theory = malloc(r->ns * sizeof(double));
+        if (!r->t || !r->s || !r->s_theory) {
+            pfsph_sim_destroy(sim);
+            return -1;
+        }
     }
-    r->t[0] = 0, r->s[0] = s0;
+    r->t[0] = 0, r->s[0] += s0;
     for (size_t k = 1; k <= ns; k++) {
         if (pfsph_sim_advance(sim, cfg->t_melt + dts * (double)k, &err) != PFSPH_OK) {
             fprintf(stderr, "drop: %s\n", err.msg);
@@ -169,10 +172,28 @@ int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
             return -1;
         }
         r->t[k] = dts * (double)k;
-        r->s[k] = deformation(c, NULL);
+        r->s[k] += deformation(c, NULL);
     }
     const size_t lost = pfsph_sim_removed(sim);
     pfsph_sim_destroy(sim);
+    if (lost) {
+        fprintf(stderr, "drop: %zu particles left the domain\n", lost);
+        return -1;
+    }
+    return 0;
+}
+
+int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
+{
+    memset(r, 0, sizeof *r);
+    const clock_t c0 = clock();
+    const int nseeds = cfg->nseeds > 0 ? cfg->nseeds : 1;
+    double s0 = 0, s0rate = 0;
+    for (int q = 0; q < nseeds; q++)
+        if (one_drop(cfg, cfg->seed + q, r, &s0, &s0rate)) return -1;
+    for (size_t k = 0; k < r->ns; k++) r->s[k] /= nseeds;
+    s0 /= nseeds, s0rate /= nseeds;
+    const double wd2 = r->omega0 * r->omega0 - r->gamma_lamb * r->gamma_lamb;
     r->cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
     /* Rayleigh-Lamb: a damped oscillator from s(0) with the measured initial rate */
     const double wd = wd2 > 0 ? sqrt(wd2) : 0, gl = r->gamma_lamb;
@@ -184,10 +205,6 @@ int pfm_oscillation(const pfm_osc *cfg, pfm_osc_result *r)
     fit(r->t, r->s, r->ns, r->omega0, &w, &g);
     r->T = 2 * PI / w;
     r->gamma = g;
-    if (lost) {
-        fprintf(stderr, "drop: %zu particles left the domain\n", lost);
-        return -1;
-    }
     return 0;
 }
 

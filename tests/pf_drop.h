@@ -15,7 +15,10 @@
 typedef struct pfm_osc {
     int dim;
     double R, d, sigma, nu, eps0, periods, t_melt;
-    int seed;
+    int seed;       /* the first thermostat seed */
+    int nseeds;     /* realisations averaged (seed, seed + 1, ...); the thermal shape noise falls as
+                 * 1 / sqrt(nseeds) */
+    const char *pw; /* extra pairwise keys, each followed by a comma (NULL: none); PF_PW overrides */
 } pfm_osc;
 
 typedef struct pfm_osc_result {

@@ -46,7 +46,7 @@ static void step(pfsph_sim *sim)
  * the thermostat at its default temperature) */
 static double eq21(double th_deg, double cww)
 {
-    return pfsph_pairwise_angle_ratio(2, pfsph_thermo_reduced_default(2), th_deg) * cww;
+    return pfsph_pairwise_angle_ratio(2, PFSPH_THERMO_REDUCED_DEFAULT, th_deg) * cww;
 }
 
 static void test_matrix(void **state)
