@@ -102,6 +102,49 @@ double pfsph_pairwise_visc_struct(int dim, double theta)
     return visc_struct2[n - 1];
 }
 
+/* The bulk viscosity of the hot pair-force liquid (docs/viscosity.md): nu_eff / nu_0 against the
+ * Morris viscosity nu_morris / nu_0 applied, nu_0 = sqrt(sigma d / rho), measured wall-free with
+ * bench/pf_shear.c (a free slab, the decay of its shear mode u_x = A cos(2 pi y / H); DFSPH,
+ * sigma 4 N/m, d = 1 cm, rho 1000) at the 3D default temperature, theta 0.01 (Eq. 5's k,
+ * H = 24 d; nu_morris 3e-4 / 1e-3 / 3e-3 m^2/s read 1.39 / 2.28 / 6.55e-3; at d = 5 mm 2.03e-3
+ * for 1e-3): the 3D liquid multiplies the Morris viscosity by about 2.2. Linear in between and
+ * beyond the ends. 2D keeps the opt-in box correction above (docs/viscosity.md: the 2D liquid
+ * at its default temperature is shear-thinning, so no single viscosity table fits it). */
+static const double visc_x3[] = {0.0475, 0.158, 0.475};
+static const double visc_y3[] = {0.219, 0.361, 1.036};
+
+static bool visc_table(int dim, double theta, const double **x, const double **y, size_t *n)
+{
+    /* measured at the default temperature only: within 25 % of it */
+    if (dim != 3 || !(fabs(theta / pfsph_thermo_reduced_default(dim) - 1) <= 0.25)) return false;
+    *x = visc_x3;
+    *y = visc_y3;
+    *n = sizeof visc_x3 / sizeof visc_x3[0];
+    return true;
+}
+
+/* piecewise linear through (a[i], b[i]), the end segments extended */
+static double lerp_table(const double *a, const double *b, size_t n, double v)
+{
+    size_t i = 1;
+    while (i < n - 1 && v > a[i]) i++;
+    return b[i - 1] + (v - a[i - 1]) / (a[i] - a[i - 1]) * (b[i] - b[i - 1]);
+}
+
+double pfsph_pairwise_visc_eff(int dim, double theta, double x)
+{
+    const double *a, *b;
+    size_t n;
+    return visc_table(dim, theta, &a, &b, &n) ? lerp_table(a, b, n, x) : NAN;
+}
+
+double pfsph_pairwise_visc_morris(int dim, double theta, double y)
+{
+    const double *a, *b;
+    size_t n;
+    return visc_table(dim, theta, &a, &b, &n) ? lerp_table(b, a, n, y) : NAN;
+}
+
 /* Contact angles at temperature (docs/pairwise.md, "Contact angles at temperature"), by
  * dimension. 2D (tests/physics/test_pf_contact_angle.c with PF_RATIO, PF_HALF=0.07, PF_SEED=5): the static angle
  * of 2D drops of 196 particles (14 x 14 d squares at the start) on 3-layer plates, no gravity,

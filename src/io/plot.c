@@ -1,5 +1,5 @@
-/* Diffuse particle counts over time as a PNG line chart (the paper's Fig. 14), read from a run's
- * stats.csv. Self-contained: a tiny bitmap font, Bresenham lines, libpng, atomic rename. */
+/* Line charts as PNG: diffuse particle counts over time (the paper's Fig. 14), read from a run's
+ * stats.csv, and the validation pages' charts (pfsph_plot_lines). Self-contained: a tiny bitmap font, Bresenham lines, libpng, atomic rename. */
 #include <errno.h>
 #include <math.h>
 #include <png.h>
@@ -42,20 +42,71 @@ static const struct {
     char c;
     unsigned char row[7];
 } font[] = {
-    {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},      {'2', {14, 17, 1, 2, 4, 8, 31}},
-    {'3', {31, 2, 4, 2, 1, 17, 14}},     {'4', {2, 6, 10, 18, 31, 2, 2}},     {'5', {31, 16, 30, 1, 1, 17, 14}},
-    {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},       {'8', {14, 17, 17, 14, 17, 17, 14}},
-    {'9', {14, 17, 17, 15, 1, 2, 12}},   {'.', {0, 0, 0, 0, 0, 12, 12}},      {'-', {0, 0, 0, 31, 0, 0, 0}},
-    {'+', {0, 4, 4, 31, 4, 4, 0}},       {'[', {14, 8, 8, 8, 8, 8, 14}},      {']', {14, 2, 2, 2, 2, 2, 14}},
-    {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},        {'a', {0, 0, 14, 1, 15, 17, 15}},
-    {'b', {16, 16, 22, 25, 17, 17, 30}}, {'c', {0, 0, 14, 16, 16, 17, 14}},   {'d', {1, 1, 13, 19, 17, 17, 15}},
-    {'e', {0, 0, 14, 17, 31, 16, 14}},   {'f', {6, 9, 8, 28, 8, 8, 8}},       {'g', {0, 15, 17, 17, 15, 1, 14}},
-    {'i', {4, 0, 12, 4, 4, 4, 14}},      {'k', {16, 16, 18, 20, 24, 20, 18}}, {'l', {12, 4, 4, 4, 4, 4, 14}},
-    {'m', {0, 0, 26, 21, 21, 17, 17}},   {'n', {0, 0, 22, 25, 17, 17, 17}},   {'o', {0, 0, 14, 17, 17, 17, 14}},
-    {'p', {0, 0, 30, 17, 30, 16, 16}},   {'r', {0, 0, 22, 25, 16, 16, 16}},   {'s', {0, 0, 14, 16, 14, 1, 30}},
-    {'t', {8, 8, 28, 8, 8, 9, 6}},       {'u', {0, 0, 17, 17, 17, 19, 13}},   {'w', {0, 0, 17, 17, 21, 21, 10}},
-    {'y', {0, 0, 17, 17, 15, 1, 14}},    {'M', {17, 27, 21, 21, 17, 17, 17}}, {'N', {17, 25, 21, 19, 17, 17, 17}},
-    {'D', {28, 18, 17, 17, 17, 18, 28}}, {'F', {31, 16, 16, 30, 16, 16, 16}}, {'S', {15, 16, 16, 14, 1, 1, 30}},
+    {'0', {14, 17, 19, 21, 25, 17, 14}},
+    {'1', {4, 12, 4, 4, 4, 4, 14}},
+    {'2', {14, 17, 1, 2, 4, 8, 31}},
+    {'3', {31, 2, 4, 2, 1, 17, 14}},
+    {'4', {2, 6, 10, 18, 31, 2, 2}},
+    {'5', {31, 16, 30, 1, 1, 17, 14}},
+    {'6', {6, 8, 16, 30, 17, 17, 14}},
+    {'7', {31, 1, 2, 4, 8, 8, 8}},
+    {'8', {14, 17, 17, 14, 17, 17, 14}},
+    {'9', {14, 17, 17, 15, 1, 2, 12}},
+    {'.', {0, 0, 0, 0, 0, 12, 12}},
+    {'-', {0, 0, 0, 31, 0, 0, 0}},
+    {'+', {0, 4, 4, 31, 4, 4, 0}},
+    {'[', {14, 8, 8, 8, 8, 8, 14}},
+    {']', {14, 2, 2, 2, 2, 2, 14}},
+    {'(', {2, 4, 8, 8, 8, 4, 2}},
+    {')', {8, 4, 2, 2, 2, 4, 8}},
+    {'a', {0, 0, 14, 1, 15, 17, 15}},
+    {'b', {16, 16, 22, 25, 17, 17, 30}},
+    {'c', {0, 0, 14, 16, 16, 17, 14}},
+    {'d', {1, 1, 13, 19, 17, 17, 15}},
+    {'e', {0, 0, 14, 17, 31, 16, 14}},
+    {'f', {6, 9, 8, 28, 8, 8, 8}},
+    {'g', {0, 15, 17, 17, 15, 1, 14}},
+    {'i', {4, 0, 12, 4, 4, 4, 14}},
+    {'k', {16, 16, 18, 20, 24, 20, 18}},
+    {'l', {12, 4, 4, 4, 4, 4, 14}},
+    {'m', {0, 0, 26, 21, 21, 17, 17}},
+    {'n', {0, 0, 22, 25, 17, 17, 17}},
+    {'o', {0, 0, 14, 17, 17, 17, 14}},
+    {'p', {0, 0, 30, 17, 30, 16, 16}},
+    {'r', {0, 0, 22, 25, 16, 16, 16}},
+    {'s', {0, 0, 14, 16, 14, 1, 30}},
+    {'t', {8, 8, 28, 8, 8, 9, 6}},
+    {'u', {0, 0, 17, 17, 17, 19, 13}},
+    {'w', {0, 0, 17, 17, 21, 21, 10}},
+    {'y', {0, 0, 17, 17, 15, 1, 14}},
+    {'M', {17, 27, 21, 21, 17, 17, 17}},
+    {'N', {17, 25, 21, 19, 17, 17, 17}},
+    {'D', {28, 18, 17, 17, 17, 18, 28}},
+    {'F', {31, 16, 16, 30, 16, 16, 16}},
+    {'S', {15, 16, 16, 14, 1, 1, 30}},
+    /* for the line charts of pfsph_plot_lines */
+    {'h', {16, 16, 22, 25, 17, 17, 17}},
+    {'v', {0, 0, 17, 17, 17, 10, 4}},
+    {'x', {0, 0, 17, 10, 4, 10, 17}},
+    {'z', {0, 0, 31, 2, 4, 8, 31}},
+    {'q', {0, 0, 13, 19, 15, 1, 1}},
+    {'A', {14, 17, 17, 31, 17, 17, 17}},
+    {'B', {30, 17, 17, 30, 17, 17, 30}},
+    {'C', {14, 17, 16, 16, 16, 17, 14}},
+    {'E', {31, 16, 16, 30, 16, 16, 31}},
+    {'G', {14, 17, 16, 23, 17, 17, 15}},
+    {'H', {17, 17, 17, 31, 17, 17, 17}},
+    {'I', {14, 4, 4, 4, 4, 4, 14}},
+    {'L', {16, 16, 16, 16, 16, 16, 31}},
+    {'O', {14, 17, 17, 17, 17, 17, 14}},
+    {'P', {30, 17, 17, 30, 16, 16, 16}},
+    {'R', {30, 17, 17, 30, 20, 18, 17}},
+    {'T', {31, 4, 4, 4, 4, 4, 4}},
+    {'/', {1, 1, 2, 4, 8, 16, 16}},
+    {'=', {0, 0, 31, 0, 31, 0, 0}},
+    {',', {0, 0, 0, 0, 12, 4, 8}},
+    {':', {0, 12, 12, 0, 12, 12, 0}},
+    {'^', {4, 10, 17, 0, 0, 0, 0}},
 };
 
 /* Text at (x, y) = top-left, scale s; returns the width drawn. */
@@ -232,6 +283,69 @@ int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error 
 #undef PX
 #undef PY
     free(v);
+    int rc = write_png(png_path, &im, err);
+    free(im.px);
+    return rc;
+}
+
+int pfsph_plot_lines(const char *png_path, const char *title, const char *xlabel, const char *ylabel,
+                     const pfsph_plot_series *s, int ns, pfsph_error *err)
+{
+    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (int k = 0; k < ns; k++)
+        for (size_t i = 0; i < s[k].n; i++) {
+            if (!isfinite(s[k].x[i]) || !isfinite(s[k].y[i])) continue;
+            x0 = fmin(x0, s[k].x[i]), x1 = fmax(x1, s[k].x[i]);
+            y0 = fmin(y0, s[k].y[i]), y1 = fmax(y1, s[k].y[i]);
+        }
+    if (!(x1 > x0)) x0 = 0, x1 = 1;
+    if (!(y1 > y0)) y0 = 0, y1 = 1;
+    const double ystep = nice_step(y1 - y0, 6), xstep = nice_step(x1 - x0, 8);
+    y0 = floor(y0 / ystep) * ystep, y1 = ceil(y1 / ystep) * ystep;
+    img im = {malloc((size_t)W * H * 3)};
+    if (!im.px) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    memset(im.px, 255, (size_t)W * H * 3);
+    const unsigned char black[3] = {0, 0, 0}, grey[3] = {225, 225, 225};
+    const unsigned char colors[6][3] = {{40, 100, 220}, {220, 60, 40}, {30, 160, 60},
+                                        {90, 90, 90},   {200, 140, 0}, {150, 60, 180}};
+    const int pw = W - ML - MR, ph = H - MT - MB;
+#define PX(t) (ML + (int)lround(((t)-x0) / (x1 - x0) * pw))
+#define PY(c) (MT + ph - (int)lround(((c)-y0) / (y1 - y0) * ph))
+    char lab[64];
+    for (double y = y0; y <= y1 + 1e-9 * ystep; y += ystep) {
+        line(&im, ML, PY(y), ML + pw, PY(y), grey, 1);
+        snprintf(lab, sizeof lab, "%g", fabs(y) < 1e-9 * ystep ? 0.0 : y);
+        text(&im, ML - 8 - 6 * (int)strlen(lab), PY(y) - 3, lab, black, 1);
+    }
+    for (double t = ceil(x0 / xstep) * xstep; t <= x1 * (1 + 1e-9); t += xstep) {
+        line(&im, PX(t), MT, PX(t), MT + ph, grey, 1);
+        snprintf(lab, sizeof lab, "%g", fabs(t) < 1e-9 * xstep ? 0.0 : t);
+        text(&im, PX(t) - 3 * (int)strlen(lab), MT + ph + 8, lab, black, 1);
+    }
+    line(&im, ML, MT, ML, MT + ph, black, 1);
+    line(&im, ML, MT + ph, ML + pw, MT + ph, black, 1);
+    text(&im, ML + pw / 2 - 3 * (int)strlen(xlabel), H - 24, xlabel, black, 1);
+    text(&im, 8, MT - 12, ylabel, black, 1);
+    text(&im, 8, 6, title, black, 2);
+    int lx = ML + 16, ly = MT + 14;
+    for (int k = 0; k < ns; k++) {
+        const unsigned char *c = colors[k % 6];
+        if (s[k].points) line(&im, lx + 10, ly, lx + 10, ly, c, 5);
+        else line(&im, lx, ly, lx + 20, ly, c, 3);
+        lx += 26 + text(&im, lx + 26, ly - 3, s[k].name, black, 1) + 16;
+        if (lx > W - 200) lx = ML + 16, ly += 14;
+    }
+    for (int k = 0; k < ns; k++) {
+        const unsigned char *c = colors[k % 6];
+        for (size_t i = 0; i < s[k].n; i++) {
+            if (!isfinite(s[k].x[i]) || !isfinite(s[k].y[i])) continue;
+            if (s[k].points) line(&im, PX(s[k].x[i]), PY(s[k].y[i]), PX(s[k].x[i]), PY(s[k].y[i]), c, 5);
+            else if (i > 0 && isfinite(s[k].x[i - 1]) && isfinite(s[k].y[i - 1]))
+                line(&im, PX(s[k].x[i - 1]), PY(s[k].y[i - 1]), PX(s[k].x[i]), PY(s[k].y[i]), c, 2);
+        }
+    }
+#undef PX
+#undef PY
     int rc = write_png(png_path, &im, err);
     free(im.px);
     return rc;

@@ -38,6 +38,18 @@ int pfsph_write_file_atomic(const char *path, const void *data, size_t len, pfsp
  * Written atomically. */
 int pfsph_diffuse_plot(const char *stats_csv, const char *png_path, pfsph_error *err);
 
+/* A line chart of ns series (y against x; NAN points are skipped) as a PNG, axes fitted to the
+ * data, a legend of the series' names; for the validation pages (docs/validation_drop.md).
+ * Written atomically. */
+typedef struct pfsph_plot_series {
+    const char *name;
+    const double *x, *y;
+    size_t n;
+    int points; /* 1: dots, 0: a line */
+} pfsph_plot_series;
+int pfsph_plot_lines(const char *png_path, const char *title, const char *xlabel, const char *ylabel,
+                     const pfsph_plot_series *s, int ns, pfsph_error *err);
+
 /* mkdir -p; PFSPH_EIO with a message on failure. */
 int pfsph_mkdirs(const char *path, pfsph_error *err);
 

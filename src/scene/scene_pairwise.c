@@ -99,6 +99,11 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
     if (rc) return rc;
     /* Writing the block turns the forces on unless it says "enabled": false. */
     pp->enabled = true;
+    /* the default temperature depends on the dimension (docs/viscosity.md) */
+    pp->thermo.reduced = pfsph_thermo_reduced_default(s->dim);
+    /* and in 3D the Morris viscosity is the one that makes the hot liquid flow as set (2D: the
+     * opt-in box correction, docs/viscosity.md) */
+    pp->visc_correct = s->dim == 3;
     if ((rc = pfsph__json_bool(node, path, "enabled", &pp->enabled, ctx))) return rc;
     if ((rc = pfsph__json_bool(node, path, "viscosity_correction", &pp->visc_correct, ctx))) return rc;
     if ((rc = pfsph__json_number(node, path, "k", 1.0, 4.0, &pp->k, ctx))) return rc;
@@ -310,9 +315,9 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
      * liquid-air tension of the table (docs/thermostat.md). */
     tp->kT_resolved = 0;
     if (tp->enabled) tp->kT_resolved = tp->kT >= 0 ? tp->kT : tp->reduced * tp->sigma_ref * dd;
-    /* The hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid"):
-     * nu_eff = nu_struct + gain nu_morris, nu_struct = g(theta_a) sqrt(sigma_a d / rho_a) with
-     * sigma_a the phase's own tension at temperature and theta_a its reduced temperature. */
+    /* The hot liquid's own viscosity (docs/viscosity.md): nu_eff = nu_0 F(nu_morris / nu_0),
+     * nu_0 = sqrt(sigma_a d / rho_a) with sigma_a the phase's own tension at temperature and F
+     * the wall-free measurement at theta_a, the phase's reduced temperature. */
     for (int a = 0; a < np; a++) {
         const double nu = s->phases[a].viscosity;
         pp->nu_morris[a] = nu;
@@ -322,12 +327,22 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
          * temperature (the bench's sigma target) */
         const double s13 = lam * pp->c[a][a] * rho[a] * rho[a], sg = f * s13;
         const double kTa = tp->kT_resolved * (tp->rho_ref > 0 ? rho[a] / tp->rho_ref : 1.0);
-        const double g = pfsph_pairwise_visc_struct(s->dim, kTa / (s13 * dd));
-        if (!(g > 0)) continue;
+        if (s->dim == 2) { /* the opt-in box correction (docs/thermostat.md) */
+            const double g = pfsph_pairwise_visc_struct(s->dim, kTa / (s13 * dd));
+            if (!(g > 0)) continue;
+            const double nu0 = sqrt(sg * (double)spacing / rho[a]);
+            pp->nu_struct[a] = g * nu0;
+            pp->nu_floor[a] = PFSPH_VISC_FLOOR * nu0;
+            if (pp->visc_correct) pp->nu_morris[a] = fmax((nu - pp->nu_struct[a]) / PFSPH_VISC_GAIN, pp->nu_floor[a]);
+            continue;
+        }
+        const double tha = kTa / (s13 * dd);
         const double nu0 = sqrt(sg * (double)spacing / rho[a]);
-        pp->nu_struct[a] = g * nu0;
+        if (!isfinite(pfsph_pairwise_visc_eff(s->dim, tha, 0.0)) || !(nu0 > 0)) continue;
         pp->nu_floor[a] = PFSPH_VISC_FLOOR * nu0;
-        if (pp->visc_correct) pp->nu_morris[a] = fmax((nu - pp->nu_struct[a]) / PFSPH_VISC_GAIN, pp->nu_floor[a]);
+        if (pp->visc_correct)
+            pp->nu_morris[a] = fmax(pfsph_pairwise_visc_morris(s->dim, tha, nu / nu0), PFSPH_VISC_FLOOR) * nu0;
+        pp->nu_struct[a] = pfsph_pairwise_visc_eff(s->dim, tha, pp->nu_morris[a] / nu0) * nu0;
     }
     pp->resolved = true;
     return PFSPH_OK;
@@ -366,32 +381,57 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
         const double num = pp->nu_morris[a];
         if (num > 0) fprintf(out, ", velocity relaxation ~%.3g s\n", h * h / (2.0 * (s->dim + 2) * num));
         else fprintf(out, "; viscosity 0: no friction, so no noise either (set a viscosity)\n");
-        /* the hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid") */
-        if (!(pp->nu_struct[a] > 0)) {
-            if (pp->visc_correct)
+        if (s->dim == 2) {
+            /* the hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid") */
+            if (!(pp->nu_struct[a] > 0)) {
+                if (pp->visc_correct)
+                    fprintf(out,
+                            "      viscosity_correction: no measured table for %dD at this temperature; "
+                            "the viscosity is applied as set\n",
+                            s->dim);
+                continue;
+            }
+            const double reach = pp->nu_struct[a] + PFSPH_VISC_GAIN * pp->nu_floor[a];
+            if (!pp->visc_correct) {
                 fprintf(out,
-                        "      viscosity_correction: no measured table for %dD at this temperature; "
-                        "the viscosity is applied as set\n",
-                        s->dim);
+                        "      viscosity %.4g m^2/s set; the hot liquid is expected to flow as ~%.3g "
+                        "(structural %.3g + %.3g x the set one, a box figure; wall-free this 2D liquid is "
+                        "shear-thinning, 4.7x at 1e-3 and 2.1 /s, docs/viscosity.md)\n",
+                        nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
+                continue;
+            }
+            fprintf(out,
+                    "      viscosity %.4g m^2/s set: Morris viscosity %.4g applied (structural %.3g, "
+                    "gain %.3g, floor %.3g)\n",
+                    nu, num, pp->nu_struct[a], PFSPH_VISC_GAIN, pp->nu_floor[a]);
+            if (nu < reach)
+                fprintf(out,
+                        "      warning: %s's viscosity %.4g m^2/s is below what the hot liquid reaches "
+                        "(~%.3g m^2/s at this temperature, spacing and tension); it will flow as ~%.3g\n",
+                        s->phases[a].name, nu, reach, reach);
             continue;
         }
-        const double reach = pp->nu_struct[a] + PFSPH_VISC_GAIN * pp->nu_floor[a];
-        if (!pp->visc_correct) {
+        /* the hot liquid's own viscosity (docs/viscosity.md) */
+        if (!(pp->nu_struct[a] > 0)) {
             fprintf(out,
-                    "      viscosity %.4g m^2/s set; the hot liquid is expected to flow as ~%.3g "
-                    "(structural %.3g + %.3g x the set one; `viscosity_correction` makes it the set one)\n",
-                    nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
+                    "      viscosity %.4g m^2/s set and applied as the Morris viscosity (no measured 3D "
+                    "correction at this temperature: the hot liquid may flow about twice as thick, "
+                    "docs/viscosity.md)\n",
+                    nu);
             continue;
         }
-        fprintf(out,
-                "      viscosity %.4g m^2/s set: Morris viscosity %.4g applied (structural %.3g, "
-                "gain %.3g, floor %.3g)\n",
-                nu, num, pp->nu_struct[a], PFSPH_VISC_GAIN, pp->nu_floor[a]);
-        if (nu < reach)
+        const double nu0 = pp->nu_floor[a] / PFSPH_VISC_FLOOR;
+        const double reach = pfsph_pairwise_visc_eff(s->dim, pp->theta, PFSPH_VISC_FLOOR) * nu0;
+        fprintf(out, "      viscosity %.4g m^2/s set, expected %.4g (Morris viscosity %.4g applied%s)\n", nu,
+                pp->nu_struct[a], num, pp->visc_correct ? "" : "; viscosity_correction is off");
+        if (pp->visc_correct && nu < 0.99 * reach)
             fprintf(out,
-                    "      warning: %s's viscosity %.4g m^2/s is below what the hot liquid reaches "
-                    "(~%.3g m^2/s at this temperature, spacing and tension); it will flow as ~%.3g\n",
-                    s->phases[a].name, nu, reach, reach);
+                    "      warning: %s's viscosity %.4g m^2/s is below the least the hot liquid reaches with "
+                    "the least Morris friction that holds its temperature (~%.3g m^2/s at this spacing, "
+                    "tension and temperature): it will flow as ~%.3g. That least viscosity scales as "
+                    "sqrt(spacing): a spacing %.2g times finer reaches the set one; a hotter liquid is "
+                    "thinner too (docs/viscosity.md)\n",
+                    s->phases[a].name, nu, reach, pp->nu_struct[a], reach * reach / (nu * nu));
     }
 }
 

@@ -325,6 +325,58 @@ static void test_viscosity_correction(void **state)
     free(s);
 }
 
+/* 3D viscosity_correction (on by default in 3D): nu_morris = max(F^-1(nu / nu_0), floor) nu_0 for
+ * the reference liquid, F the measured wall-free viscosity (its theta is the scene's reduced
+ * temperature, its tension the target); 2D keeps the opt-in box correction (above) */
+static void test_viscosity_bulk_3d(void **state)
+{
+    (void)state;
+    pfsph_scene *s = calloc(1, sizeof(*s));
+    pfsph_error err = {0};
+    for (int dim = 3; dim <= 3; dim++)
+        for (int on = 0; on <= 1; on++) {
+            char pw[256];
+            snprintf(pw, sizeof pw, "{%s \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}",
+                     on ? "" : "\"viscosity_correction\": false,");
+            for (int k = 0; k < 2; k++) {
+                assert_int_equal(parse(pw, s, &err), PFSPH_OK);
+                s->dim = dim; /* the scene was parsed as 2D: what a 3D parse sets */
+                s->pairwise.thermo.reduced = pfsph_thermo_reduced_default(dim);
+                s->pairwise.visc_correct = on == 1;
+                s->phases[0].viscosity = k ? 1e-2 : 1e-3; /* above and below what the liquid reaches */
+                assert_int_equal(pfsph_pairwise_resolve(s, 0.01, (pfsph_real)(s->support_factor * 0.01), &err),
+                                 PFSPH_OK);
+                const pfsph_pairwise_params *pp = &s->pairwise;
+                const double nu = s->phases[0].viscosity;
+                const double nu0 = sqrt(4 * 0.01 / 1000.0); /* the tension at temperature is the target */
+                assert_true(pp->visc_correct == (on == 1));
+                assert_true(fabs(pp->theta - pfsph_thermo_reduced_default(dim)) < 1e-15);
+                assert_true(pp->nu_morris[2] == s->phases[2].viscosity); /* the wall: as set */
+                if (dim == 2) {                                          /* no table: as set, no expectation */
+                    assert_true(pp->nu_morris[0] == nu && pp->nu_struct[0] == 0);
+                    continue;
+                }
+                assert_true(fabs(pp->nu_floor[0] - PFSPH_VISC_FLOOR * nu0) < 1e-6 * nu0);
+                const double want =
+                    on ? fmax(pfsph_pairwise_visc_morris(3, pp->theta, nu / nu0), PFSPH_VISC_FLOOR) * nu0 : nu;
+                assert_true(fabs(pp->nu_morris[0] - want) < 1e-6 * want);
+                /* the expected viscosity: the set one above the reach, the reach below it */
+                const double reach = pfsph_pairwise_visc_eff(3, pp->theta, PFSPH_VISC_FLOOR) * nu0;
+                assert_true(fabs(pp->nu_struct[0] -
+                                 pfsph_pairwise_visc_eff(3, pp->theta, pp->nu_morris[0] / nu0) * nu0) < 1e-9);
+                if (on) assert_true(fabs(pp->nu_struct[0] - fmax(nu, reach)) < 1e-6 * nu);
+            }
+        }
+    /* the table holds in 3D at its default temperature only */
+    assert_true(isfinite(pfsph_pairwise_visc_eff(3, 0.01, 0.1)) && isnan(pfsph_pairwise_visc_eff(3, 0.04, 0.1)));
+    assert_true(isnan(pfsph_pairwise_visc_eff(2, 0.01, 0.1)) && isnan(pfsph_pairwise_visc_eff(3, 0.0, 0.1)));
+    for (double y = 0.3; y < 3; y *= 1.7) { /* the inverse */
+        const double x = pfsph_pairwise_visc_morris(3, 0.01, y);
+        assert_true(fabs(pfsph_pairwise_visc_eff(3, 0.01, x) - y) < 1e-12);
+    }
+    free(s);
+}
+
 static void test_scenes(void **state)
 {
     (void)state;
@@ -359,6 +411,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_resolve_errors),
         cmocka_unit_test(test_temperature_tables),
         cmocka_unit_test(test_viscosity_correction),
+        cmocka_unit_test(test_viscosity_bulk_3d),
         cmocka_unit_test(test_parse),
         cmocka_unit_test(test_scenes),
     };
