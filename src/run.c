@@ -86,7 +86,7 @@ static int frame_file(const char *name, long *num)
         while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
         if (!digits) return 0;
         if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj") ||
-            !strcmp(p, ".geo") || !strcmp(p, ".bgeo")) {
+            !strcmp(p, ".geo") || !strcmp(p, ".bgeo") || !strcmp(p, ".vdb")) {
             *num = v;
             return 1;
         }

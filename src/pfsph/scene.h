@@ -112,6 +112,8 @@ int pfsph__body_density_check(double density, double mass, double volume, char *
 typedef struct pfsph_surface_output {
     bool on;
     bool ply, obj, vtp; /* formats */
+    bool vdb;           /* an OpenVDB level set per frame (3D; src/pfsph/vdb.h) */
+    unsigned vdb_grids; /* its grids, PFSPH_VDB_* (0: surface and velocity) */
     bool isotropic;     /* spherical kernels instead of Yu & Turk's anisotropic ones */
     int smoothing;      /* Taubin passes */
     double cell;        /* marching-cubes cell / spacing (0: default 0.5) */
