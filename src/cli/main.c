@@ -360,6 +360,8 @@ static int cmd_run(int argc, char **argv)
             end = strtod(argv[i], &e);
             if (*e || e == argv[i] || !(end >= 0) || !isfinite(end))
                 return usage_error("--end: '%s' is not a finite time >= 0", argv[i]);
+            if (end > PFSPH_MAX_END)
+                return usage_error("--end: '%s' is more than 1e6 s, the range of $.time.end", argv[i]);
         } else if (!strcmp(a, "--resume")) {
             if (++i >= argc) return usage_error("%s needs a run directory", a);
             resume = argv[i];
