@@ -360,7 +360,10 @@ int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frame
     pfsph_surface_output so = over ? *over : s->output.surface;
     if (!so.vdb_grids) so.vdb_grids = s->output.surface.vdb_grids;
     if (s->dim == 2) {
-        if (so.ply || so.obj || so.vdb) {
+        /* only formats asked for here are refused: a 2D scene without output.surface keeps the
+         * default ply, vtp, and `pfsph mesh` of such a run refused to do anything (issue 33's
+         * attack, repeated) */
+        if (over && (so.ply || so.obj || so.vdb)) {
             rc = pfsph_fail(err, PFSPH_EINPUT,
                             "%s: a 2D run: its outline is written as VTP polylines only "
                             "(--formats vtp); nothing written",
@@ -368,6 +371,7 @@ int pfsph_mesh_run(const char *dir, const pfsph_surface_output *over, int *frame
             free(s);
             return rc;
         }
+        so.ply = so.obj = so.vdb = false;
         so.vtp = true;
     }
     if (!so.ply && !so.obj && !so.vtp && !so.vdb) so.ply = so.vtp = true;
