@@ -383,8 +383,13 @@ def sec_rundir(work):
     afile = os.path.join(work, "a_file")
     open(afile, "w").write("x")
     other = os.path.join(work, "other")
-    os.makedirs(other, exist_ok=True)
+    shutil.rmtree(other, ignore_errors=True)
+    os.makedirs(other)
     open(os.path.join(other, "precious.txt"), "w").write("keep me")
+    empty = os.path.join(work, "empty")
+    shutil.rmtree(empty, ignore_errors=True)
+    os.makedirs(empty)
+    shutil.rmtree(os.path.join(work, "twice"), ignore_errors=True)
     loop = os.path.join(work, "loop")
     if not os.path.islink(loop):
         os.symlink(loop, loop)
@@ -394,7 +399,8 @@ def sec_rundir(work):
         ("-o path of 5000 characters", ["run", sc, "-o", work + "/" + "d" * 5000], (2,)),
         ("-o a directory of other files", ["run", sc, "-o", other], (2,)),
         ("-o a symlink loop", ["run", sc, "-o", loop, "--force"], (1, 2)),
-        ("--resume an empty directory", ["run", "--resume", other], (2,)),
+        ("--resume an empty directory", ["run", "--resume", empty], (2,)),
+        ("--resume a directory of other files", ["run", "--resume", other], (2,)),
         ("--resume a file", ["run", "--resume", afile], (2,)),
     ]
     for what, a, allowed in cases:
@@ -418,8 +424,13 @@ def sec_rundir(work):
         sec.findings.append("the first run ended within a second: the lock case was not tried")
     rc, out, hung = run(["run", slow, "-o", d, "--force", "--quiet"], timeout=ARGS.timeout)
     sec.judge("a second run into a running run's directory", rc, out, allowed=(2,), hang=hung)
-    p.send_signal(signal.SIGINT)
-    p.wait(timeout=60)
+    p.send_signal(signal.SIGTERM)  # SIGINT: ignored in a background job of a script, and so by pfsph
+    try:
+        p.wait(timeout=60)
+    except subprocess.TimeoutExpired:
+        sec.finding("hangs", "a run did not stop within 60 s of SIGTERM")
+        p.kill()
+        p.wait()
     # resume with a corrupt scene.json
     open(os.path.join(d, "scene.json"), "w").write("{ not json")
     rc, out, hung = run(["run", "--resume", d], timeout=ARGS.timeout)
