@@ -419,7 +419,11 @@ def sec_rundir(work):
     e = dict(os.environ, OMP_NUM_THREADS="1")
     p = subprocess.Popen([ARGS.bin, "run", slow, "-o", d, "--force", "--quiet"], env=e, stdout=subprocess.DEVNULL,
                          stderr=subprocess.DEVNULL)
-    time.sleep(1.0)
+    for _ in range(600):  # until the first run holds its lock (a sanitizer build starts slowly)
+        if os.path.exists(os.path.join(d, ".pfsph.lock")) or p.poll() is not None:
+            break
+        time.sleep(0.1)
+    time.sleep(0.5)
     if p.poll() is not None:
         sec.findings.append("the first run ended within a second: the lock case was not tried")
     rc, out, hung = run(["run", slow, "-o", d, "--force", "--quiet"], timeout=ARGS.timeout)
