@@ -55,7 +55,9 @@ typedef struct pfsph_vdb_grid_info {
 
 /* Read grid `name` of the file at path (read with the frame cap) and, when p is not NULL, its
  * world-space trilinear values at the n points p (3 n, [m]) into out (n values; the first
- * component of a vector grid). PFSPH_EINPUT for a file that is not OpenVDB, or no such grid. */
+ * component of a vector grid). PFSPH_EINPUT for a file that is not OpenVDB, or no such grid. For
+ * pfsph's own files (tests, checks): OpenVDB's reader trusts a file past its header (a truncated
+ * one makes libopenvdb 10.0 read lengths that were never read: valgrind). */
 int pfsph_read_vdb(const char *path, const char *name, pfsph_vdb_grid_info *info, const double *p, size_t n,
                    double *out, pfsph_error *err);
 
