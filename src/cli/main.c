@@ -672,7 +672,7 @@ static int cmd_mesh(int argc, char **argv)
             if (so.vdb && !pfsph_vdb_available())
                 return usage_error("%s",
                                    "--formats vdb: this build of pfsph has no OpenVDB (Debian: libopenvdb-dev, "
-                                   "then rebuild; docs/artists.md#openvdb)");
+                                   "then rebuild; docs/artists.md#openvdb-level-sets-houdini-blender)");
             set = true;
         } else if (!strcmp(a, "--smooth")) {
             char *end = NULL;

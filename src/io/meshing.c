@@ -266,7 +266,7 @@ static int mesh_particles(const pfsph_surface_output *so, int dim, double spacin
     }
     if (!rc && pfsph_surface_velocity(&m, x, vel, ps->n, 2 * spacing))
         rc = pfsph_fail(err, PFSPH_ENOMEM, "surface: out of memory");
-    /* the level set for volume tools: voxels of the mesher's cell (docs/artists.md#openvdb) */
+    /* the level set for volume tools: voxels of the mesher's cell (docs/artists.md#openvdb-level-sets-houdini-blender) */
     if (!rc && so->vdb) {
         snprintf(path, sizeof path, "%s/frames/liquid_%05d.vdb", dir, frame);
         pfsph_vdb_frame vf = {.mesh = &m,

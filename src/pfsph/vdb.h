@@ -1,6 +1,6 @@
 /* The liquid as an OpenVDB level set for volume tools (Houdini, Blender): a C interface to the
  * optional C++ exporter (src/vdb/vdb.cpp, built when OpenVDB is found: PFSPH_OPENVDB). Without
- * it every function here fails with PFSPH_EINPUT saying so. docs/artists.md#openvdb. */
+ * it every function here fails with PFSPH_EINPUT saying so. docs/artists.md#openvdb-level-sets-houdini-blender. */
 #ifndef PFSPH_VDB_H
 #define PFSPH_VDB_H
 

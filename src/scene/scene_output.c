@@ -65,7 +65,7 @@ static int parse_surface(parser *p, const cJSON *v)
                     if (!pfsph_vdb_available())
                         return pfsph__json_fail(&p->ctx, ep,
                                                 "\"vdb\": this build of pfsph has no OpenVDB (Debian: libopenvdb-dev, "
-                                                "then rebuild; docs/artists.md#openvdb)");
+                                                "then rebuild; docs/artists.md#openvdb-level-sets-houdini-blender)");
                     o->vdb = true;
                 } else
                     return pfsph__json_fail(&p->ctx, ep,

@@ -1,7 +1,7 @@
 /* The OpenVDB exporter behind src/pfsph/vdb.h: the liquid's mesh as a narrow-band level set
  * (openvdb::tools::meshToLevelSet), a velocity grid on its band and a fog volume, written to
  * memory and then through the library's checked atomic writer; the reader for the tests.
- * Compiled only when OpenVDB is found (PFSPH_OPENVDB); docs/artists.md#openvdb. */
+ * Compiled only when OpenVDB is found (PFSPH_OPENVDB); docs/artists.md#openvdb-level-sets-houdini-blender. */
 #include <openvdb/openvdb.h>
 #include <openvdb/io/Stream.h>
 #include <openvdb/tools/Interpolation.h>

@@ -3,7 +3,7 @@
 
 #define NO_VDB                                                                                   \
     "this build of pfsph has no OpenVDB (Debian: apt-get install libopenvdb-dev, then rebuild; " \
-    "docs/artists.md#openvdb)"
+    "docs/artists.md#openvdb-level-sets-houdini-blender)"
 
 bool pfsph_vdb_available(void) { return false; }
 
