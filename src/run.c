@@ -87,7 +87,7 @@ static int frame_file(const char *name, long *num)
         while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
         if (!digits) return 0;
         if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj") ||
-            !strcmp(p, ".geo") || !strcmp(p, ".bgeo")) {
+            !strcmp(p, ".geo") || !strcmp(p, ".bgeo") || !strcmp(p, ".vdb")) {
             *num = v;
             return 1;
         }
@@ -545,6 +545,11 @@ static int truncate_csv(const char *path, const char *header, int last, long *ke
 /* the frame count fits an int (and the file names) */
 static int check_end(const pfsph_scene *s, double end, pfsph_error *err)
 {
+    /* at most the range of $.time.end: with a tiny fps the frame count alone let `--end 2e300`
+     * through, a run that never ended (the attack of issue 33, repeated) */
+    if (isfinite(end) && end > PFSPH_MAX_END)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: end time %g s: more than %g s, the range of $.time.end", s->source,
+                          end, PFSPH_MAX_END);
     if (!isfinite(end) || !(end >= 0) || floor(end * s->fps + 1e-9) > PFSPH_MAX_FRAMES)
         return pfsph_fail(err, PFSPH_EINPUT,
                           "%s: end time %g s at %g fps ($.time.fps) makes %.3g frames, more "

@@ -21,6 +21,7 @@
 #include "mpi/mpi_cli.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
+#include "pfsph/vdb.h"
 #include "physics/solver.h"
 #ifdef PFSPH_HAVE_VIEWER
 #include "view/view.h"
@@ -32,7 +33,7 @@ static const char *USAGE =
     "       pfsph check SCENE\n"
     "       pfsph render RUN_DIR [--video] [--color-by phase|speed|density|pressure]\n"
     "                            [--size WxH] [--particles] [--all-walls] [--no-legend]\n"
-    "       pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--droplet R]\n"
+    "       pfsph mesh RUN_DIR [--formats ply,obj,vtp,vdb] [--smooth N] [--isotropic] [--droplet R]\n"
     "                  [--threads N]\n"
     "       pfsph export RUN_DIR --houdini [--ascii | --classic]\n"
     "       pfsph view [SCENE | RUN_DIR] [--screenshot FILE --frames N] [...]\n"
@@ -112,15 +113,16 @@ static const char *HELP_RENDER =
     "  -h, --help              this text\n";
 
 static const char *HELP_MESH =
-    "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp] [--smooth N] [--isotropic] [--droplet R]\n"
+    "usage: pfsph mesh RUN_DIR [--formats ply,obj,vtp,vdb] [--smooth N] [--isotropic] [--droplet R]\n"
     "                  [--threads N]\n"
     "\n"
     "Reconstruct the liquid surface of every fluid frame of RUN_DIR (a finished or stopped\n"
-    "run) into RUN_DIR/frames/liquid_NNNNN.{ply,obj,vtp}, one closed mesh per fluid phase with\n"
+    "run) into RUN_DIR/frames/liquid_NNNNN.{ply,obj,vtp,vdb}, one closed mesh per fluid phase with\n"
     "the phase per face, and rewrite the .pvd collections. Anisotropic kernels (Yu & Turk 2013);\n"
     "docs/surfaces.md. Settings default to the scene's output.surface.\n"
     "\n"
-    "  --formats LIST  comma-separated: ply, obj, vtp (default: the scene's, else ply,vtp)\n"
+    "  --formats LIST  comma-separated: ply, obj, vtp, vdb (an OpenVDB level set: its grids are\n"
+    "                  the scene's vdb_grids; default: the scene's formats, else ply,vtp)\n"
     "  --smooth N      Taubin smoothing passes of the mesh, 0..100 (default 0)\n"
     "  --isotropic     spherical kernels instead of anisotropic ones\n"
     "  --droplet R     blob radius of isolated particles in spacings (default 0.62: their own\n"
@@ -366,6 +368,8 @@ static int cmd_run(int argc, char **argv)
             end = strtod(argv[i], &e);
             if (*e || e == argv[i] || !(end >= 0) || !isfinite(end))
                 return usage_error("--end: '%s' is not a finite time >= 0", argv[i]);
+            if (end > PFSPH_MAX_END)
+                return usage_error("--end: '%s' is more than 1e6 s, the range of $.time.end", argv[i]);
         } else if (!strcmp(a, "--resume")) {
             if (++i >= argc) return usage_error("%s needs a run directory", a);
             resume = argv[i];
@@ -677,11 +681,16 @@ static int cmd_mesh(int argc, char **argv)
             so.ply = strstr(argv[i], "ply") != NULL;
             so.obj = strstr(argv[i], "obj") != NULL;
             so.vtp = strstr(argv[i], "vtp") != NULL;
+            so.vdb = strstr(argv[i], "vdb") != NULL;
             char tmp[256];
             snprintf(tmp, sizeof tmp, "%s", argv[i]);
             for (char *t = strtok(tmp, ","); t; t = strtok(NULL, ","))
-                if (strcmp(t, "ply") && strcmp(t, "obj") && strcmp(t, "vtp"))
-                    return usage_error("--formats: unknown format '%s' (ply, obj, vtp)", t);
+                if (strcmp(t, "ply") && strcmp(t, "obj") && strcmp(t, "vtp") && strcmp(t, "vdb"))
+                    return usage_error("--formats: unknown format '%s' (ply, obj, vtp, vdb)", t);
+            if (so.vdb && !pfsph_vdb_available())
+                return usage_error("%s",
+                                   "--formats vdb: this build of pfsph has no OpenVDB (Debian: libopenvdb-dev, "
+                                   "then rebuild; docs/artists.md#openvdb-level-sets-houdini-blender)");
             set = true;
         } else if (!strcmp(a, "--smooth")) {
             char *end = NULL;

@@ -12,8 +12,10 @@
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
 
-/* Spray, foam, bubble (a diffuse particle's type). */
-static const float PFSPH__DIFFUSE_COL[3][3] = {{0.98f, 0.98f, 0.98f}, {0.80f, 0.82f, 0.85f}, {0.55f, 0.78f, 0.98f}};
+/* Spray, foam, bubble (a diffuse particle's type): white, cream, light blue. Foam was a light
+ * grey (0.80, 0.82, 0.85), which read as the walls' grey (0.78, 0.78, 0.80) in previews (issue
+ * 33): cream differs from the walls, the spray and the bubbles by 0.35 or more in a channel. */
+static const float PFSPH__DIFFUSE_COL[3][3] = {{0.98f, 0.98f, 0.98f}, {0.96f, 0.84f, 0.45f}, {0.55f, 0.78f, 0.98f}};
 
 /* Viridis, sampled at five stops and interpolated linearly; t is clamped to 0..1 (NaN: 0). */
 static inline void pfsph__viridis(double t, float out[3])

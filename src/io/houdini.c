@@ -1,5 +1,5 @@
 /* `pfsph export RUN --houdini`: a run's frames as Houdini geometry (houdini.h): fluid and diffuse
- * particles as point clouds with stable ids, pscale and their fields, liquid meshes with velocity,
+ * particles as point clouds (ordered by id when the run wrote ids), pscale and their fields, liquid meshes with velocity,
  * body surfaces and the static solids as polygons; binary JSON (.bgeo) or JSON text (.geo). */
 #include "pfsph/houdini.h"
 

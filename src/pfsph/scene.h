@@ -112,6 +112,8 @@ int pfsph__body_density_check(double density, double mass, double volume, char *
 typedef struct pfsph_surface_output {
     bool on;
     bool ply, obj, vtp; /* formats */
+    bool vdb;           /* an OpenVDB level set per frame (3D; src/pfsph/vdb.h) */
+    unsigned vdb_grids; /* its grids, PFSPH_VDB_* (0: surface and velocity) */
     bool isotropic;     /* spherical kernels instead of Yu & Turk's anisotropic ones */
     int smoothing;      /* Taubin passes */
     double cell;        /* marching-cubes cell / spacing (0: default 0.5) */
@@ -231,6 +233,8 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
  * tensions and contact angles the final matrix predicts (for `pfsph check`). */
 void pfsph_pairwise_report(const pfsph_scene *s, FILE *out);
 
+/* The longest simulated time of a run [s]: $.time.end and `--end` alike. */
+#define PFSPH_MAX_END 1e6
 /* The most frames (of 1/fps) one run holds: an end time x fps above it is refused (scene and
  * pfsph_run), and so is a checkpoint whose frame is above it. */
 #define PFSPH_MAX_FRAMES 100000000

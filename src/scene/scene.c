@@ -122,7 +122,7 @@ static int parse_time(parser *p, const cJSON *root)
     static const char *const keys[] = {"end", "fps", "cfl", "dt_min", "dt_max", NULL};
     const char *P = "$.time";
     TRY(pfsph__json_check_keys(o, P, keys, &p->ctx));
-    TRY(positive(p, o, P, "end", 1e6, &s->end_time));
+    TRY(positive(p, o, P, "end", PFSPH_MAX_END, &s->end_time));
     TRY(positive(p, o, P, "fps", 1e4, &s->fps));
     TRY(positive(p, o, P, "cfl", 1.0, &s->cfl));
     TRY(positive(p, o, P, "dt_min", 1.0, &s->dt_min));

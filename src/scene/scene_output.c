@@ -4,9 +4,32 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "pfsph/vdb.h"
 #include "scene/scene_parser.h"
 
-/* output.surface: true, false or {"formats", "smoothing", "isotropic", "cell", "droplet"} */
+/* output.surface.vdb_grids: which grids a frame's .vdb holds */
+static int parse_vdb_grids(parser *p, const cJSON *v, unsigned *grids)
+{
+    const char *P = "$.output.surface.vdb_grids";
+    if (!v) return PFSPH_OK;
+    if (!cJSON_IsArray(v) || !cJSON_GetArraySize(v))
+        return pfsph__json_fail(&p->ctx, P,
+                                "expected a non-empty array of strings (\"surface\", \"velocity\", \"density\")");
+    *grids = 0;
+    int i = 0;
+    for (const cJSON *e = v->child; e; e = e->next, i++) {
+        char ep[64];
+        path_index(ep, sizeof ep, P, i);
+        const char *n = cJSON_IsString(e) ? e->valuestring : "";
+        if (!strcmp(n, "surface")) *grids |= PFSPH_VDB_SURFACE;
+        else if (!strcmp(n, "velocity")) *grids |= PFSPH_VDB_VELOCITY;
+        else if (!strcmp(n, "density")) *grids |= PFSPH_VDB_DENSITY;
+        else return pfsph__json_fail(&p->ctx, ep, "unknown grid (expected \"surface\", \"velocity\" or \"density\")");
+    }
+    return PFSPH_OK;
+}
+
+/* output.surface: true, false or {"formats", "smoothing", "isotropic", "cell", "droplet", "vdb_grids"} */
 static int parse_surface(parser *p, const cJSON *v)
 {
     pfsph_surface_output *o = &p->s->output.surface;
@@ -14,7 +37,7 @@ static int parse_surface(parser *p, const cJSON *v)
     const char *P = "$.output.surface";
     if (cJSON_IsBool(v)) o->on = cJSON_IsTrue(v);
     else if (cJSON_IsObject(v)) {
-        static const char *const keys[] = {"formats", "smoothing", "isotropic", "cell", "droplet", NULL};
+        static const char *const keys[] = {"formats", "smoothing", "isotropic", "cell", "droplet", "vdb_grids", NULL};
         TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
         o->on = true;
         TRY(pfsph__json_int(v, P, "smoothing", 0, 100, &o->smoothing, &p->ctx));
@@ -28,8 +51,8 @@ static int parse_surface(parser *p, const cJSON *v)
         if (f) {
             if (!cJSON_IsArray(f) || !cJSON_GetArraySize(f))
                 return pfsph__json_fail(&p->ctx, "$.output.surface.formats",
-                                        "expected a non-empty array of strings (\"ply\", \"obj\", \"vtp\")");
-            o->ply = o->obj = o->vtp = false;
+                                        "expected a non-empty array of strings (\"ply\", \"obj\", \"vtp\", \"vdb\")");
+            o->ply = o->obj = o->vtp = o->vdb = false;
             int i = 0;
             for (const cJSON *e = f->child; e; e = e->next, i++) {
                 char ep[64];
@@ -38,18 +61,28 @@ static int parse_surface(parser *p, const cJSON *v)
                 if (!strcmp(n, "ply")) o->ply = true;
                 else if (!strcmp(n, "obj")) o->obj = true;
                 else if (!strcmp(n, "vtp")) o->vtp = true;
-                else return pfsph__json_fail(&p->ctx, ep, "unknown format (expected \"ply\", \"obj\" or \"vtp\")");
+                else if (!strcmp(n, "vdb")) {
+                    if (!pfsph_vdb_available())
+                        return pfsph__json_fail(&p->ctx, ep,
+                                                "\"vdb\": this build of pfsph has no OpenVDB (Debian: libopenvdb-dev, "
+                                                "then rebuild; docs/artists.md#openvdb-level-sets-houdini-blender)");
+                    o->vdb = true;
+                } else
+                    return pfsph__json_fail(&p->ctx, ep,
+                                            "unknown format (expected \"ply\", \"obj\", \"vtp\" or \"vdb\")");
             }
         }
+        TRY(parse_vdb_grids(p, get(v, "vdb_grids"), &o->vdb_grids));
     } else
         return pfsph__json_fail(&p->ctx, P,
-                                "expected true, false or an object (formats, smoothing, isotropic, cell, droplet)");
+                                "expected true, false or an object (formats, smoothing, isotropic, cell, droplet, "
+                                "vdb_grids)");
     /* 2D: the outline as VTP polylines only (docs/surfaces.md#2d-contours) */
     if (o->on && p->s->dim == 2) {
-        if (get(v, "formats") && (o->ply || o->obj))
+        if (get(v, "formats") && (o->ply || o->obj || o->vdb))
             return pfsph__json_fail(&p->ctx, "$.output.surface.formats",
                                     "a 2D scene's outline is written as VTP polylines only (formats [\"vtp\"])");
-        o->ply = o->obj = false;
+        o->ply = o->obj = o->vdb = false;
         o->vtp = true;
     }
     return PFSPH_OK;

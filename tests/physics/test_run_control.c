@@ -116,6 +116,22 @@ static void test_end_on_frame(void **state)
     assert_int_equal(tu_run(cmd, out, sizeof out), 0);
     snprintf(path, sizeof path, "%s/end/frames/fluid_00003.vtp", tu_tmpdir());
     assert_int_equal(stat(path, &sb), 0);
+    /* an end beyond $.time.end's range: at fps 1e-300 `--end 2e300` is 2 frames, and ran for
+     * ever (found by tools/attack/attack.py, issue 33 repeated); refused at once */
+    char tiny[600], text[2048];
+    snprintf(tiny, sizeof tiny, "%s/tiny_fps.json", tu_tmpdir());
+    snprintf(text, sizeof text, "%s", SCENE);
+    char *f = strstr(text, "\"fps\": 100");
+    assert_non_null(f);
+    memcpy(f, "\"fps\": 1e-300", 14);
+    memmove(f + 14, f + 11, strlen(f + 11) + 1);
+    assert_int_equal(tu_write_file(tiny, text), 0);
+    snprintf(cmd, sizeof cmd, "timeout 60 '%s' run '%s' -o '%s/end2' --quiet --end 2e300", tu_pfsph_bin(), tiny,
+             tu_tmpdir());
+    st = tu_run(cmd, out, sizeof out);
+    printf("--end 2e300 at 1e-300 fps: exit %d: %s", st, out);
+    assert_int_equal(st, 2);
+    assert_non_null(strstr(out, "the range of $.time.end"));
 }
 
 /* The terminal's view of text with \r, \n and ESC [K (erase to the end of the line): the last

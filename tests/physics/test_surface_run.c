@@ -277,6 +277,22 @@ static void test_contour_run(void **state)
     }
     assert_int_equal(tu_pfsph("", out, sizeof out, "mesh '%s' --formats ply", run), 2);
     assert_non_null(strstr(out, "VTP"));
+    /* a 2D run whose scene has no output.surface: `pfsph mesh` writes the outlines (it refused,
+     * the scene's default formats being ply and vtp) */
+    char text[2048], *at;
+    snprintf(text, sizeof text, "%s", SCENE2);
+    const char *cut = ", \"surface\": true";
+    at = strstr(text, cut);
+    assert_non_null(at);
+    memmove(at, at + strlen(cut), strlen(at + strlen(cut)) + 1);
+    assert_int_equal(tu_write_file(scene, text), 0);
+    assert_int_equal(tu_pfsph("", out, sizeof out, "run '%s' -o '%s' --force --quiet --end 0.05", scene, run), 0);
+    snprintf(path, sizeof path, "%s/frames/liquid_00001.vtp", run);
+    assert_null(fopen(path, "rb"));
+    assert_int_equal(tu_pfsph("", out, sizeof out, "mesh '%s'", run), 0);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    fclose(f);
 }
 
 static void test_refusals(void **state)

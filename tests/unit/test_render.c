@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "io/colormap.h"
 #include "pfsph/io.h"
 #include "pfsph/render.h"
 #include "pfsph/scene.h"
@@ -330,7 +331,19 @@ static void test_render_key(void **state)
     rgb8(sc->phases[1].color, gas);
     rgb8(wf, wall);
     free(sc);
-    const uint8_t spray[3] = {250, 250, 250}, foam[3] = {204, 209, 217}, bubble[3] = {140, 199, 250};
+    uint8_t spray[3], foam[3], bubble[3];
+    rgb8(PFSPH__DIFFUSE_COL[0], spray);
+    rgb8(PFSPH__DIFFUSE_COL[1], foam);
+    rgb8(PFSPH__DIFFUSE_COL[2], bubble);
+    /* foam was a light grey that read as the walls' (issue 33): at least 0.3 in some channel
+     * from the plain and the slate wall colours, the spray and the bubbles */
+    const float grey[3] = {0.78f, 0.78f, 0.80f}, slate[3] = {0.46f, 0.48f, 0.53f};
+    const float *other[4] = {grey, slate, PFSPH__DIFFUSE_COL[0], PFSPH__DIFFUSE_COL[2]};
+    for (int j = 0; j < 4; j++) {
+        float d = 0;
+        for (int k = 0; k < 3; k++) d = fmaxf(d, fabsf(PFSPH__DIFFUSE_COL[1][k] - other[j][k]));
+        assert_true(d >= 0.3f);
+    }
 
     pfsph_render_opts ro = {.width = 320, .height = 180, .color_by = "phase", .last = -1, .quiet = true};
     int count = -1;
