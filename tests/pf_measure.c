@@ -2,9 +2,11 @@
 #include "pf_measure.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "pfsph/params.h"
 #include "pfsph/sim.h"
@@ -18,6 +20,28 @@ static const char *vec(char *buf, size_t cap, int dim, double x, double y, doubl
     if (dim == 2) snprintf(buf, cap, "[%g, %g]", x, y);
     else snprintf(buf, cap, "[%g, %g, %g]", x, y, z);
     return buf;
+}
+
+/* Appends a row to validation/<name> in the working directory (the data of
+ * tools/validation_plots.py), writing the header first when the file is new; a by-product: the
+ * checks do not depend on it, so a failure to write is ignored. */
+void pfm_csv_row(const char *name, const char *header, const char *fmt, ...)
+{
+    char path[256];
+    mkdir("validation", 0777);
+    snprintf(path, sizeof path, "validation/%s", name);
+    FILE *probe = fopen(path, "r");
+    const int fresh = probe == NULL;
+    if (probe) fclose(probe);
+    FILE *fp = fopen(path, "a");
+    if (!fp) return;
+    if (fresh) fprintf(fp, "%s\n", header);
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(fp, fmt, ap);
+    va_end(ap);
+    fprintf(fp, "\n");
+    fclose(fp);
 }
 
 /* ---- contact angles ---- */
@@ -201,6 +225,8 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
         print_message("target %5.1f deg%s: measured %6.1f deg (sd %.1f over %d samples, %.2f-%.2f s)\n", target[q],
                       ratio ? " (Eq. 21 of the ratio)" : "", mean, sd, cnt[q], cfg->t_avg0, cfg->t_avg1);
         th[q] = mean;
+        pfm_csv_row("contact_angles.csv", "dim,target_deg,measured_deg,sd_deg,samples", "%d,%g,%.2f,%.2f,%d", cfg->dim,
+                    target[q], mean, sd, cnt[q]);
     }
     for (int q = 0; q < nd; q++) assert_true(low[q] < 1.0);
     for (int q = 0; q < nd; q++) assert_true(fabs(th[q] - target[q]) <= cfg->tol);
@@ -422,6 +448,9 @@ void pfm_laplace_run(const pfm_laplace *cfg, const double *radii, int nr)
     double x[PFM_MAXR], y[PFM_MAXR], Rmax = 0;
     for (int i = 0; i < nr; i++) x[i] = (double)(cfg->dim - 1) / dr[i].Re, y[i] = dr[i].p, Rmax = fmax(Rmax, dr[i].Re);
     const tu_line fit = tu_line_fit(nr, x, y);
+    for (int i = 0; i < nr; i++)
+        pfm_csv_row("laplace.csv", "dim,R_spacings,R_e_m,x_per_m,p_in_pa,p_err_pa,sigma_target",
+                    "%d,%g,%.5f,%.4f,%.3f,%.3f,%g", cfg->dim, dr[i].Rs, dr[i].Re, x[i], dr[i].p, dr[i].se, SIGMA);
     print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n", fit.slope,
                   fit.slope / SIGMA, fit.icpt, 0.25 * SIGMA / Rmax, fit.r2);
     if (!cfg->checks) return;

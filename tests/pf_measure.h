@@ -9,6 +9,14 @@
 
 struct pfsph_ctx;
 
+/* Appends a row (printf-style) to validation/<name> in the working directory, the header line
+ * first when the file is new: the data of tools/validation_plots.py (docs/validation.md). */
+void pfm_csv_row(const char *name, const char *header, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 /* ---- contact angles (test_pf_contact_angle.c, _ends.c, test_pf_contact_angle_3d.c) ---- */
 
 #define PFM_MAXDROP 8

@@ -180,6 +180,7 @@ static void write_csv(const front *runs[], const char *names[], int nr)
     for (int r = 0; r < nr; r++)
         for (int k = 0; k < runs[r]->n; k++)
             fprintf(fp, "%s,%zu,%.4f,%.4f\n", names[r], runs[r]->np, runs[r]->T[k], runs[r]->Z[k]);
+    for (int k = 0; k < NMM; k++) fprintf(fp, "martin_moyce_1952,0,%.3f,%.3f\n", MM[k][0], MM[k][1]);
     fclose(fp);
 }
 
