@@ -65,7 +65,8 @@ def dam_break(data, out):
 
 
 def hysing(data, out):
-    cases = [c for c in (1, 2) if os.path.exists(os.path.join(data, "hysing_case%d.csv" % c))]
+    cases = [c for c in (1, 2) if os.path.exists(os.path.join(data, "hysing_case%d.csv" % c))
+             and os.path.exists(os.path.join(data, "hysing_case%d_reference.csv" % c))]
     if not cases:
         return print("skip Hysing: no hysing_case*.csv in", data)
     fig, axs = plt.subplots(len(cases), 3, figsize=(13, 3.8 * len(cases)), squeeze=False)
@@ -129,7 +130,9 @@ def spheric2(data, out):
         ax.set_ylabel("height [m]")
     for i, (p, col) in enumerate((("P1", 5), ("P3", 6), ("P5", 7), ("P7", 8))):
         ax = axs[1][i]
-        ax.plot(t, [float(r[p]) / 1000 for r in s], "-", lw=1, label="pfsph, d = 0.04 m")
+        v = np.array([float(r[p]) / 1000 for r in s])
+        ax.plot(t, v, "-", lw=0.6, color="0.65", label="pfsph, d = 0.04 m, every 0.01 s")
+        ax.plot(t[2:-2], np.convolve(v, np.ones(5) / 5, mode="same")[2:-2], "-", label="pfsph, 0.05 s running mean")
         ax.plot(exp[:, 0], exp[:, col] / 1000, "ko", mfc="none", label="experiment (MARIN), ~50 ms means")
         if p == "P1":
             ax.plot([0.415], [11.24], "k^", label="experiment's peak, 11.2 kPa at 0.415 s")

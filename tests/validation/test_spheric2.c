@@ -17,23 +17,24 @@
  * sampled every 0.01 s.
  * Measurement: a height is the water volume per area under the gauge, sum d^3 W(r) over the
  * particles with W the 2D Wendland kernel of support 2 d (integral 1) of their horizontal
- * distance r to the gauge, so a splash counts by its mass, not its reach; a pressure is the Wendland-weighted mean of the fluid particles' pressures within 2 d
- * of the point d / 2 outside the face (where the first particle layer sits), zero while the
- * weights add to less than a quarter of a full support's (the sensor is dry).
+ * distance r to the gauge, so a splash counts by its mass, not its reach; a pressure is the
+ * Wendland-weighted mean of the fluid particles' pressures within 2 d of the point d / 2 outside
+ * the face (where the first particle layer sits), zero while the weights add to less than a
+ * quarter of a full support's (the sensor is dry).
  *
- * Reference, typed in (see EXP below): points read from the experiment's records (SPHERIC test
- * 2 data file, MARIN's measurements, 1 kHz), each the mean over the 64 ms after the time given;
- * they are marked on the plot beside the pfsph curves. The published SPH comparisons
- * (DualSPHysics: Crespo et al. 2015, Comput. Phys. Commun. 187, Figs. 9-10, H2 and P1 at
- * d = 0.0125-0.02 m; Gomez-Gesteira et al. 2012) match the impact time within ~0.02 s and
- * the H curves within a few cm; see docs/validation.md.
- *
- * Checks (why these bounds): the front reaches P1 (the first time its pressure exceeds 1 kPa)
- * within 0.05 s of the experiment's 0.40 s (coarse spacing: the front is a few d thick); the
- * reservoir gauge H4 within 0.05 m of the experiment at 0.5, 1 and 2 s (it drains smoothly; the
- * coarse column's error is about d); the impact's peak at P1 between 0.3 and 3 times the
- * experiment's (an SPH pressure at d = 0.04 m smooths a 10 ms spike over a kernel; the factor
- * says the impact is there and not absurd); mass: no particle lost. Under AddressSanitizer it
+ * Reference, typed in (spheric2_exp.inc): points read from the experiment's records (the SPHERIC
+ * test 2 data file, MARIN's measurements at 1 kHz): heights at the time given, pressures a mean
+ * over the next ~50 ms; P1's peak, 11.2 kPa at 0.415 s, read from the record. Published SPH
+ * comparisons with this experiment exist (DualSPHysics: Crespo et al. 2011, PLoS ONE 6(6)
+ * e20685); their figures were not available here, so docs/validation.md quotes none.
+ * Checks (why these bounds; measured values in docs/validation.md): the front reaches P1 (the
+ * first time its pressure exceeds 1 kPa) within 0.05 s of the experiment's 0.394 s (the front is
+ * a few d thick at this spacing); the heights in front of the box (x 0.992) and in the reservoir
+ * (x 2.638) within 0.06 m of the experiment at every reference time (about 1.5 d; measured at
+ * most 0.048 and 0.045); P1's impact peak between 1 and 5 times the record's 11.2 kPa (a
+ * solver that lost the impact, or blew up, fails; PCISPH's impact spike at this spacing reads
+ * 3.3x); P3's 0.05 s means from 0.8 s on (the flow after the impact) within a factor 2 of the
+ * experiment's (measured 0.96-1.84); no particle lost. Under AddressSanitizer it
  * skips (tu_release_only). Writes validation/spheric2.csv for tools/validation_plots.py, which
  * reads the experiment's points from spheric2_exp.inc beside this file.
  * Study knobs: PF_D (spacing [m]), PF_T (end [s]), PF_SOLVER. */
@@ -135,6 +136,15 @@ static double h_at(const series *r, int g, double t) /* mean over [t, t + 0.064]
     return c ? m / c : NAN;
 }
 
+static double p_at(const series *r, int s, double t) /* mean over [t, t + 0.05] */
+{
+    double m = 0;
+    int c = 0;
+    for (int k = 0; k < r->n; k++)
+        if (r->t[k] >= t - 1e-9 && r->t[k] <= t + 0.05 + 1e-9) m += r->p[k][s], c++;
+    return c ? m / c : NAN;
+}
+
 static void test_spheric2(void **state)
 {
     (void)state;
@@ -189,11 +199,10 @@ static void test_spheric2(void **state)
     }
 
     /* against the experiment's points */
-    double pk = 0, pk_exp = 0;
+    double pk = 0;
+    const double pk_exp = 11240; /* the record's P1 maximum, at 0.415 s (1 kHz) */
     for (int k = 0; k < r.n; k++)
         if (r.t[k] < 1.0 && r.p[k][0] > pk) pk = r.p[k][0];
-    for (int e = 0; e < NEXP; e++)
-        if (EXP[e][0] < 1.0 && EXP[e][5] > pk_exp) pk_exp = EXP[e][5];
     printf("   t    H1 (exp)      H2 (exp)      H3 (exp)      H4 (exp)\n");
     for (int e = 0; e < NEXP; e++) {
         if (EXP[e][0] > T) continue;
@@ -202,17 +211,31 @@ static void test_spheric2(void **state)
         printf("\n");
     }
     const double ta = p1_arrival(&r);
-    printf("P1 arrival (> 1 kPa) %.2f s (experiment 0.40 s); P1 peak before 1 s %.0f Pa (0.01 s samples; experiment's "
-           "64 ms means reach %.0f Pa)\n",
-           ta, pk, pk_exp);
+    double dh2 = 0, dh4 = 0, r3lo = 1e9, r3hi = 0;
+    printf("   t    P1 (exp)        P3 (exp)        P5 (exp)        P7 (exp)   [Pa, 0.05 s means]\n");
+    for (int e = 0; e < NEXP; e++) {
+        if (EXP[e][0] > T) continue;
+        printf("%5.2f  %6.0f (%5.0f)  %6.0f (%5.0f)  %6.0f (%5.0f)  %6.0f (%5.0f)\n", EXP[e][0], p_at(&r, 0, EXP[e][0]),
+               EXP[e][5], p_at(&r, 2, EXP[e][0]), EXP[e][6], p_at(&r, 4, EXP[e][0]), EXP[e][7], p_at(&r, 6, EXP[e][0]),
+               EXP[e][8]);
+        dh2 = fmax(dh2, fabs(h_at(&r, 1, EXP[e][0]) - EXP[e][2]));
+        dh4 = fmax(dh4, fabs(h_at(&r, 3, EXP[e][0]) - EXP[e][4]));
+        if (EXP[e][0] >= 0.8) {
+            const double q = p_at(&r, 2, EXP[e][0]) / EXP[e][6];
+            r3lo = fmin(r3lo, q), r3hi = fmax(r3hi, q);
+        }
+    }
+    printf("P1 arrival (> 1 kPa) %.2f s (experiment 0.394 s); P1 peak before 1 s %.0f Pa (0.01 s samples; the "
+           "experiment's record %.0f Pa: ratio %.2f); worst height differences H2 %.3f m, H4 %.3f m; P3 from 0.8 s "
+           "over the experiment's %.2f-%.2f\n",
+           ta, pk, pk_exp, pk / pk_exp, dh2, dh4, r3lo, r3hi);
     fflush(stdout);
-    if (d != 0.04 || T < 2) return; /* study runs */
+    if (d != 0.04 || T < 6) return; /* study runs */
     assert_true(r.np1 == r.np0);
-    assert_true(fabs(ta - 0.40) <= 0.05);
-    for (int e = 0; e < NEXP; e++)
-        if (fabs(EXP[e][0] - 0.5) < 1e-6 || fabs(EXP[e][0] - 1.0) < 1e-6 || fabs(EXP[e][0] - 2.0) < 1e-6)
-            assert_true(fabs(h_at(&r, 3, EXP[e][0]) - EXP[e][4]) <= 0.05);
-    assert_true(pk >= 0.3 * pk_exp && pk <= 3 * pk_exp);
+    assert_true(fabs(ta - 0.394) <= 0.05);
+    assert_true(dh2 <= 0.06 && dh4 <= 0.06);
+    assert_true(pk >= pk_exp && pk <= 5 * pk_exp);
+    assert_true(r3lo >= 0.5 && r3hi <= 2.0);
 }
 
 int main(int argc, char **argv)
