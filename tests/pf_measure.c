@@ -2,9 +2,11 @@
 #include "pf_measure.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "pfsph/params.h"
 #include "pfsph/sim.h"
@@ -18,6 +20,28 @@ static const char *vec(char *buf, size_t cap, int dim, double x, double y, doubl
     if (dim == 2) snprintf(buf, cap, "[%g, %g]", x, y);
     else snprintf(buf, cap, "[%g, %g, %g]", x, y, z);
     return buf;
+}
+
+/* Appends a row to validation/<name> in the working directory (the data of
+ * tools/validation_plots.py), writing the header first when the file is new; a by-product: the
+ * checks do not depend on it, so a failure to write is ignored. */
+void pfm_csv_row(const char *name, const char *header, const char *fmt, ...)
+{
+    char path[256];
+    mkdir("validation", 0777);
+    snprintf(path, sizeof path, "validation/%s", name);
+    FILE *probe = fopen(path, "r");
+    const int fresh = probe == NULL;
+    if (probe) fclose(probe);
+    FILE *fp = fopen(path, "a");
+    if (!fp) return;
+    if (fresh) fprintf(fp, "%s\n", header);
+    va_list ap;
+    va_start(ap, fmt);
+    vfprintf(fp, fmt, ap);
+    va_end(ap);
+    fprintf(fp, "\n");
+    fclose(fp);
 }
 
 /* ---- contact angles ---- */
@@ -201,6 +225,8 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
         print_message("target %5.1f deg%s: measured %6.1f deg (sd %.1f over %d samples, %.2f-%.2f s)\n", target[q],
                       ratio ? " (Eq. 21 of the ratio)" : "", mean, sd, cnt[q], cfg->t_avg0, cfg->t_avg1);
         th[q] = mean;
+        pfm_csv_row("contact_angles.csv", "dim,target_deg,measured_deg,sd_deg,samples", "%d,%g,%.2f,%.2f,%d", cfg->dim,
+                    target[q], mean, sd, cnt[q]);
     }
     for (int q = 0; q < nd; q++) assert_true(low[q] < 1.0);
     for (int q = 0; q < nd; q++) assert_true(fabs(th[q] - target[q]) <= cfg->tol);
@@ -422,10 +448,121 @@ void pfm_laplace_run(const pfm_laplace *cfg, const double *radii, int nr)
     double x[PFM_MAXR], y[PFM_MAXR], Rmax = 0;
     for (int i = 0; i < nr; i++) x[i] = (double)(cfg->dim - 1) / dr[i].Re, y[i] = dr[i].p, Rmax = fmax(Rmax, dr[i].Re);
     const tu_line fit = tu_line_fit(nr, x, y);
+    for (int i = 0; i < nr; i++)
+        pfm_csv_row("laplace.csv", "dim,R_spacings,R_e_m,x_per_m,p_in_pa,p_err_pa,sigma_target",
+                    "%d,%g,%.5f,%.4f,%.3f,%.3f,%g", cfg->dim, dr[i].Rs, dr[i].Re, x[i], dr[i].p, dr[i].se, SIGMA);
     print_message("fit: slope %.4f N/m = %.3f sigma, intercept %.3f Pa (bound %.3f), R^2 %.4f\n", fit.slope,
                   fit.slope / SIGMA, fit.icpt, 0.25 * SIGMA / Rmax, fit.r2);
     if (!cfg->checks) return;
     assert_true(fabs(fit.slope / SIGMA - 1) <= 0.15);
     assert_true(fabs(fit.icpt) <= 0.25 * SIGMA / Rmax);
     assert_true(fit.r2 >= 0.9);
+}
+
+/* ---- a 2D bubble's shape ---- */
+
+/* Wendland C2 (2D), support H; only ratios of it are used */
+static double bubble_wk(double r2, double H)
+{
+    double q = sqrt(r2) / H;
+    if (q >= 1) return 0;
+    double a = 1 - q;
+    return a * a * a * a * (1 + 4 * q);
+}
+
+static double lerp0(double a, double b) { return a / (a - b); } /* where a + t (b - a) = 0 */
+
+/* The bubble's outline: the 0.5 level of the Shepard colour field c = sum_gas W / sum W (support
+ * 2 d) on a grid of spacing d / 2, traced by marching squares; the area is that of the cells'
+ * sub-0.5 polygons summed exactly (each cell's polygon from the same interpolated crossings). */
+void pfm_bubble_measure(const pfsph_ctx *c, int gas, pfm_bubble *s)
+{
+    const pfsph_particles *f = c->fluid;
+    const double d = c->spacing, H = 2 * d, g = 0.5 * d;
+    double sx = 0, sy = 0, sv = 0;
+    double x0 = 1e30, y0 = 1e30, x1 = -1e30, y1 = -1e30;
+    int ng = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->phase[i] != gas) continue;
+        double x = f->x[i], y = f->y[i];
+        sx += x;
+        sy += y;
+        sv += f->vy[i];
+        ng++;
+        if (x < x0) x0 = x;
+        if (x > x1) x1 = x;
+        if (y < y0) y0 = y;
+        if (y > y1) y1 = y;
+    }
+    s->ngas = ng;
+    s->cx = sx / ng;
+    s->cy = sy / ng;
+    s->vy = sv / ng;
+    double mxx = 0, myy = 0, mxy = 0;
+    for (size_t i = 0; i < f->n; i++) {
+        if (f->phase[i] != gas) continue;
+        double dx = f->x[i] - s->cx, dy = f->y[i] - s->cy;
+        mxx += dx * dx;
+        myy += dy * dy;
+        mxy += dx * dy;
+    }
+    double tr = mxx + myy, det = mxx * myy - mxy * mxy, disc = sqrt(fmax(0, 0.25 * tr * tr - det));
+    s->aspect = sqrt((0.5 * tr - disc) / (0.5 * tr + disc));
+    s->hw = sqrt(myy / mxx);
+
+    /* colour field on the grid around the gas, particles within H of it */
+    x0 -= 2 * H;
+    y0 -= 2 * H;
+    x1 += 2 * H;
+    y1 += 2 * H;
+    const int nx = (int)ceil((x1 - x0) / g) + 1, ny = (int)ceil((y1 - y0) / g) + 1;
+    double *cf = calloc((size_t)nx * ny, sizeof *cf), *wt = calloc((size_t)nx * ny, sizeof *wt);
+    if (!cf || !wt) abort();
+    for (size_t i = 0; i < f->n; i++) {
+        double x = f->x[i], y = f->y[i];
+        if (x < x0 - H || x > x1 + H || y < y0 - H || y > y1 + H) continue;
+        int ia = (int)floor((x - H - x0) / g), ib = (int)ceil((x + H - x0) / g);
+        int ja = (int)floor((y - H - y0) / g), jb = (int)ceil((y + H - y0) / g);
+        for (int jj = ja < 0 ? 0 : ja; jj <= jb && jj < ny; jj++)
+            for (int ii = ia < 0 ? 0 : ia; ii <= ib && ii < nx; ii++) {
+                double dx = x0 + ii * g - x, dy = y0 + jj * g - y, w = bubble_wk(dx * dx + dy * dy, H);
+                wt[jj * nx + ii] += w;
+                if (f->phase[i] == gas) cf[jj * nx + ii] += w;
+            }
+    }
+    for (int k = 0; k < nx * ny; k++) cf[k] = (wt[k] > 0 ? cf[k] / wt[k] : 0) - 0.5; /* > 0: gas */
+    double P = 0, A = 0;
+    for (int jj = 0; jj + 1 < ny; jj++)
+        for (int ii = 0; ii + 1 < nx; ii++) {
+            /* corners counter-clockwise: (0,0) (1,0) (1,1) (0,1) */
+            const double v[4] = {cf[jj * nx + ii], cf[jj * nx + ii + 1], cf[(jj + 1) * nx + ii + 1],
+                                 cf[(jj + 1) * nx + ii]};
+            const double cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
+            /* polygon of the gas part of the cell (walk the corners, insert edge crossings) */
+            double px[8], py[8], ex[4], ey[4];
+            int np = 0, ne = 0;
+            for (int e = 0; e < 4; e++) {
+                int a = e, b = (e + 1) & 3;
+                if (v[a] > 0) {
+                    px[np] = cx[a];
+                    py[np++] = cy[a];
+                }
+                if ((v[a] > 0) != (v[b] > 0)) {
+                    double t = lerp0(v[a], v[b]);
+                    px[np] = cx[a] + t * (cx[b] - cx[a]);
+                    py[np++] = cy[a] + t * (cy[b] - cy[a]);
+                    ex[ne] = px[np - 1];
+                    ey[ne++] = py[np - 1];
+                }
+            }
+            for (int k = 0; k < np; k++) A += 0.5 * (px[k] * py[(k + 1) % np] - px[(k + 1) % np] * py[k]);
+            /* contour segments: crossings in walk order pair up (0-1, 2-3); for a saddle this
+             * joins the crossings of one corner region, either pairing has nearly the same length */
+            for (int k = 0; k + 1 < ne; k += 2) P += hypot(ex[k + 1] - ex[k], ey[k + 1] - ey[k]);
+        }
+    free(cf);
+    free(wt);
+    s->perim = P * g;
+    s->area = A * g * g;
+    s->circ = 2 * sqrt(PI * s->area) / s->perim;
 }

@@ -9,6 +9,14 @@
 
 struct pfsph_ctx;
 
+/* Appends a row (printf-style) to validation/<name> in the working directory, the header line
+ * first when the file is new: the data of tools/validation_plots.py (docs/validation.md). */
+void pfm_csv_row(const char *name, const char *header, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 /* ---- contact angles (test_pf_contact_angle.c, _ends.c, test_pf_contact_angle_3d.c) ---- */
 
 #define PFM_MAXDROP 8
@@ -81,5 +89,22 @@ typedef struct pfm_laplace {
 } pfm_laplace;
 
 void pfm_laplace_run(const pfm_laplace *cfg, const double *radii, int nr);
+
+/* ---- a 2D bubble's shape (test_pf_rising_bubble_hysing.c, test_hysing_cases.c) ---- */
+
+/* The gas particles' (phase index `gas`) centroid, mean vertical velocity and second moments,
+ * and the bubble's outline: the 0.5 level of the Shepard colour field c = sum_gas W / sum W
+ * (Wendland, support 2 d) on a grid of d / 2, traced by marching squares; circularity
+ * 2 sqrt(pi A) / P of that contour (Hysing et al. 2009's definition). */
+typedef struct pfm_bubble {
+    double cx, cy, vy;  /* gas centroid and mean vertical velocity */
+    double aspect;      /* sqrt(smaller / larger eigenvalue of the gas second moments) */
+    double hw;          /* sqrt(<dy^2> / <dx^2>): height over width, < 1 for a flattened bubble */
+    double circ;        /* circularity: 2 sqrt(pi A) / perimeter of the 0.5 contour */
+    double perim, area; /* that contour's length and enclosed area (marching squares) */
+    int ngas;
+} pfm_bubble;
+
+void pfm_bubble_measure(const struct pfsph_ctx *c, int gas, pfm_bubble *s);
 
 #endif

@@ -64,6 +64,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pf_measure.h"
 #include "pfsph/sim.h"
 #include "testutil.h"
 
@@ -90,121 +91,6 @@ static const char *SCENE =
     "   {\"phases\": [\"gas\", \"gas\"], \"sigma\": 0.245},"
     "   {\"phases\": [\"water\", \"gas\"], \"sigma\": 24.5},"
     "   {\"phases\": [\"water\", \"wall\"], \"contact_angle\": 90}]}}";
-
-typedef struct shape {
-    double cx, cy, vy;  /* gas centroid and mean vertical velocity */
-    double aspect;      /* sqrt(smaller / larger eigenvalue of the gas second moments) */
-    double hw;          /* sqrt(<dy^2> / <dx^2>): height over width, < 1 for a flattened bubble */
-    double circ;        /* circularity: 2 sqrt(pi A) / perimeter of the 0.5 contour */
-    double perim, area; /* that contour's length and enclosed area (marching squares) */
-    int ngas;
-} shape;
-
-/* Wendland C2 (2D), support H; only ratios of it are used */
-static double wk(double r2, double H)
-{
-    double q = sqrt(r2) / H;
-    if (q >= 1) return 0;
-    double a = 1 - q;
-    return a * a * a * a * (1 + 4 * q);
-}
-
-static double lerp0(double a, double b) { return a / (a - b); } /* where a + t (b - a) = 0 */
-
-/* The bubble's outline: the 0.5 level of the Shepard colour field c = sum_gas W / sum W (support
- * 2 d) on a grid of spacing d / 2, traced by marching squares; the area is that of the cells'
- * sub-0.5 polygons summed exactly (each cell's polygon from the same interpolated crossings). */
-static void measure(const pfsph_ctx *c, shape *s)
-{
-    const pfsph_particles *f = c->fluid;
-    const double d = c->spacing, H = 2 * d, g = 0.5 * d;
-    double sx = 0, sy = 0, sv = 0;
-    double x0 = 1e30, y0 = 1e30, x1 = -1e30, y1 = -1e30;
-    int ng = 0;
-    for (size_t i = 0; i < f->n; i++) {
-        if (f->phase[i] != GAS) continue;
-        double x = f->x[i], y = f->y[i];
-        sx += x;
-        sy += y;
-        sv += f->vy[i];
-        ng++;
-        if (x < x0) x0 = x;
-        if (x > x1) x1 = x;
-        if (y < y0) y0 = y;
-        if (y > y1) y1 = y;
-    }
-    s->ngas = ng;
-    s->cx = sx / ng;
-    s->cy = sy / ng;
-    s->vy = sv / ng;
-    double mxx = 0, myy = 0, mxy = 0;
-    for (size_t i = 0; i < f->n; i++) {
-        if (f->phase[i] != GAS) continue;
-        double dx = f->x[i] - s->cx, dy = f->y[i] - s->cy;
-        mxx += dx * dx;
-        myy += dy * dy;
-        mxy += dx * dy;
-    }
-    double tr = mxx + myy, det = mxx * myy - mxy * mxy, disc = sqrt(fmax(0, 0.25 * tr * tr - det));
-    s->aspect = sqrt((0.5 * tr - disc) / (0.5 * tr + disc));
-    s->hw = sqrt(myy / mxx);
-
-    /* colour field on the grid around the gas, particles within H of it */
-    x0 -= 2 * H;
-    y0 -= 2 * H;
-    x1 += 2 * H;
-    y1 += 2 * H;
-    const int nx = (int)ceil((x1 - x0) / g) + 1, ny = (int)ceil((y1 - y0) / g) + 1;
-    double *cf = calloc((size_t)nx * ny, sizeof *cf), *wt = calloc((size_t)nx * ny, sizeof *wt);
-    if (!cf || !wt) abort();
-    for (size_t i = 0; i < f->n; i++) {
-        double x = f->x[i], y = f->y[i];
-        if (x < x0 - H || x > x1 + H || y < y0 - H || y > y1 + H) continue;
-        int ia = (int)floor((x - H - x0) / g), ib = (int)ceil((x + H - x0) / g);
-        int ja = (int)floor((y - H - y0) / g), jb = (int)ceil((y + H - y0) / g);
-        for (int jj = ja < 0 ? 0 : ja; jj <= jb && jj < ny; jj++)
-            for (int ii = ia < 0 ? 0 : ia; ii <= ib && ii < nx; ii++) {
-                double dx = x0 + ii * g - x, dy = y0 + jj * g - y, w = wk(dx * dx + dy * dy, H);
-                wt[jj * nx + ii] += w;
-                if (f->phase[i] == GAS) cf[jj * nx + ii] += w;
-            }
-    }
-    for (int k = 0; k < nx * ny; k++) cf[k] = (wt[k] > 0 ? cf[k] / wt[k] : 0) - 0.5; /* > 0: gas */
-    double P = 0, A = 0;
-    for (int jj = 0; jj + 1 < ny; jj++)
-        for (int ii = 0; ii + 1 < nx; ii++) {
-            /* corners counter-clockwise: (0,0) (1,0) (1,1) (0,1) */
-            const double v[4] = {cf[jj * nx + ii], cf[jj * nx + ii + 1], cf[(jj + 1) * nx + ii + 1],
-                                 cf[(jj + 1) * nx + ii]};
-            const double cx[4] = {0, 1, 1, 0}, cy[4] = {0, 0, 1, 1};
-            /* polygon of the gas part of the cell (walk the corners, insert edge crossings) */
-            double px[8], py[8], ex[4], ey[4];
-            int np = 0, ne = 0;
-            for (int e = 0; e < 4; e++) {
-                int a = e, b = (e + 1) & 3;
-                if (v[a] > 0) {
-                    px[np] = cx[a];
-                    py[np++] = cy[a];
-                }
-                if ((v[a] > 0) != (v[b] > 0)) {
-                    double t = lerp0(v[a], v[b]);
-                    px[np] = cx[a] + t * (cx[b] - cx[a]);
-                    py[np++] = cy[a] + t * (cy[b] - cy[a]);
-                    ex[ne] = px[np - 1];
-                    ey[ne++] = py[np - 1];
-                }
-            }
-            for (int k = 0; k < np; k++) A += 0.5 * (px[k] * py[(k + 1) % np] - px[(k + 1) % np] * py[k]);
-            /* contour segments: crossings in walk order pair up (0-1, 2-3); for a saddle this
-             * joins the crossings of one corner region, either pairing has nearly the same length */
-            for (int k = 0; k + 1 < ne; k += 2) P += hypot(ex[k + 1] - ex[k], ey[k + 1] - ey[k]);
-        }
-    free(cf);
-    free(wt);
-    s->perim = P * g;
-    s->area = A * g * g;
-    s->circ = 2 * sqrt(PI * s->area) / s->perim;
-}
 
 enum { NMAX = 128, SMOOTH = 5 };
 
@@ -240,8 +126,8 @@ static void run(int n, double t_end, int rest, run_result *r)
     const double dt_s = 0.05;
     r->nk = (int)lround(t_end / dt_s);
     assert_true(r->nk < NMAX);
-    shape s;
-    measure(c, &s);
+    pfm_bubble s;
+    pfm_bubble_measure(c, GAS, &s);
     r->ngas = s.ngas;
     printf("n=%d%s: %d gas particles (area %.4f, pi/16 = %.4f), outline area %.4f, circularity %.4f at t=0\n", n,
            rest ? " at rest" : "", s.ngas, s.ngas * d * d, PI / 16, s.area, s.circ);
@@ -250,7 +136,7 @@ static void run(int n, double t_end, int rest, run_result *r)
         rc = pfsph_sim_advance(sim, t, &err);
         if (rc) fprintf(stderr, "%s\n", err.msg);
         assert_int_equal(rc, PFSPH_OK);
-        measure(c, &s);
+        pfm_bubble_measure(c, GAS, &s);
         assert_int_equal(s.ngas, r->ngas);
         r->t[k] = t;
         r->yc[k] = s.cy;
