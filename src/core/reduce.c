@@ -3,7 +3,7 @@
 
 double pfsph__sum(const pfsph_real *a, size_t n)
 {
-    enum { BLOCK = 4096 };
+    enum { BLOCK = PFSPH_SUM_BLOCK };
     size_t nb = (n + BLOCK - 1) / BLOCK;
     double total = 0;
     /* Small fixed-size stack buffer of partials per chunk of blocks keeps this allocation free. */

@@ -6,7 +6,10 @@
 
 #include "pfsph/types.h"
 
-/* Deterministic sum (fixed blocks, serial combination): same bits for any thread count. */
+/* Deterministic sum (fixed blocks, serial combination): same bits for any thread count. A pass
+ * that sums as it goes gets the same bits with a double per block of PFSPH_SUM_BLOCK values,
+ * each summed from 0 in order, then the blocks' sums added to 0 in order. */
+#define PFSPH_SUM_BLOCK 4096
 double pfsph__sum(const pfsph_real *a, size_t n);
 
 #endif

@@ -59,9 +59,9 @@ static int divergence_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_
 {
     (void)state;
     (void)bad;
-    (void)err;
     pfsph_solve_stats out = {0, 0, 0};
-    st->solver->pre_forces(st->solver_state, st->ctx, st->solver_scratch, &out);
+    int rc = st->solver->pre_forces(st->solver_state, st->ctx, st->ap, st->solver_scratch, &out);
+    if (rc) return pfsph_fail(err, rc, "out of memory in the %s solver's divergence solve", st->solver->name);
     st->stats.div_iterations = out.div_iterations;
     return PFSPH_OK;
 }
@@ -69,7 +69,8 @@ static int divergence_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_
 const pfsph_stage_ops pfsph_stage_divergence = {.name = "divergence",
                                                 .slot = PFSPH_STAGE_PRESSURE,
                                                 .reads = PFSPH_D_POS | PFSPH_D_DENSITY | PFSPH_D_NLIST | PFSPH_D_DT,
-                                                .writes = PFSPH_D_VEL | PFSPH_D_SOLVER | PFSPH_D_STATS,
+                                                /* ap: its scratch (pre_forces) */
+                                                .writes = PFSPH_D_VEL | PFSPH_D_AP | PFSPH_D_SOLVER | PFSPH_D_STATS,
                                                 .run = divergence_run};
 
 static int pressure_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
