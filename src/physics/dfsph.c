@@ -41,7 +41,8 @@ enum { FAC, RATE, PV, BX, BY, BZ, BC, XQ, V4, NSCR };
  *   each particle's RATE (a particle reads its own rate before it writes its Q);
  * - the pressure accelerations' arrays hold the wall sums until they are compacted, then in the
  *   divergence solve the corrected velocities (a_p is not kept there);
- * the density solve recomputes v_j + dt (a_np,j + a_p,j) from the arrays it writes (the
+ * the density solve keeps a_np + a_p (the integrator then gets it whole, with a_np set to -0:
+ * -0 + a = a exactly) and recomputes v_j + dt (a_np,j + a_p,j) from it (the
  * expression that stored it, the same bits) instead of keeping the velocities; the positions come
  * from the grid walk's x_ij; the wall sums are kept only for the particles with a wall neighbour
  * (compact, in the solver's state); the mean residual is summed during the rate pass in
@@ -431,17 +432,17 @@ static void corrected_walk(const dfsph *D, const pfsph_ctx *c, int upd, int dive
                 out[0][i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a0);
                 out[1][i] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a1);
                 out[2][i] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a2);
-            } else {
-                out[0][i] = a0;
-                out[1][i] = a1;
-                out[2][i] = a2;
+            } else { /* a_np + a_p: the integrator gets it whole (solve) */
+                out[0][i] = ex[i] + a0;
+                out[1][i] = ey[i] + a1;
+                out[2][i] = ez[i] + a2;
             }
         }
     }
 }
 
 /* The corrected velocity of particle j: kept (divergence), or v + dt (a_np + a_p) as
- * corrected_walk computes it (density solve). */
+ * corrected_walk computes it, from the sum it keeps (density solve). */
 static inline void velocity_of(const pfsph_particles *f, int kept, pfsph_real dt, const pfsph_real *const in[3],
                                const pfsph_real *ex, const pfsph_real *ey, const pfsph_real *ez, size_t j,
                                pfsph_real *vx, pfsph_real *vy, pfsph_real *vz)
@@ -451,9 +452,12 @@ static inline void velocity_of(const pfsph_particles *f, int kept, pfsph_real dt
         *vy = in[1][j];
         *vz = in[2][j];
     } else {
-        *vx = f->vx[j] + dt * (ex[j] + in[0][j]);
-        *vy = f->vy[j] + dt * (ey[j] + in[1][j]);
-        *vz = f->vz[j] + dt * (ez[j] + in[2][j]);
+        (void)ex;
+        (void)ey;
+        (void)ez;
+        *vx = f->vx[j] + dt * in[0][j];
+        *vy = f->vy[j] + dt * in[1][j];
+        *vz = f->vz[j] + dt * in[2][j];
     }
 }
 
@@ -623,6 +627,9 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
     if (D->walk) { /* pre_forces made the compact wall sums and the blocks' room for this step */
         out->iterations = iterate_walk(D, c, 0, f->p, ap, scr[W_FAC], f->rho, D->tol, D->min_iter, D->max_iter, &avg);
         restore_rho(c);
+        /* ap holds a_np + a_p: a_np becomes -0, so that the integrator's a_np + a_p is it exactly */
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < f->n; i++) c->ax[i] = c->ay[i] = c->az[i] = -(pfsph_real)0;
     } else out->iterations = iterate(c, 0, f->p, ap, scr, D->tol, D->min_iter, D->max_iter, &avg);
     out->density_err_avg = avg;
 }

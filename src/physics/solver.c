@@ -85,12 +85,13 @@ static int pressure_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     return PFSPH_OK;
 }
 
-const pfsph_stage_ops pfsph_stage_pressure = {.name = "pressure",
-                                              .slot = PFSPH_STAGE_PRESSURE,
-                                              .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_ACC |
-                                                  PFSPH_D_NLIST | PFSPH_D_DT,
-                                              .writes = PFSPH_D_PRESSURE | PFSPH_D_AP | PFSPH_D_SOLVER | PFSPH_D_STATS,
-                                              .run = pressure_run};
+const pfsph_stage_ops pfsph_stage_pressure = {
+    .name = "pressure",
+    .slot = PFSPH_STAGE_PRESSURE,
+    .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_ACC | PFSPH_D_NLIST | PFSPH_D_DT,
+    /* ACC: a solver may hand a_np over in ap (solver.h) */
+    .writes = PFSPH_D_PRESSURE | PFSPH_D_AP | PFSPH_D_ACC | PFSPH_D_SOLVER | PFSPH_D_STATS,
+    .run = pressure_run};
 
 /* the forces stage computed the pressure (pfsph_stage_forces_eos): the solver only reports */
 static int pressure_report_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)

@@ -93,7 +93,8 @@ typedef struct pfsph_solver_ops {
                       pfsph_solve_stats *out);
     /* Pressure accelerations a_p for the step ctx->dt, given ctx->nd (number density at x),
      * ctx->ax.. (non-pressure accelerations); writes fluid->p and ap[0..2]; the integrator then
-     * applies v += dt (a + a_p), x += dt v. */
+     * applies v += dt (a + a_p), x += dt v. A solver may hand over a + a_p in ap and -0 in
+     * ctx->ax.. instead (the integrator's sum is then the same bits: DFSPH without lists). */
     void (*solve)(void *state, const pfsph_ctx *ctx, pfsph_real *const ap[3], pfsph_real *const *scratch,
                   pfsph_solve_stats *out);
     /* Optional (may be NULL: fluid->p): the pressure whose wall term (Akinci 2012) the fluid
