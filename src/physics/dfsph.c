@@ -444,17 +444,13 @@ static void corrected_walk(const dfsph *D, const pfsph_ctx *c, int upd, int dive
 /* The corrected velocity of particle j: kept (divergence), or v + dt (a_np + a_p) as
  * corrected_walk computes it, from the sum it keeps (density solve). */
 static inline void velocity_of(const pfsph_particles *f, int kept, pfsph_real dt, const pfsph_real *const in[3],
-                               const pfsph_real *ex, const pfsph_real *ey, const pfsph_real *ez, size_t j,
-                               pfsph_real *vx, pfsph_real *vy, pfsph_real *vz)
+                               size_t j, pfsph_real *vx, pfsph_real *vy, pfsph_real *vz)
 {
     if (kept) {
         *vx = in[0][j];
         *vy = in[1][j];
         *vz = in[2][j];
     } else {
-        (void)ex;
-        (void)ey;
-        (void)ez;
         *vx = f->vx[j] + dt * in[0][j];
         *vy = f->vy[j] + dt * in[1][j];
         *vz = f->vz[j] + dt * in[2][j];
@@ -464,8 +460,8 @@ static inline void velocity_of(const pfsph_particles *f, int kept, pfsph_real dt
 /* density_rate over grid walks, for particles [i0, i1): the rates into R; returns the sum of the
  * compressions as pfsph__sum adds them within one block. */
 static inline double rate_block(const dfsph *D, const pfsph_ctx *c, int divergence, const pfsph_real *const in[3],
-                                const pfsph_real *ex, const pfsph_real *ey, const pfsph_real *ez, const pfsph_real *fac,
-                                pfsph_real *R, pfsph_hits *H, pfsph_hits_fn hits, size_t *kb, size_t i0, size_t i1)
+                                const pfsph_real *fac, pfsph_real *R, pfsph_hits *H, pfsph_hits_fn hits, size_t *kb,
+                                size_t i0, size_t i1)
 {
     const pfsph_particles *f = c->fluid;
     const pfsph_real dt = (pfsph_real)c->dt;
@@ -477,11 +473,11 @@ static inline double rate_block(const dfsph *D, const pfsph_ctx *c, int divergen
     for (size_t i = i0; i < i1; i++) {
         const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
         pfsph_real vxi, vyi, vzi;
-        velocity_of(f, divergence, dt, in, ex, ey, ez, i, &vxi, &vyi, &vzi);
+        velocity_of(f, divergence, dt, in, i, &vxi, &vyi, &vzi);
         pfsph_real s = 0;
         PFSPH_FOR_HITS(c->grid, hits, H, k, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, j, dw, dx, dy, dz, {
             pfsph_real vxj, vyj, vzj;
-            velocity_of(f, divergence, dt, in, ex, ey, ez, j, &vxj, &vyj, &vzj);
+            velocity_of(f, divergence, dt, in, j, &vxj, &vyj, &vzj);
             /* (v_i - v_j) . x_ij, summed x + y, then + z */
             const pfsph_real vd = (vxi - vxj) * dx + (vyi - vyj) * dy + (vzi - vzj) * dz;
             s += vd * dw;
@@ -498,8 +494,7 @@ static inline double rate_block(const dfsph *D, const pfsph_ctx *c, int divergen
 
 /* All particles' rates; returns the sum of their compressions with pfsph__sum's bits. */
 static double rate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, const pfsph_real *const in[3],
-                        const pfsph_real *ex, const pfsph_real *ey, const pfsph_real *ez, const pfsph_real *fac,
-                        pfsph_real *R)
+                        const pfsph_real *fac, pfsph_real *R)
 {
     const size_t n = c->fluid->n, nb = (n + PFSPH_SUM_BLOCK - 1) / PFSPH_SUM_BLOCK;
     const pfsph_hits_fn hits = pfsph_hits_select();
@@ -512,8 +507,8 @@ static double rate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, cons
         for (size_t b = 0; b < nb; b++) {
             const size_t i0 = b * PFSPH_SUM_BLOCK, i1 = i0 + PFSPH_SUM_BLOCK < n ? i0 + PFSPH_SUM_BLOCK : n;
             /* the two modes as their own loops: the kept velocities or their expression */
-            part[b] = divergence ? rate_block(D, c, 1, in, ex, ey, ez, fac, R, &H, hits, &kb, i0, i1)
-                                 : rate_block(D, c, 0, in, ex, ey, ez, fac, R, &H, hits, &kb, i0, i1);
+            part[b] = divergence ? rate_block(D, c, 1, in, fac, R, &H, hits, &kb, i0, i1)
+                                 : rate_block(D, c, 0, in, fac, R, &H, hits, &kb, i0, i1);
         }
     }
     double total = 0;
@@ -531,7 +526,7 @@ static int iterate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, pfsp
     const pfsph_real *const in[3] = {io[0], io[1], io[2]};
     for (int it = 0;; it++) {
         corrected_walk(D, c, it > 0, divergence, fac, p, R, ex, ey, ez, io);
-        const double sum = rate_walk(D, c, divergence, in, ex, ey, ez, fac, R);
+        const double sum = rate_walk(D, c, divergence, in, fac, R);
         *avg = n ? sum / (double)n : 0;
         if (it >= max_it || (it >= min_it && *avg <= tol)) return it;
     }
