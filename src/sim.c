@@ -127,8 +127,7 @@ static int build_particles(const pfsph_scene *s, double d, const uint8_t *solid_
 int pfsph__sim_alloc_scratch(pfsph_sim *sim, size_t n)
 {
     if (!n) n = 1;
-    const int w0 = sim->scr_solver + sim->st.solver->nscratch - sim->st.solver->nscratch4,
-              w1 = sim->scr_solver + sim->st.solver->nscratch;
+    const int w1 = sim->nscr_solver4 ? sim->scr_solver + sim->st.solver->nscratch : 0, w0 = w1 - sim->nscr_solver4;
     for (int k = 0; k < sim->nscr; k++) {
         const size_t m = k >= w0 && k < w1 ? 4 * n : n; /* the solver's packed arrays */
         pfsph_real *q = realloc(sim->scr[k], m * sizeof(pfsph_real));
@@ -370,6 +369,10 @@ int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_f
     sim->st.lists = pfsph__sim_lists(s, n_most);
     /* the schedule decides the step's arrays; it needs the model's objects, so until they
      * exist it is planned from the scene (what it will hold), and built at the end */
+    /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
+     * the estimate counts it; the solver's scratch depends on it */
+    const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
+    sim->st.lists = pfsph__sim_lists(s, n_most);
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
     if ((rc = pfsph__sim_alloc_scratch(sim, sim->st.em ? sim->fluid.cap : sim->fluid.n))) goto nomem;
@@ -388,6 +391,7 @@ int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_f
     }
     cfg->settings = s->solver_settings;
     cfg->cfl = s->cfl;
+    cfg->lists = sim->st.lists;
     if ((rc = sim->st.solver->create(&sim->st.solver_state, c, cfg, err))) goto fail;
     double g = sqrt(s->gravity[0] * s->gravity[0] + s->gravity[1] * s->gravity[1] + s->gravity[2] * s->gravity[2]);
     sim->st.amax = g;
@@ -517,29 +521,41 @@ static void build_schedule(pfsph_sim *sim)
 /* The step's arrays for this schedule: the stages' shared scratch (the most one stage asks),
  * the thermostat's, and pair_a's own arrays only when a stage between the pair walk and the
  * pairwise stage reads or writes ap (else they live in ap's arrays: an explicit hand-over,
- * checked here). Reallocates (zeroed) when the layout changes. */
+ * checked here). The solver's: in the shared scratch when they hold nothing from one call to
+ * the next, or (without lists, walk_nscratch) when no stage between the solver's first and last
+ * asks for scratch (checked here too); else arrays of their own. Reallocates (zeroed) when the
+ * layout changes. */
 static int plan_buffers(pfsph_sim *sim)
 {
     const pfsph_scene *s = &sim->scene;
-    int nstage = 0, pair_own = 0, from = -1;
+    int nstage = 0, pair_own = 0, from = -1, solver_first = -1, solver_last = -1;
     for (int k = 0; k < sim->nstages; k++) {
         const pfsph_stage_ops *o = sim->stages[k].ops;
         if (o->nscratch > nstage) nstage = o->nscratch;
         if (from >= 0 && (o->reads & PFSPH_D_PAIR_ACC)) from = -1; /* handed over */
         if (from >= 0 && ((o->reads | o->writes) & PFSPH_D_AP)) pair_own = 1;
         if (o->writes & PFSPH_D_PAIR_ACC) from = k;
+        if (o->writes & PFSPH_D_SOLVER) {
+            if (solver_first < 0) solver_first = k;
+            solver_last = k;
+        }
     }
     const int thermo = s->pairwise.enabled && s->pairwise.thermo.enabled;
     const pfsph_solver_ops *so = sim->st.solver;
-    const int shared = so->scratch_per_call && !so->nscratch4; /* in the stages' scratch */
-    if (shared && so->nscratch > nstage) nstage = so->nscratch;
+    const int walk = so->walk_nscratch > 0 && !sim->st.lists;
+    int kept_free = 1; /* no stage between the solver's first and last asks for scratch */
+    for (int k = solver_first + 1; k < solver_last; k++)
+        if (sim->stages[k].ops->nscratch) kept_free = 0;
+    const int nsolver = walk ? so->walk_nscratch : so->nscratch, nsolver4 = walk ? 0 : so->nscratch4;
+    const int shared = walk ? kept_free : so->scratch_per_call && !so->nscratch4; /* in the stages' scratch */
+    if (shared && nsolver > nstage) nstage = nsolver;
     int stage0 = SCR_COMMON, noise0 = stage0 + nstage, pair0 = noise0 + (thermo ? 3 : 0),
         solver0 = shared ? stage0 : pair0 + (pair_own ? 3 : 0),
-        total = shared ? pair0 + (pair_own ? 3 : 0) : solver0 + so->nscratch;
+        total = shared ? pair0 + (pair_own ? 3 : 0) : solver0 + nsolver;
     if (total > SCR_MAX) return PFSPH_ENOMEM;
     const int same = sim->nscr == total && sim->scr_stage == stage0 && sim->nscr_stage == nstage &&
         sim->scr_noise == (thermo ? noise0 : -1) && sim->scr_pair == (pair_own ? pair0 : -1) &&
-        sim->scr_solver == solver0;
+        sim->scr_solver == solver0 && sim->nscr_solver4 == nsolver4;
     if (same) return PFSPH_OK;
     for (int k = total; k < SCR_MAX; k++) {
         free(sim->scr[k]);
@@ -551,6 +567,7 @@ static int plan_buffers(pfsph_sim *sim)
     sim->scr_noise = thermo ? noise0 : -1;
     sim->scr_pair = pair_own ? pair0 : -1;
     sim->scr_solver = solver0;
+    sim->nscr_solver4 = nsolver4;
     return sim->scr_cap ? pfsph__sim_alloc_scratch(sim, sim->scr_cap) : PFSPH_OK;
 }
 

@@ -205,14 +205,25 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
     const double P = (double)pfsph_particles_bytes_per_particle();
     const double sort = 1.25 * (2 * sizeof(uint32_t) + sizeof(pfsph_real));
     const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
-    const int shared = ops && ops->scratch_per_call && !ops->nscratch4;
+    /* neighbour lists, when the run builds them; without them a solver with walk_nscratch keeps
+     * that many arrays in the stages' shared scratch (no built-in stage between its first and
+     * last asks for scratch: plan_buffers in src/sim.c) */
+    const int lists = pfsph__sim_lists(s, (double)nf_max);
+    const double nlist = lists ? nlist_bytes_per_particle(s) : 0;
+    const int walk = ops && ops->walk_nscratch > 0 && !lists;
+    const int nsolver = !ops ? 0
+        : walk               ? ops->walk_nscratch
+                             : ops->nscratch,
+              nsolver4 = ops && !walk ? ops->nscratch4 : 0;
+    const int shared = walk || (ops && ops->scratch_per_call && !ops->nscratch4);
     int nstage = 1; /* the stages' shared scratch: the integrator's energies */
-    if (shared && ops->nscratch > nstage) nstage = ops->nscratch;
+    if (shared && nsolver > nstage) nstage = nsolver;
     const int nthermo = s->pairwise.enabled && s->pairwise.thermo.enabled ? 3 : 0;
-    /* neighbour lists, when the run builds them */
-    const double nlist = pfsph__sim_lists(s, (double)nf_max) ? nlist_bytes_per_particle(s) : 0;
-    const int nscr =
-        SCR_COMMON + nstage + (ops && !shared ? ops->nscratch + 3 * ops->nscratch4 : 0) + nthermo; /* packed: 4 each */
+    const int nscr = SCR_COMMON + nstage + (!shared ? nsolver + 3 * nsolver4 : 0) + nthermo; /* packed: 4 each */
+    /* what the solver keeps per fluid particle near a wall in that layout (DFSPH's wall sums):
+     * for as many particles as half the wall's (walls of 2 layers, wetted on one side by about a
+     * layer within h where the fluid touches them; the bench's dam break has 0.12 of the wall's) */
+    const double near = walk ? fmin((double)nf_max, 0.5 * (double)nb) * ops->walk_near_bytes : 0;
     /* output: the surface layers of a frame (a byte each) and, with pair forces, the
      * mechanical pressure (src/sim.c, pfsph_sim_output); frames stream through a 1 MiB buffer */
     const double out = (s->output.surface_layer ? 1 : 0) + (s->pairwise.enabled ? sizeof(pfsph_real) : 0);
@@ -228,7 +239,7 @@ int pfsph_scene_estimate(const pfsph_scene *s, size_t *n_fluid, size_t *n_bounda
      * arrays are the step's scratch */
     const double per_diffuse = P + 4 * sizeof(uint32_t) + sizeof(pfsph_real) + 1;
     const double nd_max = s->diffuse.enabled && s->diffuse.max_particles > 0 ? (double)s->diffuse.max_particles : 0;
-    const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary + nd_max * per_diffuse;
+    const double part_bytes = (double)nf_max * per_fluid + (double)nb * per_boundary + nd_max * per_diffuse + near;
     if (n_fluid) *n_fluid = (size_t)nf;
     if (n_boundary) *n_boundary = (size_t)nb;
     /* a run's fixed buffers: the frame writer's and the checkpoint encoder's (1 MiB each) */

@@ -41,6 +41,7 @@ struct pfsph_sim {
     int scr_noise;             /* first of the thermostat's 3 arrays (its accelerations), or -1 */
     int scr_pair;              /* first of pair_a's 3 arrays, or -1: they live in ap's */
     int scr_solver;            /* first of the solver's */
+    int nscr_solver4;          /* the last of the solver's that hold 4 values per particle */
     size_t scr_cap;            /* entries in each scratch array */
     double sound_speed;
     pfsph__sched stages[MAX_STAGES];

@@ -6,10 +6,11 @@
 
 #include "pfsph/types.h"
 
-/* The blocks of pfsph__sum (a distributed run reproduces its order: src/mpi/decomp.c). */
+/* Deterministic sum (fixed blocks, serial combination): same bits for any thread count. A pass
+ * that sums as it goes gets the same bits with a double per block of PFSPH_SUM_BLOCK values,
+ * each summed from 0 in order, then the blocks' sums added to 0 in order; a distributed run
+ * reproduces that order (src/mpi/decomp.c). */
 enum { PFSPH_SUM_BLOCK = 4096 };
-
-/* Deterministic sum (fixed blocks, serial combination): same bits for any thread count. */
 double pfsph__sum(const pfsph_real *a, size_t n);
 
 #endif

@@ -6,6 +6,8 @@
  * (src/core/nlist.h) or, without them, the grid (physics/neighbours.h: the same bits).
  * Derivation and choices: docs/solvers.md, "DFSPH". */
 #include <math.h>
+#include <omp.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,6 +31,23 @@
 enum { FAC, RATE, PV, BX, BY, BZ, BC, XQ, V4, NSCR };
 #define ERR PV
 #define NSCR4 2
+
+/* Without neighbour lists (grid walks; issue 28: 100 B per particle at 2e7) the scratch is one
+ * array, FAC, kept from pre_forces to solve in the stages' shared scratch (solver.h,
+ * walk_nscratch; after solve it holds the wall pressure), and a call borrows what holds nothing
+ * while it runs:
+ * - fluid->rho (m delta, written by the density stage; put back by the same expression, the
+ *   same bits, before the call returns) holds Q = p / delta^2 during the acceleration pass, then
+ *   each particle's RATE (a particle reads its own rate before it writes its Q);
+ * - the pressure accelerations' arrays hold the wall sums until they are compacted, then in the
+ *   divergence solve the corrected velocities (a_p is not kept there);
+ * the density solve keeps a_np + a_p (the integrator then gets it whole, with a_np set to -0:
+ * -0 + a = a exactly) and recomputes v_j + dt (a_np,j + a_p,j) from it (the
+ * expression that stored it, the same bits) instead of keeping the velocities; the positions come
+ * from the grid walk's x_ij; the wall sums are kept only for the particles with a wall neighbour
+ * (compact, in the solver's state); the mean residual is summed during the rate pass in
+ * pfsph__sum's blocks and order. The same terms in the same order as with lists: the same bits. */
+enum { W_FAC, W_NSCR };
 
 typedef pfsph_real v4r __attribute__((vector_size(4 * sizeof(pfsph_real))));
 /* a load of 4 values at any alignment of pfsph_real (GCC's idiom of __m128_u); a macro, not a
@@ -61,6 +80,13 @@ typedef struct dfsph {
     double tol, div_tol, cfl, c;
     int min_iter, max_iter, div_max_iter;
     double full; /* neighbours (fluid + boundary) of a particle inside the fluid */
+    int walk;    /* no lists: the layout of W_NSCR */
+    /* walk: the wall sums (bx, by, bz, bc) of the particles with a wall neighbour, ascending */
+    uint32_t *near;
+    pfsph_real *nearb; /* 4 per entry of near */
+    size_t nnear, near_cap;
+    double *part; /* the mean residual's sum per block of PFSPH_SUM_BLOCK particles */
+    size_t part_cap;
 } dfsph;
 
 static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg, pfsph_error *err)
@@ -76,11 +102,20 @@ static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config 
     D->c = cfg->sound_speed;
     const double q = (double)ctx->h / (double)ctx->spacing;
     D->full = ctx->dim == 2 ? 3.14159265358979 * q * q : 4.18879020478639 * q * q * q;
+    D->walk = !cfg->lists;
     *state = D;
     return PFSPH_OK;
 }
 
-static void destroy(void *state) { free(state); }
+static void destroy(void *state)
+{
+    dfsph *D = state;
+    if (!D) return;
+    free(D->near);
+    free(D->nearb);
+    free(D->part);
+    free(D);
+}
 
 /* DFSPH factor 1 / A_i with A_i = |g_i|^2 / m_i + sum_j |grad W_ij|^2 / m_j, g_i = sum_j grad
  * W_ij + (1/V0) sum_b V_b grad W_ib: how much one unit of p_i / delta_i^2 on i (and its
@@ -106,9 +141,11 @@ static void factors(const dfsph *D, const pfsph_ctx *ctx, pfsph_real *fac, pfsph
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
-            xq[4 * i] = xi; /* the positions stay put until the integration */
-            xq[4 * i + 1] = yi;
-            xq[4 * i + 2] = zi;
+            if (xq) { /* the positions stay put until the integration */
+                xq[4 * i] = xi;
+                xq[4 * i + 1] = yi;
+                xq[4 * i + 2] = zi;
+            }
             double gx = 0, gy = 0, gz = 0, s2 = 0;
             int nn = 0;
             PFSPH_FOR_NEIGHBOURS(nl, ctx->grid, hits, &H, k, f->x, f->y, f->z, i, xi, yi, zi, h2, (uint32_t)i, j, dwj, {
@@ -278,6 +315,223 @@ static void density_rate(const pfsph_ctx *c, const pfsph_real *xq, const pfsph_r
     }
 }
 
+/* ---- without lists: the grid-walk layout (W_NSCR above) ---- */
+
+/* a wall sum that is not +0: the particle had a wall neighbour (one whose sums are all +0 adds
+ * the same +0 whether kept or not) */
+static inline int nonzero(pfsph_real v) { return v != 0 || signbit(v); }
+
+/* Keeps the wall sums t[0..3] of the particles where one is not +0, ascending (fixed chunks,
+ * so the order does not depend on the threads). */
+static int compact_walls(dfsph *D, size_t n, pfsph_real *const t[4])
+{
+    enum { CHUNKS = 64 };
+    size_t off[CHUNKS + 1];
+    off[0] = 0;
+#pragma omp parallel for schedule(static)
+    for (int c = 0; c < CHUNKS; c++) {
+        size_t m = 0;
+        for (size_t i = n * (size_t)c / CHUNKS; i < n * (size_t)(c + 1) / CHUNKS; i++)
+            m += nonzero(t[0][i]) || nonzero(t[1][i]) || nonzero(t[2][i]) || nonzero(t[3][i]);
+        off[c + 1] = m;
+    }
+    for (int c = 0; c < CHUNKS; c++) off[c + 1] += off[c];
+    const size_t m = off[CHUNKS];
+    if (m > D->near_cap) {
+        const size_t cap = m + m / 4;
+        uint32_t *idx = realloc(D->near, cap * sizeof *idx);
+        if (idx) D->near = idx;
+        pfsph_real *b = realloc(D->nearb, 4 * cap * sizeof *b);
+        if (b) D->nearb = b;
+        if (!idx || !b) return PFSPH_ENOMEM;
+        D->near_cap = cap;
+    }
+    D->nnear = m;
+#pragma omp parallel for schedule(static)
+    for (int c = 0; c < CHUNKS; c++) {
+        size_t k = off[c];
+        for (size_t i = n * (size_t)c / CHUNKS; i < n * (size_t)(c + 1) / CHUNKS; i++)
+            if (nonzero(t[0][i]) || nonzero(t[1][i]) || nonzero(t[2][i]) || nonzero(t[3][i])) {
+                D->near[k] = (uint32_t)i;
+                for (int a = 0; a < 4; a++) D->nearb[4 * k + a] = t[a][i];
+                k++;
+            }
+    }
+    return PFSPH_OK;
+}
+
+/* The wall sums of particle i, for a pass whose threads each visit their particles in
+ * ascending order (static schedules): *k is the thread's place in the compact set, SIZE_MAX
+ * before its first particle. NULL: none (all +0). */
+static inline const pfsph_real *walls_of(const dfsph *D, size_t *k, size_t i)
+{
+    if (*k == SIZE_MAX) { /* the first entry at or after i */
+        size_t lo = 0, hi = D->nnear;
+        while (lo < hi) {
+            const size_t mid = lo + (hi - lo) / 2;
+            if (D->near[mid] < i) lo = mid + 1;
+            else hi = mid;
+        }
+        *k = lo;
+    }
+    if (*k < D->nnear && D->near[*k] == i) return D->nearb + 4 * (*k)++;
+    return NULL;
+}
+
+/* fluid->rho as the density stage wrote it (pfsph__density_check): m delta */
+static void restore_rho(const pfsph_ctx *c)
+{
+    pfsph_particles *f = c->fluid;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < f->n; i++) f->rho[i] = c->mass[f->phase[i]] * c->nd[i];
+}
+
+/* corrected_velocity over grid walks: R holds the rates on entry (with upd) and Q on return; out
+ * receives the corrected velocities (divergence) or a_p (density solve). */
+static void corrected_walk(const dfsph *D, const pfsph_ctx *c, int upd, int divergence, const pfsph_real *fac,
+                           pfsph_real *p, pfsph_real *R, const pfsph_real *ex, const pfsph_real *ey,
+                           const pfsph_real *ez, pfsph_real *const out[3])
+{
+    const pfsph_particles *f = c->fluid;
+    const size_t n = f->n;
+    const pfsph_real dt = (pfsph_real)c->dt;
+    const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
+    const pfsph_real *nd = c->nd;
+    const pfsph_kernel *k = &c->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const pfsph_hits_fn hits = pfsph_hits_select();
+#pragma omp parallel
+    {
+        pfsph_hits H;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (upd) p[i] = updated(c, divergence, R, fac, p, i);
+            R[i] = p[i] / (nd[i] * nd[i]);
+        }
+        size_t kb = SIZE_MAX;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i], pi = R[i];
+            pfsph_real ax = 0, ay = 0, az = 0;
+            PFSPH_FOR_HITS(c->grid, hits, &H, k, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, j, dw, dx, dy, dz, {
+                const pfsph_real s = (pi + R[j]) * dw;
+                ax += s * dx;
+                ay += s * dy;
+                az += s * dz;
+            });
+            const pfsph_real *B = walls_of(D, &kb, i);
+            if (pi > 0) {
+                const pfsph_real wb = pi * inv_v0;
+                ax += wb * (B ? B[0] : 0);
+                ay += wb * (B ? B[1] : 0);
+                az += wb * (B ? B[2] : 0);
+            }
+            const pfsph_real inv_m = -(pfsph_real)1 / c->mass[f->phase[i]];
+            const pfsph_real a0 = inv_m * ax, a1 = inv_m * ay, a2 = inv_m * az;
+            if (divergence) {
+                out[0][i] = f->vx[i] + dt * ((ex ? ex[i] : 0) + a0);
+                out[1][i] = f->vy[i] + dt * ((ey ? ey[i] : 0) + a1);
+                out[2][i] = f->vz[i] + dt * ((ez ? ez[i] : 0) + a2);
+            } else { /* a_np + a_p: the integrator gets it whole (solve) */
+                out[0][i] = ex[i] + a0;
+                out[1][i] = ey[i] + a1;
+                out[2][i] = ez[i] + a2;
+            }
+        }
+    }
+}
+
+/* The corrected velocity of particle j: kept (divergence), or v + dt (a_np + a_p) as
+ * corrected_walk computes it, from the sum it keeps (density solve). */
+static inline void velocity_of(const pfsph_particles *f, int kept, pfsph_real dt, const pfsph_real *const in[3],
+                               size_t j, pfsph_real *vx, pfsph_real *vy, pfsph_real *vz)
+{
+    if (kept) {
+        *vx = in[0][j];
+        *vy = in[1][j];
+        *vz = in[2][j];
+    } else {
+        *vx = f->vx[j] + dt * in[0][j];
+        *vy = f->vy[j] + dt * in[1][j];
+        *vz = f->vz[j] + dt * in[2][j];
+    }
+}
+
+/* density_rate over grid walks, for particles [i0, i1): the rates into R; returns the sum of the
+ * compressions as pfsph__sum adds them within one block. */
+static inline double rate_block(const dfsph *D, const pfsph_ctx *c, int divergence, const pfsph_real *const in[3],
+                                const pfsph_real *fac, pfsph_real *R, pfsph_hits *H, pfsph_hits_fn hits, size_t *kb,
+                                size_t i0, size_t i1)
+{
+    const pfsph_particles *f = c->fluid;
+    const pfsph_real dt = (pfsph_real)c->dt;
+    const pfsph_real inv_v0 = (pfsph_real)1 / c->V0;
+    const pfsph_kernel *k = &c->kern;
+    const pfsph_real h2 = k->h * k->h;
+    const double nd0 = c->nd0;
+    double sum = 0;
+    for (size_t i = i0; i < i1; i++) {
+        const pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
+        pfsph_real vxi, vyi, vzi;
+        velocity_of(f, divergence, dt, in, i, &vxi, &vyi, &vzi);
+        pfsph_real s = 0;
+        PFSPH_FOR_HITS(c->grid, hits, H, k, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, j, dw, dx, dy, dz, {
+            pfsph_real vxj, vyj, vzj;
+            velocity_of(f, divergence, dt, in, j, &vxj, &vyj, &vzj);
+            /* (v_i - v_j) . x_ij, summed x + y, then + z */
+            const pfsph_real vd = (vxi - vxj) * dx + (vyi - vyj) * dy + (vzi - vzj) * dz;
+            s += vd * dw;
+        });
+        const pfsph_real *B = walls_of(D, kb, i);
+        const pfsph_real bx = B ? B[0] : 0, by = B ? B[1] : 0, bz = B ? B[2] : 0, bc = B ? B[3] : 0;
+        const pfsph_real sb = vxi * bx + vyi * by + vzi * bz - bc;
+        R[i] = s + sb * inv_v0;
+        double fi, res = residual_of(c, divergence, R, fac, i, &fi);
+        sum += (double)(pfsph_real)(res > 0 ? res / nd0 : 0);
+    }
+    return sum;
+}
+
+/* All particles' rates; returns the sum of their compressions with pfsph__sum's bits. */
+static double rate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, const pfsph_real *const in[3],
+                        const pfsph_real *fac, pfsph_real *R)
+{
+    const size_t n = c->fluid->n, nb = (n + PFSPH_SUM_BLOCK - 1) / PFSPH_SUM_BLOCK;
+    const pfsph_hits_fn hits = pfsph_hits_select();
+    double *part = D->part;
+#pragma omp parallel
+    {
+        pfsph_hits H;
+        size_t kb = SIZE_MAX;
+#pragma omp for schedule(static)
+        for (size_t b = 0; b < nb; b++) {
+            const size_t i0 = b * PFSPH_SUM_BLOCK, i1 = i0 + PFSPH_SUM_BLOCK < n ? i0 + PFSPH_SUM_BLOCK : n;
+            /* the two modes as their own loops: the kept velocities or their expression */
+            part[b] = divergence ? rate_block(D, c, 1, in, fac, R, &H, hits, &kb, i0, i1)
+                                 : rate_block(D, c, 0, in, fac, R, &H, hits, &kb, i0, i1);
+        }
+    }
+    double total = 0;
+    for (size_t b = 0; b < nb; b++) total += part[b];
+    return total;
+}
+
+/* iterate() over grid walks; io: the pressure accelerations' arrays (a_p, or the divergence
+ * solve's velocities); R: fluid->rho. */
+static int iterate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real *const io[3],
+                        const pfsph_real *fac, pfsph_real *R, double tol, int min_it, int max_it, double *avg)
+{
+    const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay, *ez = divergence ? NULL : c->az;
+    const size_t n = c->fluid->n;
+    const pfsph_real *const in[3] = {io[0], io[1], io[2]};
+    for (int it = 0;; it++) {
+        corrected_walk(D, c, it > 0, divergence, fac, p, R, ex, ey, ez, io);
+        const double sum = rate_walk(D, c, divergence, in, fac, R);
+        *avg = n ? sum / (double)n : 0;
+        if (it >= max_it || (it >= min_it && *avg <= tol)) return it;
+    }
+}
+
 /* Jacobi iterations on p (density mode: velocities v + dt (a_np + a_p); divergence mode: v +
  * dt a_p) until the mean residual is within tol after at least min_it updates, or max_it
  * updates were made. On return ap (when not NULL) and v4 belong to the final p. Returns the updates
@@ -300,15 +554,43 @@ static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real
 /* Divergence solve: make D delta / Dt = 0 where the fluid compresses, correcting v in place.
  * The divergence pressure is kept in fluid->aux between steps (it follows the particles through
  * the grid sort and into checkpoints); half of it warm-starts the next step. */
-static void pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const *scr, pfsph_solve_stats *out)
+static int pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsph_real *const *scr,
+                      pfsph_solve_stats *out)
 {
-    const dfsph *D = state;
+    dfsph *D = state;
     pfsph_particles *f = c->fluid;
     const size_t n = f->n;
+    out->div_iterations = 0;
+    if (D->walk) {
+        pfsph_real *const tmp[4] = {ap[0], ap[1], ap[2], f->rho};
+        factors(D, c, scr[W_FAC], tmp, NULL);
+        int rc = compact_walls(D, n, tmp);
+        const size_t nb = (n + PFSPH_SUM_BLOCK - 1) / PFSPH_SUM_BLOCK;
+        if (!rc && nb > D->part_cap) {
+            double *q = realloc(D->part, nb * sizeof *q);
+            if (q) {
+                D->part = q;
+                D->part_cap = nb;
+            } else rc = PFSPH_ENOMEM;
+        }
+        if (!rc && D->div_max_iter > 0 && n) {
+            for (size_t i = 0; i < n; i++) f->aux[i] *= (pfsph_real)0.5;
+            double avg;
+            out->div_iterations =
+                iterate_walk(D, c, 1, f->aux, ap, scr[W_FAC], f->rho, D->div_tol, 0, D->div_max_iter, &avg);
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++) {
+                f->vx[i] = ap[0][i];
+                f->vy[i] = ap[1][i];
+                f->vz[i] = ap[2][i];
+            }
+        }
+        restore_rho(c);
+        return rc;
+    }
     pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
     factors(D, c, scr[FAC], bsum, scr[XQ]);
-    out->div_iterations = 0;
-    if (D->div_max_iter <= 0 || !n) return;
+    if (D->div_max_iter <= 0 || !n) return PFSPH_OK;
     pfsph_real *pv = f->aux;
     for (size_t i = 0; i < n; i++) pv[i] *= (pfsph_real)0.5;
     double avg;
@@ -321,6 +603,7 @@ static void pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const *scr, 
         f->vz[i] = v4[4 * i + 2];
     }
     out->div_iterations = it;
+    return PFSPH_OK;
 }
 
 /* Density solve: the predicted number density delta_i + dt D delta_i / Dt(v*) reaches delta0,
@@ -336,16 +619,22 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
      * at rest they drove vmax to 0.5-2 m/s (docs/solvers.md, "DFSPH"). */
     for (size_t i = 0; i < f->n; i++) f->p[i] *= (pfsph_real)0.5;
     double avg;
-    out->iterations = iterate(c, 0, f->p, ap, scr, D->tol, D->min_iter, D->max_iter, &avg);
+    if (D->walk) { /* pre_forces made the compact wall sums and the blocks' room for this step */
+        out->iterations = iterate_walk(D, c, 0, f->p, ap, scr[W_FAC], f->rho, D->tol, D->min_iter, D->max_iter, &avg);
+        restore_rho(c);
+        /* ap holds a_np + a_p: a_np becomes -0, so that the integrator's a_np + a_p is it exactly */
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < f->n; i++) c->ax[i] = c->ay[i] = c->az[i] = -(pfsph_real)0;
+    } else out->iterations = iterate(c, 0, f->p, ap, scr, D->tol, D->min_iter, D->max_iter, &avg);
     out->density_err_avg = avg;
 }
 
 /* The wall felt both solves' pressures this step: their sum is what a body must feel back. */
 static const pfsph_real *wall_pressure(void *state, const pfsph_ctx *c, pfsph_real *const *scr)
 {
-    (void)state;
     const pfsph_particles *f = c->fluid;
-    pfsph_real *pw = scr[PV];
+    /* without lists in FAC's array, which holds nothing after the solve */
+    pfsph_real *pw = ((const dfsph *)state)->walk ? scr[W_FAC] : scr[PV];
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < f->n; i++) pw[i] = f->p[i] + f->aux[i];
     return pw;
@@ -400,6 +689,8 @@ const pfsph_solver_ops pfsph_solver_dfsph = {
     .nscratch = NSCR,
     .nscratch4 = NSCR4,
     .neighbour_lists = 1,
+    .walk_nscratch = W_NSCR,
+    .walk_near_bytes = sizeof(uint32_t) + 4 * sizeof(pfsph_real),
     .np_cap_without_viscosity = 1,
     .create = create,
     .destroy = destroy,

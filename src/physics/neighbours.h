@@ -22,6 +22,20 @@
         }                                                \
     } while (0)
 
+/* The same with X_ij as DX, DY, DZ (the hits' x - x_j) */
+#define PFSPH_NB_FLUSH_X_(k, H, J, DW, DX, DY, DZ, ...)  \
+    do {                                                 \
+        pfsph__terms_dwr((k), (H)->n, (H)->r2, (H)->t1); \
+        for (int nb_e_ = 0; nb_e_ < (H)->n; nb_e_++) {   \
+            const uint32_t J = (H)->j[nb_e_];            \
+            const pfsph_real DW = (H)->t1[nb_e_];        \
+            const pfsph_real DX = (H)->dx[nb_e_];        \
+            const pfsph_real DY = (H)->dy[nb_e_];        \
+            const pfsph_real DZ = (H)->dz[nb_e_];        \
+            __VA_ARGS__                                  \
+        }                                                \
+    } while (0)
+
 /* Runs BODY (the statements after DW) for every neighbour of fluid particle i at (x, y, z),
  * with J its index in the target set and DW = pfsph_kernel_dw_r(k, |x_ij|): from list L when it
  * is not NULL, else by a walk of grid G over the targets (tx, ty, tz) with the hits function
@@ -41,6 +55,16 @@
             pfsph_grid_ranges((G), (x), (y), (z), &nb_r_);                                                             \
             PFSPH_HITS_WALK(hits, H, nb_r_, tx, ty, tz, x, y, z, h2, skip, PFSPH_NB_FLUSH_(k, H, J, DW, __VA_ARGS__)); \
         }                                                                                                              \
+    } while (0)
+
+/* PFSPH_FOR_NEIGHBOURS's grid walk alone, its BODY also given DX, DY, DZ = x - tx[J] etc. as the
+ * walk computed them (the bits of (x - tx[J]), so a pass needs no positions of its own). */
+#define PFSPH_FOR_HITS(G, hits, H, k, tx, ty, tz, x, y, z, h2, skip, J, DW, DX, DY, DZ, ...) \
+    do {                                                                                     \
+        pfsph_ranges nb_r_;                                                                  \
+        pfsph_grid_ranges((G), (x), (y), (z), &nb_r_);                                       \
+        PFSPH_HITS_WALK(hits, H, nb_r_, tx, ty, tz, x, y, z, h2, skip,                       \
+                        PFSPH_NB_FLUSH_X_(k, H, J, DW, DX, DY, DZ, __VA_ARGS__));            \
     } while (0)
 
 #endif

@@ -64,9 +64,9 @@ static int divergence_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_
 {
     (void)state;
     (void)bad;
-    (void)err;
     pfsph_solve_stats out = {0, 0, 0};
-    st->solver->pre_forces(st->solver_state, st->ctx, st->solver_scratch, &out);
+    int rc = st->solver->pre_forces(st->solver_state, st->ctx, st->ap, st->solver_scratch, &out);
+    if (rc) return pfsph_fail(err, rc, "out of memory in the %s solver's divergence solve", st->solver->name);
     st->stats.div_iterations = out.div_iterations;
     return PFSPH_OK;
 }
@@ -74,7 +74,8 @@ static int divergence_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_
 const pfsph_stage_ops pfsph_stage_divergence = {.name = "divergence",
                                                 .slot = PFSPH_STAGE_PRESSURE,
                                                 .reads = PFSPH_D_POS | PFSPH_D_DENSITY | PFSPH_D_NLIST | PFSPH_D_DT,
-                                                .writes = PFSPH_D_VEL | PFSPH_D_SOLVER | PFSPH_D_STATS,
+                                                /* ap: its scratch (pre_forces) */
+                                                .writes = PFSPH_D_VEL | PFSPH_D_AP | PFSPH_D_SOLVER | PFSPH_D_STATS,
                                                 .run = divergence_run};
 
 static int pressure_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
@@ -89,12 +90,13 @@ static int pressure_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     return PFSPH_OK;
 }
 
-const pfsph_stage_ops pfsph_stage_pressure = {.name = "pressure",
-                                              .slot = PFSPH_STAGE_PRESSURE,
-                                              .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_ACC |
-                                                  PFSPH_D_NLIST | PFSPH_D_DT,
-                                              .writes = PFSPH_D_PRESSURE | PFSPH_D_AP | PFSPH_D_SOLVER | PFSPH_D_STATS,
-                                              .run = pressure_run};
+const pfsph_stage_ops pfsph_stage_pressure = {
+    .name = "pressure",
+    .slot = PFSPH_STAGE_PRESSURE,
+    .reads = PFSPH_D_POS | PFSPH_D_VEL | PFSPH_D_DENSITY | PFSPH_D_ACC | PFSPH_D_NLIST | PFSPH_D_DT,
+    /* ACC: a solver may hand a_np over in ap (solver.h) */
+    .writes = PFSPH_D_PRESSURE | PFSPH_D_AP | PFSPH_D_ACC | PFSPH_D_SOLVER | PFSPH_D_STATS,
+    .run = pressure_run};
 
 /* the forces stage computed the pressure (pfsph_stage_forces_eos): the solver only reports */
 static int pressure_report_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)

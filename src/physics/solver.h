@@ -28,6 +28,8 @@ typedef struct pfsph_solver_config {
     double rho_common;  /* > 0: one Tait pressure scale for all phases [kg/m^3]; 0: per phase */
     double cfl;
     const double *settings; /* the solver's own keys' values, in the order of its row's keys */
+    int lists;              /* the run builds neighbour lists (pfsph__sim_lists): else its scratch is
+                             * walk_nscratch's layout */
 } pfsph_solver_config;
 
 /* What one solve reports (stats.csv columns). */
@@ -59,6 +61,15 @@ typedef struct pfsph_solver_ops {
      * is NULL, by grid walks with the same terms in the same order (physics/neighbours.h). Its
      * key "neighbour_lists" (true, false, "auto") chooses: pfsph__sim_lists (sim_estimate.c). */
     int neighbour_lists;
+    /* Optional, with neighbour_lists: the scratch when the run walks the grid instead (config.lists
+     * 0): walk_nscratch arrays of one value in place of nscratch / nscratch4. They carry values from
+     * pre_forces to solve, so they lie in the stages' shared scratch only when no stage between
+     * the first and the last stage that write PFSPH_D_SOLVER asks for scratch, else in arrays of
+     * their own (src/sim.c, plan_buffers). A call may also use what holds nothing during it (the
+     * solver's file says what). walk_near_bytes: bytes the solver keeps per fluid particle within h
+     * of a wall particle in that layout (the estimate counts them). 0: nscratch's layout always. */
+    int walk_nscratch;
+    int walk_near_bytes;
     /* Non-zero: amax_np, the non-pressure acceleration dt_limit receives, leaves viscosity out:
      * |g| + the largest pair-force acceleration (an upper bound of |g + a_pair|). Viscosity
      * smooths velocities; it compresses nothing that the solve must undo (DFSPH, docs/solvers.md). */
@@ -75,11 +86,15 @@ typedef struct pfsph_solver_ops {
     int (*create)(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg, pfsph_error *err);
     void (*destroy)(void *state); /* NULL is a no-op */
     /* Optional (may be NULL): called after the density stage and the choice of ctx->dt, before
-     * the non-pressure forces: where a divergence-free solver (DFSPH) corrects the velocities. */
-    void (*pre_forces)(void *state, const pfsph_ctx *ctx, pfsph_real *const *scratch, pfsph_solve_stats *out);
+     * the non-pressure forces: where a divergence-free solver (DFSPH) corrects the velocities. The
+     * pressure accelerations' arrays ap hold nothing yet: it may use them as scratch. Returns
+     * PFSPH_OK or PFSPH_ENOMEM. */
+    int (*pre_forces)(void *state, const pfsph_ctx *ctx, pfsph_real *const ap[3], pfsph_real *const *scratch,
+                      pfsph_solve_stats *out);
     /* Pressure accelerations a_p for the step ctx->dt, given ctx->nd (number density at x),
      * ctx->ax.. (non-pressure accelerations); writes fluid->p and ap[0..2]; the integrator then
-     * applies v += dt (a + a_p), x += dt v. */
+     * applies v += dt (a + a_p), x += dt v. A solver may hand over a + a_p in ap and -0 in
+     * ctx->ax.. instead (the integrator's sum is then the same bits: DFSPH without lists). */
     void (*solve)(void *state, const pfsph_ctx *ctx, pfsph_real *const ap[3], pfsph_real *const *scratch,
                   pfsph_solve_stats *out);
     /* Optional (may be NULL: fluid->p): the pressure whose wall term (Akinci 2012) the fluid
