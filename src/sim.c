@@ -364,15 +364,12 @@ int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_f
         sim->boundary.rho[i] = (pfsph_real)s->phases[sim->boundary.phase[i]].rest_density;
     setup_done(&clk, "sorted the boundary into %zu grid cells, its volumes", sim->bgrid.ncells);
     /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
-     * the estimate counts it (before the schedule: the interactive PCISPH's lists unfuse it) */
+     * the estimate counts it; before the schedule (the interactive PCISPH's lists unfuse it) and
+     * the scratch (the solver's depends on it) */
     const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
     sim->st.lists = pfsph__sim_lists(s, n_most);
     /* the schedule decides the step's arrays; it needs the model's objects, so until they
      * exist it is planned from the scene (what it will hold), and built at the end */
-    /* neighbour lists or grid walks (the same bits): for the most fluid the run will hold, as
-     * the estimate counts it; the solver's scratch depends on it */
-    const double n_most = (double)sim->fluid.n + (sim->st.em ? (double)pfsph_emitters_max(sim->st.em, s->end_time) : 0);
-    sim->st.lists = pfsph__sim_lists(s, n_most);
     build_schedule(sim);
     if ((rc = plan_buffers(sim))) goto fail;
     if ((rc = pfsph__sim_alloc_scratch(sim, sim->st.em ? sim->fluid.cap : sim->fluid.n))) goto nomem;
