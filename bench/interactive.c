@@ -11,41 +11,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
-#include <time.h>
 
 #include <omp.h>
 
+#include "bench_util.h"
 #include "cli/omp_env.h"
 #include "physics/solver.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
-
-static double cpu_seconds(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
-        1e-6 * (double)ru.ru_stime.tv_usec;
-}
-
-static double wall_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double load_average(void)
-{
-    double l = -1;
-    FILE *f = fopen("/proc/loadavg", "r");
-    if (f) {
-        if (fscanf(f, "%lf", &l) != 1) l = -1;
-        fclose(f);
-    }
-    return l;
-}
 
 /* the limits of timestep.c and the PCISPH / DFSPH dt_limit, as candidates */
 enum { L_DTMAX, L_CFL, L_FORCE, L_PCI, L_VISC, L_FRAME, NLIM };
@@ -113,7 +86,7 @@ int main(int argc, char **argv)
     for (int l = 0; l < NLIM; l++) cand[l] = malloc(cap * sizeof(double));
     long bound[NLIM] = {0};
     double iters = 0;
-    const double load0 = load_average(), w0 = wall_seconds(), c0 = cpu_seconds();
+    const double load0 = bench_load_average(), w0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
     const int frames = (int)lround(end * fps);
     int rc = 0;
     for (int fr = 1; fr <= frames && !rc; fr++) {
@@ -150,7 +123,7 @@ int main(int argc, char **argv)
             n++;
         }
     }
-    const double wall = wall_seconds() - w0, cpu = cpu_seconds() - c0, load1 = load_average();
+    const double wall = bench_wall_seconds() - w0, cpu = bench_cpu_seconds() - c0, load1 = bench_load_average();
     const double sim_t = pfsph_sim_time(sim);
     const unsigned long long steps = (unsigned long long)pfsph_sim_steps(sim);
     size_t nb = 0;

@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "pfsph/sim.h"
 #include "pfsph/thermostat.h"
 
@@ -80,17 +81,9 @@ int main(int argc, char **argv)
                  "\"water\"}],"
                  " \"pairwise\": {%s %s \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": %s}]}}",
                  seed, 0.5 * d, -m, -m, -m, W + m, H + m, Z + m, solver, nu, W, H, Z, kkey, pwx, sig);
-    static pfsph_scene s;
+    pfsph_sim *sim = bench_sim_from_json(json, "pf_shear");
+    if (!sim) return 2;
     pfsph_error err = {0};
-    if (pfsph_scene_parse(&s, json, "pf_shear", &err) != PFSPH_OK) {
-        fprintf(stderr, "%s\n%s\n", err.msg, json);
-        return 2;
-    }
-    pfsph_sim *sim = NULL;
-    if (pfsph_sim_create(&sim, &s, &err) != PFSPH_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        return 2;
-    }
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     pfsph_particles *f = c->fluid;
     if (teq > 0 && pfsph_sim_advance(sim, teq, &err) != PFSPH_OK) {

@@ -23,6 +23,7 @@
 #include <stdlib.h>
 #include <time.h>
 
+#include "bench_util.h"
 #include "pfsph/sim.h"
 #include "pfsph/thermostat.h"
 
@@ -127,17 +128,9 @@ int main(int argc, char **argv)
                  " \"layers\": 3, \"slip\": \"free-slip\"}] %s}",
                  seed, 0.5 * d, -2 * w, -2 * w, -2 * w, L + 2 * w, L + 2 * w, Z + 2 * w, solver, rho, nu, vx, L, L, Z,
                  L, L, Z, pw);
-    static pfsph_scene s;
+    pfsph_sim *sim = bench_sim_from_json(json, "pf_visc");
+    if (!sim) return 2;
     pfsph_error err = {0};
-    if (pfsph_scene_parse(&s, json, "pf_visc", &err) != PFSPH_OK) {
-        fprintf(stderr, "%s\n%s\n", err.msg, json);
-        return 2;
-    }
-    pfsph_sim *sim = NULL;
-    if (pfsph_sim_create(&sim, &s, &err) != PFSPH_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        return 2;
-    }
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     pfsph_particles *f = c->fluid;
     /* melt the lattice at rest first (PF_TEQ seconds), then add the mode to the thermal motion */

@@ -5,23 +5,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 
 #include <cjson/cJSON.h>
 #include <omp.h>
 
+#include "bench_util.h"
 #include "cli/omp_env.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
-
-/* CPU time of the process (all threads): on a shared machine it moves less than wall time */
-static double cpu_seconds(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
-        1e-6 * (double)ru.ru_stime.tv_usec;
-}
 
 static void usage(void)
 {
@@ -94,7 +85,7 @@ int main(int argc, char **argv)
         return 2;
     }
     const double t0 = omp_get_wtime();
-    const double c0 = cpu_seconds();
+    const double c0 = bench_cpu_seconds();
     /* pfsph_sim_advance's loop, stepped here so that the solver iterations can be summed */
     int rc = PFSPH_OK;
     unsigned long long its = 0, div_its = 0;
@@ -103,7 +94,7 @@ int main(int argc, char **argv)
         its += (unsigned long long)pfsph_sim_stats(sim)->iterations;
         div_its += (unsigned long long)pfsph_sim_stats(sim)->div_iterations;
     }
-    const double wall = omp_get_wtime() - t0, cpu = cpu_seconds() - c0;
+    const double wall = omp_get_wtime() - t0, cpu = bench_cpu_seconds() - c0;
     if (rc) fprintf(stderr, "%s\n", err.msg);
     const unsigned long long steps = (unsigned long long)pfsph_sim_steps(sim);
     printf("%s, %s, %zu fluid particles, %d threads: %.3f s simulated in %.2f s wall, %llu steps "

@@ -78,15 +78,12 @@ static void record(pfsph_sim *sim, double a, double T_end, double dt, front *f)
 {
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     const double s = sqrt(2 * G / a);
-    pfsph_error err = {0};
     f->n = 0;
     f->np = c->fluid->n;
     f->T[f->n] = 0;
     f->Z[f->n++] = front_x(c) / a;
     for (int k = 1; k * dt * s <= T_end + 1e-9 && f->n < NMAX; k++) {
-        int rc = pfsph_sim_advance(sim, k * dt, &err);
-        if (rc) fprintf(stderr, "%s\n", err.msg);
-        assert_int_equal(rc, PFSPH_OK);
+        tu_advance(sim, k * dt);
         f->T[f->n] = k * dt * s;
         f->Z[f->n++] = front_x(c) / a;
     }
@@ -97,15 +94,7 @@ static void run_mm(int n_per_a, front *f)
     const double a = A_MM, d = a / n_per_a, L = 16 * a, w = 3 * d, T_end = 9.3;
     char json[4096];
     snprintf(json, sizeof json, SCENE, 0.5 * d, -w, -w, L + w, 3 * a, T_end / sqrt(2 * G / a), a, 2 * a, L, 2.5 * a);
-    static pfsph_scene sc;
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&sc, json, "Martin & Moyce dam break", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim;
-    rc = pfsph_sim_create(&sim, &sc, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = tu_sim_from_json(json, "Martin & Moyce dam break");
     record(sim, a, T_end, 0.005 * sqrt(a / 0.2), f); /* the same ~0.01 of T at both scales */
     pfsph_sim_destroy(sim);
 }

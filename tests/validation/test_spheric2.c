@@ -152,25 +152,13 @@ static void test_spheric2(void **state)
     const double d = tu_env_num("PF_D", 0.04), T = tu_env_num("PF_T", 6);
     char json[4096];
     snprintf(json, sizeof json, SCENE, 0.5 * d, tu_env("PF_SOLVER", "pcisph"), T);
-    static pfsph_scene sc;
-    pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&sc, json, "SPHERIC test 2", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim;
-    rc = pfsph_sim_create(&sim, &sc, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    pfsph_sim *sim = tu_sim_from_json(json, "SPHERIC test 2");
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     static series r;
     r.np0 = c->fluid->n;
     printf("SPHERIC test 2, d = %g m: %zu water particles\n", d, r.np0);
     for (int k = 0; k <= (int)lround(T / 0.01) && k < NMAX; k++) {
-        if (k) {
-            rc = pfsph_sim_advance(sim, 0.01 * k, &err);
-            if (rc) fprintf(stderr, "%s\n", err.msg);
-            assert_int_equal(rc, PFSPH_OK);
-        }
+        if (k) tu_advance(sim, 0.01 * k);
         r.t[r.n] = 0.01 * k;
         measure(c, r.h[r.n], r.p[r.n]);
         if (k % 10 == 0) {
