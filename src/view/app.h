@@ -69,7 +69,7 @@ typedef struct pfsph_vlive {
 } pfsph_vlive;
 
 /* Live mode: the liquid's surface, rebuilt on a thread of its own (vsurf.c). */
-#define PFSPH_VSURF_LEVELS 3
+#define PFSPH_VSURF_LEVELS 4
 typedef struct pfsph_vsurf {
     pthread_t th;
     pthread_mutex_t mu;

@@ -13,7 +13,7 @@
 
 /* Marching cells (/ d) from fine to coarse; the field and the marching scale with the cells on
  * the surface, (1 / cell)^2, the kernels (PCA) with the particles. */
-static const double CELL[PFSPH_VSURF_LEVELS] = {0.5, 0.75, 1.0};
+static const double CELL[PFSPH_VSURF_LEVELS] = {0.5, 0.75, 1.0, 1.25};
 
 /* Phases drawn as a surface: fluids and gases (each gas a closed region of its own, a bubble). */
 bool pfsph_vsurf_meshes_phase(const pfsph_scene *sc, int ph)
