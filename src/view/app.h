@@ -66,6 +66,10 @@ typedef struct pfsph_vlive {
     double sps;         /* steps per second, over the last half second */
     double rtf;         /* real-time factor: simulated s per wall s, over the last half second */
     uint64_t published; /* snapshots published */
+    /* queued changes: when the oldest was queued; applied so far, the step they act from, and
+     * how long the last and the slowest waited for the step in progress [s] */
+    double cmd_t0, lat_last, lat_max;
+    uint64_t applied, applied_step;
 } pfsph_vlive;
 
 /* Live mode: the liquid's surface, rebuilt on a thread of its own (vsurf.c). */
@@ -75,6 +79,7 @@ typedef struct pfsph_vsurf {
     pthread_mutex_t mu;
     pthread_cond_t cv;
     bool started, quit;
+    int dim;
     double spacing, budget; /* particle spacing [m]; the time a rebuild may take [s] (1/30) */
     /* the job: the liquid's positions and phases of the snapshot handed over */
     double *x;

@@ -183,7 +183,13 @@ static void upload_live_mesh(pfsph_vapp *A)
         }
         for (size_t t = 0; t < m->ntris; t++) {
             int ph = m->phase[t];
-            if (ph < sc->nphases && sc->phases[ph].kind == PFSPH_PHASE_GAS) {
+            if (sc->dim == 2) { /* the outline: in the phase's colour, darker */
+                ng++;
+                for (int c = 0; c < 3; c++)
+                    for (int k = 0; k < 3; k++)
+                        A->mv[9 * m->tri[3 * t + c] + 6 + k] =
+                            ph < sc->nphases ? 0.45f * sc->phases[ph].color[k] : 0.1f;
+            } else if (ph < sc->nphases && sc->phases[ph].kind == PFSPH_PHASE_GAS) {
                 ng++;
                 for (int c = 0; c < 3; c++)
                     memcpy(A->mv + 9 * m->tri[3 * t + c] + 6, sc->phases[ph].color, 3 * sizeof(float));
@@ -195,7 +201,7 @@ static void upload_live_mesh(pfsph_vapp *A)
         size_t a = 0, b = m->ntris;
         for (size_t t = 0; t < m->ntris; t++) {
             int ph = m->phase[t];
-            size_t o = ph < sc->nphases && sc->phases[ph].kind == PFSPH_PHASE_GAS ? --b : a++;
+            size_t o = sc->dim == 2 || (ph < sc->nphases && sc->phases[ph].kind == PFSPH_PHASE_GAS) ? --b : a++;
             memcpy(idx + 3 * o, m->tri + 3 * t, 3 * sizeof *idx);
         }
     }
@@ -240,8 +246,9 @@ void pfsph_vframe_draw(pfsph_vapp *A)
     const bool bmesh = A->show_surface && !d2 && A->rf.bmesh.ntris && !A->is_live;
     const bool lsurf = pfsph_vframe_live_surface(A);
     if (lsurf && A->live_mesh_new) upload_live_mesh(A);
-    /* the surface covers every phase of the fluid set (liquids and gases: vsurf.c) */
-    n = liq || lsurf ? 0 : add_sprites(A, 0, &f->fluid, d2 ? 1.3 * r : r, 0, 0, lo, hi, NULL);
+    /* the surface covers every phase of the fluid set (liquids and gases: vsurf.c); in 2D the
+     * outline is drawn over the particles */
+    n = liq || (lsurf && !d2) ? 0 : add_sprites(A, 0, &f->fluid, d2 ? 1.3 * r : r, 0, 0, lo, hi, NULL);
     if (A->show_diffuse) n = add_sprites(A, n, &f->diffuse, 0.4 * r, 0, 2, 0, 1, NULL);
     if (A->show_bodies && !bmesh) n = add_sprites(A, n, &f->bodies, r, 0, 3, 0, 1, NULL);
     pfsph_vdraw_sprites(A->draw, 0, A->spr, n);

@@ -297,8 +297,9 @@ int pfsph_view_main(int argc, char **argv)
         rc = pfsph_fail(&err, PFSPH_EIO, "cannot start the simulation thread");
         goto fail;
     }
-    /* live 3D: the liquid's surface on a thread of its own (vsurf.c); without it, particles */
-    if (A->is_live && A->scene->dim == 3) {
+    /* live: the liquid's surface (2D: its outline) on a thread of its own (vsurf.c); without
+     * it, particles */
+    if (A->is_live) {
         if (pfsph_vsurf_start(&A->S, A->scene)) {
             fprintf(stderr, "pfsph: view: cannot start the surface thread; particles only\n");
         } else {

@@ -1,5 +1,5 @@
 /* Live mode's liquid surface (app.h): the library's reconstruction (pfsph_surface_reconstruct,
- * docs/surfaces.md) rebuilt on a worker thread of its own from a copy of the drawn snapshot's
+ * docs/surfaces.md; in 2D the outline, pfsph_surface_contour2d, drawn as a band) rebuilt on a worker thread of its own from a copy of the drawn snapshot's
  * fluid, at a marching cell chosen from the measured time of the last rebuilds so that one
  * rebuild fits a 1/30 s frame; the simulation never waits for it. */
 #include <math.h>
@@ -62,6 +62,46 @@ static void adapt(pfsph_vsurf *S, double sec)
     }
 }
 
+/* 2D: the outline (pfsph_surface_contour2d) as a band of triangles of half-width w along the
+ * vertex normals, in the plane z, so that the mesh path draws it over the particles. */
+static int contour_band(const double *x, const uint8_t *ph, size_t n, const pfsph_surface_opts *o, double w, double z,
+                        pfsph_surface_mesh *m, pfsph_error *err)
+{
+    pfsph_surface_contour c;
+    int rc = pfsph_surface_contour2d(x, ph, n, o, &c, err);
+    if (rc) return rc;
+    m->nverts = 2 * c.nverts;
+    m->ntris = 2 * c.nsegs;
+    m->v = malloc((m->nverts ? m->nverts : 1) * 3 * sizeof *m->v);
+    m->n = malloc((m->nverts ? m->nverts : 1) * 3 * sizeof *m->n);
+    m->tri = malloc((m->ntris ? m->ntris : 1) * 3 * sizeof *m->tri);
+    m->phase = malloc(m->ntris ? m->ntris : 1);
+    if (!m->v || !m->n || !m->tri || !m->phase) {
+        pfsph_surface_contour_free(&c);
+        pfsph_surface_mesh_free(m);
+        memset(m, 0, sizeof *m);
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
+    }
+    for (size_t i = 0; i < c.nverts; i++)
+        for (int side = 0; side < 2; side++) {
+            double sg = side ? w : -w;
+            double *v = m->v + 3 * (2 * i + (size_t)side);
+            v[0] = c.v[3 * i] + sg * c.n[3 * i];
+            v[1] = c.v[3 * i + 1] + sg * c.n[3 * i + 1];
+            v[2] = z;
+            float *nn = m->n + 3 * (2 * i + (size_t)side);
+            nn[0] = nn[1] = 0, nn[2] = 1; /* facing the camera: flat */
+        }
+    for (size_t sgi = 0; sgi < c.nsegs; sgi++) {
+        uint32_t a = 2 * c.seg[2 * sgi], b = 2 * c.seg[2 * sgi + 1];
+        uint32_t *t = m->tri + 6 * sgi;
+        t[0] = a, t[1] = b, t[2] = b + 1, t[3] = a, t[4] = b + 1, t[5] = a + 1;
+        m->phase[2 * sgi] = m->phase[2 * sgi + 1] = c.phase[sgi];
+    }
+    pfsph_surface_contour_free(&c);
+    return PFSPH_OK;
+}
+
 static void *worker(void *arg)
 {
     pfsph_vsurf *S = arg;
@@ -82,7 +122,9 @@ static void *worker(void *arg)
         memset(m, 0, sizeof *m);
         pfsph_error err = {0};
         double t0 = omp_get_wtime();
-        int rc = S->n ? pfsph_surface_reconstruct(S->x, S->ph, S->n, &o, m, &err) : PFSPH_OK;
+        int rc = !S->n    ? PFSPH_OK
+            : S->dim == 2 ? contour_band(S->x, S->ph, S->n, &o, 0.25 * S->spacing, S->spacing, m, &err)
+                          : pfsph_surface_reconstruct(S->x, S->ph, S->n, &o, m, &err);
         double sec = omp_get_wtime() - t0;
         pthread_mutex_lock(&S->mu);
         S->job = false;
@@ -110,6 +152,7 @@ int pfsph_vsurf_start(pfsph_vsurf *S, const pfsph_scene *sc)
 {
     memset(S, 0, sizeof *S);
     S->spacing = 2 * sc->particle_radius;
+    S->dim = sc->dim;
     S->budget = 1.0 / 30;
     S->ir = 1;
     S->posted_time = -1;

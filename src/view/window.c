@@ -27,6 +27,18 @@ static void save_png(pfsph_vapp *A, const char *path)
     free(rgb);
 }
 
+/* Live: the changes made with keys or the mouse, and how soon they acted. */
+static void print_changes(pfsph_vapp *A)
+{
+    if (!A->is_live) return;
+    pthread_mutex_lock(&A->L.mu);
+    if (A->L.applied)
+        printf("changes: %llu applied, the last from step %llu, %.1f ms after it was made (at most %.1f ms)\n",
+               (unsigned long long)A->L.applied, (unsigned long long)A->L.applied_step, 1e3 * A->L.lat_last,
+               1e3 * A->L.lat_max);
+    pthread_mutex_unlock(&A->L.mu);
+}
+
 /* Live 3D: what the surface drew and what it cost (screenshots and --bench). */
 static void print_surface(pfsph_vapp *A)
 {
@@ -79,6 +91,7 @@ static int write_outputs(pfsph_vapp *A)
     printf("wrote %s (%dx%d, t = %.6g s, step %llu, %zu fluid particles)\n", A->o.screenshot, A->fb_w, A->fb_h,
            A->shown->time, (unsigned long long)A->shown->steps, A->shown->fluid.n);
     print_surface(A);
+    print_changes(A);
     return 0;
 }
 
@@ -206,6 +219,8 @@ int pfsph_vwindow_run(pfsph_vapp *A)
                        (double)(st - bench_steps0) / (now - bench_t0), A->fb_w, A->fb_h, ss * ss,
                        (const char *)glGetString(GL_RENDERER));
                 print_surface(A);
+                print_changes(A);
+                print_changes(A);
                 break;
             }
             glfwPollEvents();

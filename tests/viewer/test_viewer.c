@@ -140,7 +140,7 @@ static void test_live_2d(void **state)
     snprintf(dump, sizeof dump, "%s/dump", dir);
     snprintf(cmd, sizeof cmd,
              "%s view %s --screenshot %s --frames 20 --dump %s --no-overlay --hide walls "
-             "--color-by phase --threads 2",
+             "--color-by phase --threads 2 --particles",
              tu_pfsph_bin(), scene, shot, dump);
     int st = tu_run(cmd, out, sizeof out);
     print_message("%s", out);
@@ -433,6 +433,35 @@ static void test_live_surface(void **state)
         }
         free(m.rgb);
     }
+    /* 2D: the outline (a band of triangles) over the particles; the particles alone without it */
+    char scene2[600], shot2[700];
+    write_scene(tu_tmpdir(), "live2d_outline.json", SCENE2D, scene2, sizeof scene2);
+    assert_int_equal(
+        live_shot(scene2, "--frames 3 --paused --hide walls", "outline.png", shot, sizeof shot, out, sizeof out), 0);
+    size_t ntris = 0;
+    assert_non_null(strstr(out, "surface: "));
+    assert_int_equal(sscanf(strstr(out, "surface: "), "surface: %zu triangles", &ntris), 1);
+    assert_int_equal(live_shot(scene2, "--frames 3 --paused --hide walls --particles", "outline_off.png", shot2,
+                               sizeof shot2, out, sizeof out),
+                     0);
+    img a = tu_read_png(shot), b = tu_read_png(shot2);
+    unsigned char *ma = mask_of(&a), *mb = mask_of(&b);
+    size_t px = 0, changed = 0;
+    for (size_t o = 0; o < (size_t)a.w * a.h; o++) {
+        if (!ma[o] && !mb[o]) continue;
+        px++;
+        int ch = 0;
+        for (int c = 0; c < 3; c++) ch |= abs((int)a.rgb[3 * o + c] - (int)b.rgb[3 * o + c]) > 40;
+        changed += ch;
+    }
+    print_message("2D outline: %zu triangles; %zu of %zu scene pixels change with it (at least 3 %%)\n", ntris, changed,
+                  px);
+    assert_true(ntris > 100);
+    assert_true(changed > 0.03 * (double)px);
+    free(ma);
+    free(mb);
+    free(a.rgb);
+    free(b.rgb);
 }
 
 /* Bad input: exit status 2 and a message naming the problem, before any window opens. */
