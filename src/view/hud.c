@@ -110,7 +110,7 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi)
         pthread_mutex_lock(&S->mu);
         bool gave_up = S->gave_up, failed = S->failed;
         double last = 1e3 * S->last_s, avg = 1e3 * S->avg_s, budget = 1e3 * S->budget, rate = S->rate;
-        double retry = S->retry_at - omp_get_wtime();
+        double retry = S->retry_at - omp_get_wtime(), cell = S->cell;
         char smsg[300];
         snprintf(smsg, sizeof smsg, "%s", S->msg);
         pthread_mutex_unlock(&S->mu);
@@ -123,14 +123,14 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi)
         } else if (gave_up) {
             /* the automatic fallback: the surface could not keep up at the coarsest cell */
             snprintf(line, sizeof line,
-                     "SURFACE TOO SLOW (%.0f MS > %.0f MS AT CELL %.2g D): PARTICLES, RETRY IN %.0f S", last, budget,
-                     A->S.cell, retry > 0 ? retry : 0);
+                     "SURFACE TOO SLOW (%.0f MS > %.0f MS AT CELL %.3g D): PARTICLES, RETRY IN %.0f S", last, budget,
+                     cell, retry > 0 ? retry : 0);
             col = RED;
         } else if (!A->live_mesh.nverts) {
             snprintf(line, sizeof line, "SURFACE: FIRST REBUILD...");
         } else {
             snprintf(line, sizeof line,
-                     "SURFACE %zu TRIANGLES  CELL %.2g D  %.0f MS (MEAN %.0f)  %.0f/S  (M: PARTICLES)",
+                     "SURFACE %zu TRIANGLES  CELL %.3g D  %.0f MS (MEAN %.0f)  %.0f/S  (M: PARTICLES)",
                      A->live_mesh.ntris, A->live_mesh_cell, last, avg, rate);
         }
         panel_text(A, 6 * s, y, s, line, col);

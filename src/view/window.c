@@ -47,7 +47,7 @@ static void print_surface(pfsph_vapp *A)
     const bool drawn = pfsph_vframe_live_surface(A);
     pthread_mutex_lock(&S->mu);
     if (drawn)
-        printf("surface: %zu triangles at t = %.6g s, cell %.2g d, %llu rebuilds, last %.1f ms, mean %.1f ms\n",
+        printf("surface: %zu triangles at t = %.6g s, cell %.3g d, %llu rebuilds, last %.1f ms, mean %.1f ms\n",
                A->live_mesh.ntris, A->live_mesh_time, A->live_mesh_cell, (unsigned long long)S->nbuilt, 1e3 * S->last_s,
                1e3 * S->avg_s);
     else
@@ -172,6 +172,9 @@ int pfsph_vwindow_run(pfsph_vapp *A)
                 /* off: drop the old mesh, so that turning it on does not show a stale one */
                 pfsph_surface_mesh_free(&A->live_mesh);
                 memset(&A->live_mesh, 0, sizeof A->live_mesh);
+                pthread_mutex_lock(&A->S.mu);
+                A->S.posted_time = -1; /* turned on again (paused, say): rebuild the frame shown */
+                pthread_mutex_unlock(&A->S.mu);
             }
         } else if (A->R.playing && glfwGetTime() >= A->R.next_t) {
             A->R.next_t += 1.0 / fps_play;
