@@ -79,6 +79,7 @@ typedef struct pfsph_vsurf {
     pthread_mutex_t mu;
     pthread_cond_t cv;
     bool started, quit;
+    bool sync; /* a screenshot: every drawn frame's mesh, no limit on the rebuild rate */
     int dim;
     double spacing, budget; /* particle spacing [m]; the time a rebuild may take [s] (1/30) */
     /* the job: the liquid's positions and phases of the snapshot handed over */
@@ -87,6 +88,7 @@ typedef struct pfsph_vsurf {
     size_t n, cap;
     bool job;
     double job_time, posted_time;
+    double post_wall, next_post; /* wall time of the last hand-over; the next one not before */
     uint64_t posted_steps;
     /* the meshes: the worker's, the newest finished; their simulated times and cells (/ d) */
     pfsph_surface_mesh mesh[2];

@@ -304,6 +304,7 @@ int pfsph_view_main(int argc, char **argv)
             fprintf(stderr, "pfsph: view: cannot start the surface thread; particles only\n");
         } else {
             /* a screenshot takes the finest cell unless told a budget: the same picture at any load */
+            A->S.sync = o->screenshot != NULL;
             A->S.budget = o->surface_budget > 0 ? 1e-3 * o->surface_budget : o->screenshot ? INFINITY : 1.0 / 30;
         }
     }

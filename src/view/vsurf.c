@@ -141,6 +141,7 @@ static void *worker(void *arg)
             S->ir = t;
             S->fresh = true;
             if (S->n) adapt(S, sec);
+            S->next_post = S->post_wall + fmax(1.0 / 30, 2 * sec);
         }
         pthread_cond_broadcast(&S->cv);
     }
@@ -193,7 +194,12 @@ bool pfsph_vsurf_post(pfsph_vsurf *S, const pfsph_scene *sc, const pfsph_vframe 
     bool posted = false;
     pthread_mutex_lock(&S->mu);
     if (S->gave_up && omp_get_wtime() >= S->retry_at) S->gave_up = false;
-    if (!S->job && !S->gave_up && !S->failed && (f->steps != S->posted_steps || f->time != S->posted_time)) {
+    /* at most one rebuild per 1/30 s, and a core at most half busy with them (the next one
+     * not before twice the last one's time after its start): the simulation keeps the rest;
+     * a screenshot (sync) waits for every frame's mesh instead */
+    const double now = omp_get_wtime();
+    const bool due = S->sync || now >= S->next_post;
+    if (!S->job && due && !S->gave_up && !S->failed && (f->steps != S->posted_steps || f->time != S->posted_time)) {
         const pfsph_particles *ps = &f->fluid;
         if (ps->n > S->cap) {
             double *x = realloc(S->x, 3 * ps->n * sizeof *x);
@@ -217,6 +223,7 @@ bool pfsph_vsurf_post(pfsph_vsurf *S, const pfsph_scene *sc, const pfsph_vframe 
             S->job_time = f->time;
             S->posted_steps = f->steps;
             S->posted_time = f->time;
+            S->post_wall = now;
             posted = true;
             pthread_cond_broadcast(&S->cv);
         }
