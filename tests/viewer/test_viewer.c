@@ -483,6 +483,9 @@ static void test_bad_input(void **state)
     assert_non_null(strstr(out, "vorticity"));
     snprintf(cmd, sizeof cmd, "%s view --frames 0", tu_pfsph_bin());
     assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    snprintf(cmd, sizeof cmd, "%s view --surface-budget 0", tu_pfsph_bin());
+    assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "--surface-budget"));
     snprintf(cmd, sizeof cmd, "%s view --hide water", tu_pfsph_bin());
     assert_int_equal(tu_run(cmd, out, sizeof out), 2);
     assert_non_null(strstr(out, "water"));
