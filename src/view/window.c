@@ -39,7 +39,7 @@ static void print_changes(pfsph_vapp *A)
     pthread_mutex_unlock(&A->L.mu);
 }
 
-/* Live 3D: what the surface drew and what it cost (screenshots and --bench). */
+/* Live: what the surface (2D: the outline) drew and what it cost (screenshots and --bench). */
 static void print_surface(pfsph_vapp *A)
 {
     pfsph_vsurf *S = &A->S;
