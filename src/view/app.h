@@ -66,7 +66,44 @@ typedef struct pfsph_vlive {
     double sps;         /* steps per second, over the last half second */
     double rtf;         /* real-time factor: simulated s per wall s, over the last half second */
     uint64_t published; /* snapshots published */
+    /* queued changes: when the oldest was queued; applied so far, the step they act from, and
+     * how long the last and the slowest waited for the step in progress [s] */
+    double cmd_t0, lat_last, lat_max;
+    uint64_t applied, applied_step;
 } pfsph_vlive;
+
+/* Live mode: the liquid's surface, rebuilt on a thread of its own (vsurf.c). */
+#define PFSPH_VSURF_LEVELS 4
+typedef struct pfsph_vsurf {
+    pthread_t th;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    bool started, quit;
+    bool sync; /* a screenshot: every drawn frame's mesh, no limit on the rebuild rate */
+    int dim;
+    double spacing, budget; /* particle spacing [m]; the time a rebuild may take [s] (1/30) */
+    /* the job: the liquid's positions and phases of the snapshot handed over */
+    double *x;
+    uint8_t *ph;
+    size_t n, cap;
+    bool job;
+    double job_time, posted_time;
+    double post_wall, next_post; /* wall time of the last hand-over; the next one not before */
+    uint64_t posted_steps;
+    /* the meshes: the worker's, the newest finished; their simulated times and cells (/ d) */
+    pfsph_surface_mesh mesh[2];
+    double mesh_time[2], mesh_cell[2];
+    int iw, ir;
+    bool fresh;
+    /* the cost: level (index of the cell), the last and the smoothed rebuild times [s] */
+    int level, over, under;
+    double cell, last_s, avg_s;
+    uint64_t nbuilt, rate_n0;
+    double rate, rate_t0; /* rebuilds per second, over the last half second */
+    bool gave_up, failed; /* too slow at the coarsest cell (retried at retry_at) / an error */
+    double retry_at;
+    char msg[300];
+} pfsph_vsurf;
 
 /* Replay mode: the frames of a run directory. */
 typedef struct pfsph_vreplay {
@@ -89,7 +126,9 @@ typedef struct pfsph_vopts {
     const char *screenshot, *dump;
     bool hide_walls, hide_bodies, hide_diffuse;
     int frames;
-    int samples; /* 0: automatic */
+    double surface_budget; /* ms, 0: default */
+    const char *press;     /* keys pressed, one per drawn frame after the first (tests, demos) */
+    int samples;           /* 0: automatic */
     double bench;
 } pfsph_vopts;
 
@@ -99,6 +138,10 @@ typedef struct pfsph_vapp {
     pfsph_scene *scene; /* live: as loaded; replay: RUN_DIR/scene.json */
     bool is_live;
     pfsph_vlive L;
+    pfsph_vsurf S;                /* live, 3D: the liquid's surface */
+    pfsph_surface_mesh live_mesh; /* live: the surface drawn (from S) */
+    double live_mesh_time, live_mesh_cell;
+    bool live_mesh_new;
     pfsph_vreplay R;
     pfsph_vframe rf; /* replay: the frame shown */
     const pfsph_vframe *shown;
@@ -107,9 +150,11 @@ typedef struct pfsph_vapp {
     double vref;  /* speed colour scale */
     int by;
     bool show_walls, show_bodies, show_diffuse, show_help;
-    bool show_surface;                  /* replay: meshes where the run has them (M toggles) */
+    bool show_surface;                  /* meshes (replay: where the run has them; live: the liquid's surface
+                                           where it keeps up) or particles (M toggles) */
     bool cut_walls;                     /* 3D: the walls facing the camera cut away (X toggles) */
     pfsph_vmesh *gl_liquid, *gl_bodies; /* the shown frame's meshes on the GPU */
+    pfsph_vmesh *gl_gas;                /* live: the gases' surfaces (bubbles), in their phase colours */
     float *mv;                          /* vertex staging for the uploads */
     size_t mv_cap;
     int pair_a, pair_b; /* selected phase pair (live) */
@@ -135,6 +180,8 @@ extern const char *const pfsph_vby_name[PFSPH_VBY_COUNT];
 
 /* ---- frame.c ---------------------------------------------------------------------------- */
 void pfsph_vframe_free(pfsph_vframe *f);
+/* Whether live mode draws its reconstructed surface now (on, a mesh there, not given up). */
+bool pfsph_vframe_live_surface(pfsph_vapp *A);
 /* Draw A->shown (and the overlay unless --no-overlay) into the frame. */
 void pfsph_vframe_draw(pfsph_vapp *A);
 
@@ -147,6 +194,19 @@ void *pfsph_vlive_main(void *arg);
 void pfsph_vlive_post(pfsph_vlive *L, const pfsph_vcmd *q);
 /* Wait (up to 120 s) for a snapshot newer than the one drawn. */
 void pfsph_vlive_wait_fresh(pfsph_vlive *L);
+
+/* ---- vsurf.c ------------------------------------------------------------------------------ */
+/* Whether phase ph is drawn as a surface (fluids and gases). */
+bool pfsph_vsurf_meshes_phase(const pfsph_scene *sc, int ph);
+/* Start / stop the surface thread (start: 0, or -1 when it cannot). */
+int pfsph_vsurf_start(pfsph_vsurf *S, const pfsph_scene *sc);
+void pfsph_vsurf_stop(pfsph_vsurf *S);
+/* Hand f's liquid to the thread when it is idle and f is newer than the last handed over. */
+bool pfsph_vsurf_post(pfsph_vsurf *S, const pfsph_scene *sc, const pfsph_vframe *f);
+/* Wait for the job handed over to finish. */
+void pfsph_vsurf_wait(pfsph_vsurf *S);
+/* Swap the newest finished mesh into *out (with its simulated time and cell / d); false: none new. */
+bool pfsph_vsurf_take(pfsph_vsurf *S, pfsph_surface_mesh *out, double *time, double *cell);
 
 /* ---- replay.c ----------------------------------------------------------------------------- */
 /* Load fluid frame index k into f (and the boundary, bodies, diffuse and mesh files of its number). */
@@ -162,6 +222,8 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi);
 /* ---- input.c ------------------------------------------------------------------------------ */
 /* Select the next phase pair that can act (not two solids). */
 void pfsph_vinput_next_pair(pfsph_vapp *A);
+/* A key pressed (GLFW_KEY_*): what the window's key callback does, also for --press. */
+void pfsph_vinput_key(pfsph_vapp *A, int key);
 /* Key, mouse button, cursor and scroll callbacks for the window (its user pointer: A). */
 void pfsph_vinput_attach(GLFWwindow *w);
 

@@ -162,6 +162,64 @@ static void upload_meshes(pfsph_vapp *A)
     }
 }
 
+/* Live mode: the reconstructed surface into its vertex buffers: the liquid phases' faces shaded as
+ * water, the gases' (bubbles) in their phase's colour, both with the reconstruction's smooth
+ * normals and one shared vertex array. */
+static void upload_live_mesh(pfsph_vapp *A)
+{
+    A->live_mesh_new = false;
+    if (!A->gl_liquid) A->gl_liquid = pfsph_vmesh_create();
+    if (!A->gl_gas) A->gl_gas = pfsph_vmesh_create();
+    if (!A->gl_liquid || !A->gl_gas) return;
+    const pfsph_surface_mesh *m = &A->live_mesh;
+    const pfsph_scene *sc = A->scene;
+    uint32_t *idx = NULL;
+    size_t nl = 0, ng = 0;
+    if (m->ntris && m->n && mv_reserve(A, 9 * m->nverts) && (idx = malloc(3 * m->ntris * sizeof *idx))) {
+        /* vertex colours from the faces (a vertex bounds one phase: phases are meshed apart) */
+        for (size_t i = 0; i < m->nverts; i++) {
+            float *v = A->mv + 9 * i;
+            for (int k = 0; k < 3; k++) v[k] = (float)m->v[3 * i + k], v[3 + k] = m->n[3 * i + k], v[6 + k] = 0.7f;
+        }
+        for (size_t t = 0; t < m->ntris; t++) {
+            int ph = m->phase[t];
+            if (sc->dim == 2) { /* the outline: in the phase's colour, darker */
+                ng++;
+                for (int c = 0; c < 3; c++)
+                    for (int k = 0; k < 3; k++)
+                        A->mv[9 * m->tri[3 * t + c] + 6 + k] =
+                            ph < sc->nphases ? 0.45f * sc->phases[ph].color[k] : 0.1f;
+            } else if (ph < sc->nphases && sc->phases[ph].kind == PFSPH_PHASE_GAS) {
+                ng++;
+                for (int c = 0; c < 3; c++)
+                    memcpy(A->mv + 9 * m->tri[3 * t + c] + 6, sc->phases[ph].color, 3 * sizeof(float));
+            } else {
+                nl++;
+            }
+        }
+        /* liquid faces from the front of idx, gas faces from the back */
+        size_t a = 0, b = m->ntris;
+        for (size_t t = 0; t < m->ntris; t++) {
+            int ph = m->phase[t];
+            size_t o = sc->dim == 2 || (ph < sc->nphases && sc->phases[ph].kind == PFSPH_PHASE_GAS) ? --b : a++;
+            memcpy(idx + 3 * o, m->tri + 3 * t, 3 * sizeof *idx);
+        }
+    }
+    pfsph_vmesh_upload(A->gl_liquid, nl ? A->mv : NULL, nl ? m->nverts : 0, idx, 3 * nl);
+    pfsph_vmesh_upload(A->gl_gas, ng ? A->mv : NULL, ng ? m->nverts : 0, idx ? idx + 3 * nl : NULL, 3 * ng);
+    free(idx);
+}
+
+/* Whether live mode draws its reconstructed surface now (on, a mesh there, not given up). */
+bool pfsph_vframe_live_surface(pfsph_vapp *A)
+{
+    if (!A->is_live || !A->show_surface || !A->S.started || !A->live_mesh.nverts) return false;
+    pthread_mutex_lock(&A->S.mu);
+    bool ok = !A->S.gave_up && !A->S.failed;
+    pthread_mutex_unlock(&A->S.mu);
+    return ok;
+}
+
 void pfsph_vframe_draw(pfsph_vapp *A)
 {
     const pfsph_vframe *f = A->shown;
@@ -186,11 +244,16 @@ void pfsph_vframe_draw(pfsph_vapp *A)
     if (f->mesh_new) upload_meshes(A);
     const bool liq = A->show_surface && !d2 && A->rf.liquid.ntris && !A->is_live;
     const bool bmesh = A->show_surface && !d2 && A->rf.bmesh.ntris && !A->is_live;
-    n = liq ? 0 : add_sprites(A, 0, &f->fluid, d2 ? 1.3 * r : r, 0, 0, lo, hi, NULL);
+    const bool lsurf = pfsph_vframe_live_surface(A);
+    if (lsurf && A->live_mesh_new) upload_live_mesh(A);
+    /* the surface covers every phase of the fluid set (liquids and gases: vsurf.c); in 2D the
+     * outline is drawn over the particles */
+    n = liq || (lsurf && !d2) ? 0 : add_sprites(A, 0, &f->fluid, d2 ? 1.3 * r : r, 0, 0, lo, hi, NULL);
     if (A->show_diffuse) n = add_sprites(A, n, &f->diffuse, 0.4 * r, 0, 2, 0, 1, NULL);
     if (A->show_bodies && !bmesh) n = add_sprites(A, n, &f->bodies, r, 0, 3, 0, 1, NULL);
     pfsph_vdraw_sprites(A->draw, 0, A->spr, n);
-    if (liq) pfsph_vdraw_mesh(A->draw, A->gl_liquid, 1);
+    if (liq || lsurf) pfsph_vdraw_mesh(A->draw, A->gl_liquid, 1);
+    if (lsurf) pfsph_vdraw_mesh(A->draw, A->gl_gas, 0);
     if (bmesh && A->show_bodies) pfsph_vdraw_mesh(A->draw, A->gl_bodies, 0);
     pfsph_vdraw_composite(A->draw);
     if (!A->o.no_overlay) {

@@ -1,6 +1,7 @@
 /* The viewer's overlay (app.h): clock and counts, the selected phase pair, messages, the
  * legend, the replay slider and the help, as text on translucent panels. */
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -103,10 +104,42 @@ void pfsph_vhud_draw(pfsph_vapp *A, double lo, double hi)
                  A->rf.bmesh.ntris, A->show_surface ? "(M: PARTICLES)" : "HIDDEN (M: MESHES)");
         panel_text(A, 6 * s, y, s, line, INK);
     }
+    if (A->is_live && A->S.started) {
+        y += lh;
+        pfsph_vsurf *S = &A->S;
+        pthread_mutex_lock(&S->mu);
+        bool gave_up = S->gave_up, failed = S->failed;
+        double last = 1e3 * S->last_s, avg = 1e3 * S->avg_s, budget = 1e3 * S->budget, rate = S->rate;
+        double retry = S->retry_at - omp_get_wtime(), cell = S->cell;
+        char smsg[300];
+        snprintf(smsg, sizeof smsg, "%s", S->msg);
+        pthread_mutex_unlock(&S->mu);
+        const float *col = INK;
+        if (!A->show_surface) {
+            snprintf(line, sizeof line, "PARTICLES (M: SURFACE)");
+        } else if (failed) {
+            snprintf(line, sizeof line, "%s: PARTICLES", smsg);
+            col = RED;
+        } else if (gave_up) {
+            /* the automatic fallback: the surface could not keep up at the coarsest cell */
+            snprintf(line, sizeof line,
+                     "SURFACE TOO SLOW (%.0f MS > %.0f MS AT CELL %.3g D): PARTICLES, RETRY IN %.0f S", last, budget,
+                     cell, retry > 0 ? retry : 0);
+            col = RED;
+        } else if (!A->live_mesh.nverts) {
+            snprintf(line, sizeof line, "SURFACE: FIRST REBUILD...");
+        } else {
+            snprintf(line, sizeof line,
+                     "SURFACE %zu TRIANGLES  CELL %.3g D  %.0f MS (MEAN %.0f)  %.0f/S  (M: PARTICLES)",
+                     A->live_mesh.ntris, A->live_mesh_cell, last, avg, rate);
+        }
+        panel_text(A, 6 * s, y, s, line, col);
+    }
 
     /* legend, bottom right (none for a liquid drawn as water: the field does not colour it) */
     float lw = 120 * s, bx = A->fb_w - lw - 10 * s, by = A->fb_h - (A->is_live ? 14 : 26) * s;
-    if (meshes && A->show_surface && A->rf.liquid.ntris && A->by != PFSPH_VBY_PHASE) {
+    if (((meshes && A->rf.liquid.ntris) || pfsph_vframe_live_surface(A)) && A->show_surface &&
+        A->by != PFSPH_VBY_PHASE) {
         /* nothing */
     } else if (A->by == PFSPH_VBY_PHASE) {
         float yy = by;

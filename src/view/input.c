@@ -66,12 +66,16 @@ static void on_key(GLFWwindow *w, int key, int sc, int action, int mods)
 {
     (void)sc;
     (void)mods;
-    pfsph_vapp *A = glfwGetWindowUserPointer(w);
     if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+    pfsph_vinput_key(glfwGetWindowUserPointer(w), key);
+}
+
+void pfsph_vinput_key(pfsph_vapp *A, int key)
+{
     A->dirty = true;
     switch (key) {
     case GLFW_KEY_ESCAPE:
-    case GLFW_KEY_Q: glfwSetWindowShouldClose(w, 1); return;
+    case GLFW_KEY_Q: glfwSetWindowShouldClose(A->win, 1); return;
     case GLFW_KEY_C: A->by = (A->by + 1) % PFSPH_VBY_COUNT; return;
     case GLFW_KEY_W: A->show_walls = !A->show_walls; return;
     case GLFW_KEY_B: A->show_bodies = !A->show_bodies; return;

@@ -99,6 +99,15 @@ static void apply_cmds(pfsph_vlive *L)
         }
         if (rc) snprintf(L->msg, sizeof L->msg, "refused: %s", err.msg);
     }
+    /* how long the oldest change waited for the step in progress (docs/viewer.md: a change acts
+     * from the next step, so within a frame of 1-3 steps) */
+    if (L->ncmd) {
+        double lat = omp_get_wtime() - L->cmd_t0;
+        L->applied += (uint64_t)L->ncmd;
+        L->lat_last = lat;
+        if (lat > L->lat_max) L->lat_max = lat;
+        L->applied_step = pfsph_sim_steps(L->sim);
+    }
     L->ncmd = 0;
 }
 
@@ -195,6 +204,7 @@ void pfsph_vlive_post(pfsph_vlive *L, const pfsph_vcmd *q)
     if (q->kind == PFSPH_VCMD_DRAG && L->ncmd > 0 && L->cmd[L->ncmd - 1].kind == PFSPH_VCMD_DRAG &&
         L->cmd[L->ncmd - 1].a == q->a)
         L->ncmd--;
+    if (!L->ncmd) L->cmd_t0 = omp_get_wtime();
     if (L->ncmd < PFSPH_VMAX_CMDS) L->cmd[L->ncmd++] = *q;
     pthread_cond_broadcast(&L->cv);
     pthread_mutex_unlock(&L->mu);

@@ -22,6 +22,7 @@ const char *const pfsph_view_help =
     "                  [--threads N] [--paused] [--screenshot FILE.png --frames N]\n"
     "                  [--dump DIR] [--hide walls,bodies,diffuse] [--no-overlay]\n"
     "                  [--samples 1|2] [--bench SECONDS] [--particles] [--all-walls]\n"
+    "                  [--surface-budget MS] [--press KEYS]\n"
     "\n"
     "Live mode (SCENE, a JSON file; none: the embedded default scene): the scene is simulated\n"
     "in the window, step by step, as `pfsph run` does. Replay mode (RUN_DIR, a run directory):\n"
@@ -41,7 +42,11 @@ const char *const pfsph_view_help =
     "  --samples 1|2      samples per pixel along each axis (default 2, as `pfsph render`;\n"
     "                     1 in a window on a software renderer, for speed)\n"
     "  --bench SECONDS    draw continuously for SECONDS, print frames/s and steps/s, exit\n"
-    "  --particles        replay: start with particles where the run has liquid or body meshes\n"
+    "  --particles        start with particles (replay: where the run has meshes; live:\n"
+    "                     instead of the liquid's surface)\n"
+    "  --surface-budget MS  live: the time one rebuild of the surface may take (default\n"
+    "                     33.3, a 1/30 s frame; a screenshot: no limit, the finest cell)\n"
+    "  --press KEYS       press these keys, one per frame drawn after the first (M, G, ...)\n"
     "  --all-walls        3D: keep the walls that face the camera (default: cut away)\n"
     "\n"
     "Mouse: left drag orbits (2D: pans), right or middle drag (or shift + left) pans, wheel\n"
@@ -49,8 +54,8 @@ const char *const pfsph_view_help =
     "one without keyframes along the cursor); replay:\n"
     "click or drag the slider. Keys: space pause/play, N single step (live) or\n"
     "next frame, P previous frame, Home/End first/last frame, R reset, C colour field,\n"
-    "W walls, B bodies, D diffuse, X cut-away of the walls facing the camera (3D), M meshes /\n"
-    "particles (replay), F reset the camera, S save pfsph_view_NNN.png, H help, Esc or Q quit.\n"
+    "W walls, B bodies, D diffuse, X cut-away of the walls facing the camera (3D), M surface /\n"
+    "particles, F reset the camera, S save pfsph_view_NNN.png, H help, Esc or Q quit.\n"
     "Live only:\n"
     "G gravity on/off, [ and ] turn gravity by 15 degrees, Tab next phase pair, + and - raise\n"
     "or lower its coefficient / surface tension (x1.25) or contact angle (10 degrees).\n";
@@ -107,6 +112,16 @@ static int parse_opts(int argc, char **argv, pfsph_vopts *o)
             o->bench = v ? strtod(v, &end) : -1;
             if (!v || *end || !(o->bench > 0 && o->bench <= 3600))
                 return usage("--bench: '%s' is not 0..3600 seconds", v ? v : "");
+            i++;
+        } else if (!strcmp(a, "--surface-budget")) {
+            char *end = NULL;
+            o->surface_budget = v ? strtod(v, &end) : -1;
+            if (!v || *end || !(o->surface_budget > 0 && o->surface_budget <= 60000))
+                return usage("--surface-budget: '%s' is not 0..60000 ms", v ? v : "");
+            i++;
+        } else if (!strcmp(a, "--press")) {
+            if (!v) return usage("%s needs keys", a);
+            o->press = v;
             i++;
         } else if (!strcmp(a, "--hide")) {
             if (!v) return usage("%s needs a list: walls,bodies,diffuse", a);
@@ -282,7 +297,20 @@ int pfsph_view_main(int argc, char **argv)
         rc = pfsph_fail(&err, PFSPH_EIO, "cannot start the simulation thread");
         goto fail;
     }
+    /* live: the liquid's surface (2D: its outline) on a thread of its own (vsurf.c); without
+     * it, particles */
+    if (A->is_live) {
+        if (pfsph_vsurf_start(&A->S, A->scene)) {
+            fprintf(stderr, "pfsph: view: cannot start the surface thread; particles only\n");
+        } else {
+            /* a screenshot takes the finest cell unless told a budget: the same picture at any load */
+            A->S.sync = o->screenshot != NULL;
+            A->S.budget = o->surface_budget > 0 ? 1e-3 * o->surface_budget : o->screenshot ? INFINITY : 1.0 / 30;
+        }
+    }
     status = pfsph_vwindow_run(A);
+    pfsph_vsurf_stop(&A->S);
+    pfsph_surface_mesh_free(&A->live_mesh);
     if (A->is_live) {
         pthread_mutex_lock(&A->L.mu);
         A->L.quit = true;

@@ -3,6 +3,7 @@
 #include <epoxy/gl.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "pfsph/io.h"
 #include "view/app.h"
@@ -24,6 +25,39 @@ static void save_png(pfsph_vapp *A, const char *path)
     else printf("wrote %s\n", path);
     fflush(stdout);
     free(rgb);
+}
+
+/* Live: the changes made with keys or the mouse, and how soon they acted. */
+static void print_changes(pfsph_vapp *A)
+{
+    if (!A->is_live) return;
+    pthread_mutex_lock(&A->L.mu);
+    if (A->L.applied)
+        printf("changes: %llu applied, the last from step %llu, %.1f ms after it was made (at most %.1f ms)\n",
+               (unsigned long long)A->L.applied, (unsigned long long)A->L.applied_step, 1e3 * A->L.lat_last,
+               1e3 * A->L.lat_max);
+    pthread_mutex_unlock(&A->L.mu);
+}
+
+/* Live: what the surface (2D: the outline) drew and what it cost (screenshots and --bench). */
+static void print_surface(pfsph_vapp *A)
+{
+    pfsph_vsurf *S = &A->S;
+    if (!S->started) return;
+    const bool drawn = pfsph_vframe_live_surface(A);
+    pthread_mutex_lock(&S->mu);
+    if (drawn)
+        printf("surface: %zu triangles at t = %.6g s, cell %.3g d, %llu rebuilds, last %.1f ms, mean %.1f ms\n",
+               A->live_mesh.ntris, A->live_mesh_time, A->live_mesh_cell, (unsigned long long)S->nbuilt, 1e3 * S->last_s,
+               1e3 * S->avg_s);
+    else
+        printf("surface: particles drawn (%s; %llu rebuilds, last %.1f ms, budget %.1f ms)\n",
+               !A->show_surface ? "off"
+                   : S->gave_up ? "too slow"
+                   : S->failed  ? S->msg
+                                : "no mesh yet",
+               (unsigned long long)S->nbuilt, 1e3 * S->last_s, 1e3 * S->budget);
+    pthread_mutex_unlock(&S->mu);
 }
 
 static int write_outputs(pfsph_vapp *A)
@@ -56,6 +90,8 @@ static int write_outputs(pfsph_vapp *A)
     }
     printf("wrote %s (%dx%d, t = %.6g s, step %llu, %zu fluid particles)\n", A->o.screenshot, A->fb_w, A->fb_h,
            A->shown->time, (unsigned long long)A->shown->steps, A->shown->fluid.n);
+    print_surface(A);
+    print_changes(A);
     return 0;
 }
 
@@ -125,6 +161,21 @@ int pfsph_vwindow_run(pfsph_vapp *A)
             }
             A->shown = &A->L.fr[A->L.idr];
             pthread_mutex_unlock(&A->L.mu);
+            /* the liquid's surface: the drawn snapshot to the surface thread when it is idle,
+             * its newest mesh back; a screenshot waits for the mesh of the frame it draws */
+            if (A->S.started && A->show_surface) {
+                bool posted = pfsph_vsurf_post(&A->S, A->scene, A->shown);
+                if (headless && posted) pfsph_vsurf_wait(&A->S);
+                if (pfsph_vsurf_take(&A->S, &A->live_mesh, &A->live_mesh_time, &A->live_mesh_cell))
+                    A->live_mesh_new = A->dirty = true;
+            } else if (A->live_mesh.nverts) {
+                /* off: drop the old mesh, so that turning it on does not show a stale one */
+                pfsph_surface_mesh_free(&A->live_mesh);
+                memset(&A->live_mesh, 0, sizeof A->live_mesh);
+                pthread_mutex_lock(&A->S.mu);
+                A->S.posted_time = -1; /* turned on again (paused, say): rebuild the frame shown */
+                pthread_mutex_unlock(&A->S.mu);
+            }
         } else if (A->R.playing && glfwGetTime() >= A->R.next_t) {
             A->R.next_t += 1.0 / fps_play;
             if (A->R.next_t < glfwGetTime()) A->R.next_t = glfwGetTime() + 1.0 / fps_play; /* fell behind */
@@ -154,6 +205,11 @@ int pfsph_vwindow_run(pfsph_vapp *A)
                 snprintf(name, sizeof name, "pfsph_view_%03d.png", A->saved++);
                 save_png(A, name);
             }
+            /* --press: one key per drawn frame after the first, through the key handler */
+            if (o->press && drawn >= 1 && o->press[drawn - 1]) {
+                int c = o->press[drawn - 1];
+                pfsph_vinput_key(A, c >= 'a' && c <= 'z' ? c - 'a' + 'A' : c);
+            }
             if (headless && drawn >= o->frames) {
                 status = write_outputs(A);
                 break;
@@ -165,6 +221,9 @@ int pfsph_vwindow_run(pfsph_vapp *A)
                        A->shown->fluid.n, A->shown->walls.n, drawn / (now - bench_t0),
                        (double)(st - bench_steps0) / (now - bench_t0), A->fb_w, A->fb_h, ss * ss,
                        (const char *)glGetString(GL_RENDERER));
+                print_surface(A);
+                print_changes(A);
+                print_changes(A);
                 break;
             }
             glfwPollEvents();
@@ -176,7 +235,8 @@ int pfsph_vwindow_run(pfsph_vapp *A)
     }
     pfsph_vmesh_destroy(A->gl_liquid);
     pfsph_vmesh_destroy(A->gl_bodies);
-    A->gl_liquid = A->gl_bodies = NULL;
+    pfsph_vmesh_destroy(A->gl_gas);
+    A->gl_liquid = A->gl_bodies = A->gl_gas = NULL;
     pfsph_vdraw_destroy(A->draw);
     glfwDestroyWindow(A->win);
     glfwTerminate();

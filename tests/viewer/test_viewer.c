@@ -1,8 +1,10 @@
 /* `pfsph view` under a display (xvfb-run in CI, CMakeLists.txt): a live 2D scene drawn for 20
  * frames covers the pixels its particles' positions predict; replaying a run shows the frame
  * the PNG renderer shows (2D and 3D, same camera, walls cut away or not; a run with a rigid
- * body and liquid meshes drawn as meshes, and the mesh toggle); bad input. Skipped in builds without the
- * viewer or without a display. */
+ * body and liquid meshes drawn as meshes, and the mesh toggle); live 3D draws the liquid as a
+ * surface, M (pressed with --press) and --particles go back to particles, and a surface too
+ * slow for its budget falls back to particles; bad input. Skipped in builds without the viewer
+ * or without a display. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,6 +59,17 @@ static const char *SCENE3D_MESH =
     "   \"position\": [0.28, 0.1, 0.15], \"rotation\": [0, 30, 0], \"density\": 600, \"phase\": \"wood\"}],"
     " \"output\": {\"formats\": [\"vtp\", \"ply\"], \"boundary\": true, \"surface\": true},"
     " \"camera\": {\"width\": 320, \"height\": 240}}";
+
+/* A ball of liquid (about 900 particles) at rest in zero gravity, no walls; orange, so that
+ * the water shading of a surface (blue) tells it from the particles (the phase's colour). */
+static const char *SCENE3D_DROP =
+    "{\"name\": \"viewer test 3D drop\", \"dimension\": 3, \"particle_radius\": 0.005,"
+    " \"gravity\": [0, 0, 0], \"domain\": {\"min\": [-0.1, -0.1, -0.1], \"max\": [0.1, 0.1, 0.1]},"
+    " \"solver\": {\"type\": \"pcisph\"}, \"time\": {\"end\": 100, \"fps\": 30, \"dt_max\": 0.002},"
+    " \"phases\": [{\"name\": \"juice\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": 1e-3,"
+    "   \"color\": [0.95, 0.5, 0.1]}],"
+    " \"fluid\": [{\"shape\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 0.06, \"phase\": \"juice\"}],"
+    " \"camera\": {\"width\": 320, \"height\": 240, \"eye\": [0.1, 0.08, 0.25], \"target\": [0, 0, 0]}}";
 
 typedef tu_img img;
 
@@ -127,7 +140,7 @@ static void test_live_2d(void **state)
     snprintf(dump, sizeof dump, "%s/dump", dir);
     snprintf(cmd, sizeof cmd,
              "%s view %s --screenshot %s --frames 20 --dump %s --no-overlay --hide walls "
-             "--color-by phase --threads 2",
+             "--color-by phase --threads 2 --particles",
              tu_pfsph_bin(), scene, shot, dump);
     int st = tu_run(cmd, out, sizeof out);
     print_message("%s", out);
@@ -332,6 +345,125 @@ static void test_replay_meshes(void **state)
     free(b.rgb);
 }
 
+/* Live 3D with extra options: screenshot into dir/name, stdout into out; the exit status. */
+static int live_shot(const char *scene, const char *args, const char *name, char *shot, size_t cap, char *out,
+                     size_t ocap)
+{
+    char cmd[2400];
+    snprintf(shot, cap, "%s/%s", tu_tmpdir(), name);
+    snprintf(cmd, sizeof cmd, "%s view %s --screenshot %s --no-overlay --threads 2 %s", tu_pfsph_bin(), scene, shot,
+             args);
+    int st = tu_run(cmd, out, ocap);
+    print_message("%s", out);
+    return st;
+}
+
+/* Of the scene's pixels (mask_of): the share drawn in the water shading's blue (blue above red
+ * by 40/255; the particles are orange), and the mean luminance step between neighbouring scene
+ * pixels, in 1/255 (the particles' sphere shading makes steps at every particle's rim). */
+static void liquid_stats(const img *m, double *blue, double *rough, size_t *npx)
+{
+    unsigned char *k = mask_of(m);
+    size_t n = 0, nb = 0, pairs = 0;
+    double steps = 0;
+    for (int y = 0; y < m->h; y++)
+        for (int x = 0; x < m->w; x++) {
+            size_t o = (size_t)y * m->w + x;
+            if (!k[o]) continue;
+            const unsigned char *p = m->rgb + 3 * o;
+            n++;
+            nb += p[2] > p[0] + 40;
+            double l = 0.3 * p[0] + 0.59 * p[1] + 0.11 * p[2];
+            if (x + 1 < m->w && k[o + 1]) {
+                const unsigned char *q = p + 3;
+                steps += fabs(l - (0.3 * q[0] + 0.59 * q[1] + 0.11 * q[2]));
+                pairs++;
+            }
+            if (y + 1 < m->h && k[o + m->w]) {
+                const unsigned char *q = p + 3 * (size_t)m->w;
+                steps += fabs(l - (0.3 * q[0] + 0.59 * q[1] + 0.11 * q[2]));
+                pairs++;
+            }
+        }
+    *npx = n;
+    *blue = n ? (double)nb / (double)n : 0;
+    *rough = pairs ? steps / (double)pairs : 0;
+    free(k);
+}
+
+/* Live 3D surface: by default the liquid is drawn as the reconstructed surface (the report
+ * names its triangles; the scene's pixels are the water shading's blue, and smooth); with
+ * --particles, and after M is pressed (--press M: through the key handler), particles (orange,
+ * a sphere per particle: rough); a surface budget of 1 us cannot be met at any cell: after
+ * three rebuilds at the coarsest the viewer falls back to particles and says so. */
+static void test_live_surface(void **state)
+{
+    (void)state;
+    if (!viewer_available()) tu_skip("no viewer in this build, or no display");
+    char scene[600], shot[700], out[4096];
+    write_scene(tu_tmpdir(), "drop3d.json", SCENE3D_DROP, scene, sizeof scene);
+    const char *args[4] = {"--frames 3", "--frames 3 --particles", "--frames 3 --press M",
+                           "--frames 10 --surface-budget 0.001"};
+    const char *names[4] = {"surface.png", "particles.png", "toggled.png", "budget.png"};
+    const bool surf[4] = {true, false, false, false};
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(live_shot(scene, args[k], names[k], shot, sizeof shot, out, sizeof out), 0);
+        const char *rep = strstr(out, "surface: ");
+        assert_non_null(rep);
+        size_t ntris = 0;
+        if (surf[k]) {
+            assert_int_equal(sscanf(rep, "surface: %zu triangles", &ntris), 1);
+            assert_true(ntris > 1000);
+        } else {
+            assert_non_null(strstr(rep, k == 3 ? "particles drawn (too slow" : "particles drawn (off"));
+        }
+        img m = tu_read_png(shot);
+        double blue, rough;
+        size_t npx;
+        liquid_stats(&m, &blue, &rough, &npx);
+        print_message("%s: %zu triangles, %zu liquid pixels, %.3f of them water blue, mean step %.2f / 255\n", names[k],
+                      ntris, npx, blue, rough);
+        assert_true(npx > 5000);
+        if (surf[k]) {
+            assert_true(blue > 0.9);
+            assert_true(rough < 3.0);
+        } else {
+            assert_true(blue < 0.1);
+            assert_true(rough > 4.0);
+        }
+        free(m.rgb);
+    }
+    /* 2D: the outline (a band of triangles) over the particles; the particles alone without it */
+    char scene2[600], shot2[700];
+    write_scene(tu_tmpdir(), "live2d_outline.json", SCENE2D, scene2, sizeof scene2);
+    assert_int_equal(
+        live_shot(scene2, "--frames 3 --paused --hide walls", "outline.png", shot, sizeof shot, out, sizeof out), 0);
+    size_t ntris = 0;
+    assert_non_null(strstr(out, "surface: "));
+    assert_int_equal(sscanf(strstr(out, "surface: "), "surface: %zu triangles", &ntris), 1);
+    assert_int_equal(live_shot(scene2, "--frames 3 --paused --hide walls --particles", "outline_off.png", shot2,
+                               sizeof shot2, out, sizeof out),
+                     0);
+    img a = tu_read_png(shot), b = tu_read_png(shot2);
+    unsigned char *ma = mask_of(&a), *mb = mask_of(&b);
+    size_t px = 0, changed = 0;
+    for (size_t o = 0; o < (size_t)a.w * a.h; o++) {
+        if (!ma[o] && !mb[o]) continue;
+        px++;
+        int ch = 0;
+        for (int c = 0; c < 3; c++) ch |= abs((int)a.rgb[3 * o + c] - (int)b.rgb[3 * o + c]) > 40;
+        changed += ch;
+    }
+    print_message("2D outline: %zu triangles; %zu of %zu scene pixels change with it (at least 3 %%)\n", ntris, changed,
+                  px);
+    assert_true(ntris > 100);
+    assert_true(changed > 0.03 * (double)px);
+    free(ma);
+    free(mb);
+    free(a.rgb);
+    free(b.rgb);
+}
+
 /* Bad input: exit status 2 and a message naming the problem, before any window opens. */
 static void test_bad_input(void **state)
 {
@@ -351,6 +483,9 @@ static void test_bad_input(void **state)
     assert_non_null(strstr(out, "vorticity"));
     snprintf(cmd, sizeof cmd, "%s view --frames 0", tu_pfsph_bin());
     assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    snprintf(cmd, sizeof cmd, "%s view --surface-budget 0", tu_pfsph_bin());
+    assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "--surface-budget"));
     snprintf(cmd, sizeof cmd, "%s view --hide water", tu_pfsph_bin());
     assert_int_equal(tu_run(cmd, out, sizeof out), 2);
     assert_non_null(strstr(out, "water"));
@@ -364,7 +499,7 @@ int main(int argc, char **argv)
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_input), cmocka_unit_test(test_live_2d),       cmocka_unit_test(test_replay_2d),
-        cmocka_unit_test(test_replay_3d), cmocka_unit_test(test_replay_meshes),
+        cmocka_unit_test(test_replay_3d), cmocka_unit_test(test_replay_meshes), cmocka_unit_test(test_live_surface),
     };
     /* Drawing is what this program tests: without a viewer or a display only the bad-input
      * checks can run, and the program reads skipped once they pass. */
