@@ -5,6 +5,9 @@
 #                                          the same bytes as an uninterrupted serial run to T2
 #   mpi_test.sh kill SCENE END NP1 NP2     kill -9 one rank of NP1 once checkpoints exist, resume on
 #                                          NP2 ranks: the same bytes as an uninterrupted serial run
+#   mpi_test.sh cutcheck SCENE END NP...  as compare, with the cut's coarse histogram cut to 16
+#                                          buckets (every cut refined in a second round) and
+#                                          checked against the dense histogram's every step
 #   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
 #                                          STATUS (default 2) from mpirun
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
@@ -54,6 +57,22 @@ compare)
         same "$TMP/serial" "$TMP/np$np" || exit 1
         [ "$np" = 1 ] || grep -q '"ranks":' "$TMP/np$np/summary.json" ||
             { echo "FAIL: no per-rank figures in summary.json"; exit 1; }
+    done
+    ;;
+cutcheck)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    export PFSPH_MPI_CUT_BUCKETS=16 PFSPH_MPI_CHECK_CUT=1
+    for np in "$@"; do
+        "$MPIRUN" $ROOTOPT --oversubscribe -x PFSPH_MPI_CUT_BUCKETS -x PFSPH_MPI_CHECK_CUT -np "$np" "$BIN" run \
+            "$scene" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        grep -Eq '"reductions_last_step":[[:space:]]*2' "$TMP/np$np/summary.json" ||
+            { echo "FAIL: the cut was not refined in a second round"; exit 1; }
+        grep -Eq '"checked_against_dense":[[:space:]]*[1-9]' "$TMP/np$np/summary.json" ||
+            { echo "FAIL: no cut was checked against the dense one"; exit 1; }
+        echo "ok: -np $np: $(grep -Eo '"checked_against_dense":[[:space:]]*[0-9]+' "$TMP/np$np/summary.json")"
     done
     ;;
 resume)
