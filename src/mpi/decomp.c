@@ -131,7 +131,8 @@ static int fit(pfsph_decomp *D, pfsph_particles *f, size_t n)
  * Rank q needs the walls of the cells within off of the cells it holds (twice a walk's reach
  * from its own). Each step every rank works out every rank's window the same way: when q's
  * need leaves its window, or the window is over twice the need, the window becomes the need
- * widened by a quarter each side; inside the old window q cuts its arrays down itself, else the
+ * widened by a quarter each side (PFSPH_MPI_WALL_SLACK, percent: the tests set 0 to move it
+ * every step); inside the old window q cuts its arrays down itself, else the
  * root, which keeps every wall, sends the new window's walls (one contiguous run of its sorted
  * walls). Walks see the same walls in the same order as a serial run: byte-identical. */
 static int walls_resize(pfsph_particles *b, size_t n)
@@ -173,7 +174,7 @@ static int walls_update(pfsph_decomp *D, pfsph_error *err)
     for (int q = 1; q < D->size; q++) {
         size_t lo, hi;
         wall_need(D, q, &lo, &hi);
-        const size_t wlo = D->wlo[q], whi = D->whi[q], s = (hi - lo) / 4;
+        const size_t wlo = D->wlo[q], whi = D->whi[q], s = (hi - lo) * D->wall_slack / 100;
         const int inside = lo >= wlo && hi <= whi;
         if (inside && whi - wlo <= 2 * (hi - lo) + 2) continue;
         const size_t nlo = lo > s ? lo - s : 0, nhi = hi + s < nc ? hi + s : nc;
@@ -678,6 +679,8 @@ static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err)
     const char *wv = getenv("PFSPH_MPI_WALLS");
     D->trim_walls = !(wv && !strcmp(wv, "all")) && !sim->scene.nbodies;
     for (int q = 0; q < D->size; q++) D->wlo[q] = 0, D->whi[q] = D->ncells;
+    const char *sl = getenv("PFSPH_MPI_WALL_SLACK");
+    D->wall_slack = sl && atoi(sl) >= 0 ? (size_t)atoi(sl) : 25;
     D->walls_total = sim->boundary.n;
     D->root_all = 1;
     D->d.own_lo = 0;

@@ -50,6 +50,7 @@ typedef struct pfsph_decomp {
     uint64_t cuts_checked; /* PFSPH_MPI_CHECK_CUT */
     /* the static walls this rank keeps: cells [wlo[q], whi[q]) for rank q (the root: all) */
     int trim_walls;
+    size_t wall_slack; /* percent of the need added each side when a window moves */
     size_t wlo[64], whi[64];
     uint64_t walls_total, walls_max, wall_trims, wall_fetches, wall_bytes, resident_max;
     uint64_t steps, halo_calls, bytes_sent, messages, migr_bytes, halo_particles;

@@ -8,6 +8,10 @@
 #   mpi_test.sh cutcheck SCENE END NP...  as compare, with the cut's coarse histogram cut to 16
 #                                          buckets (every cut refined in a second round) and
 #                                          checked against the dense histogram's every step
+#   mpi_test.sh walls SCENE END NP...     as compare, with no slack in the wall windows (they move
+#                                          every step): some rank holds fewer walls than the scene,
+#                                          the root sent some windows, the fluid and walls a rank
+#                                          holds stay under 1.5 N / NP + halo + walls of the scene
 #   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
 #                                          STATUS (default 2) from mpirun
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
@@ -73,6 +77,38 @@ cutcheck)
         grep -Eq '"checked_against_dense":[[:space:]]*[1-9]' "$TMP/np$np/summary.json" ||
             { echo "FAIL: no cut was checked against the dense one"; exit 1; }
         echo "ok: -np $np: $(grep -Eo '"checked_against_dense":[[:space:]]*[0-9]+' "$TMP/np$np/summary.json")"
+    done
+    ;;
+walls)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    export PFSPH_MPI_WALL_SLACK=0
+    for np in "$@"; do
+        "$MPIRUN" $ROOTOPT --oversubscribe -x PFSPH_MPI_WALL_SLACK -np "$np" "$BIN" run \
+            "$scene" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        n=$(tail -n 1 "$TMP/serial/stats.csv" | cut -d, -f5)
+        # per rank: walls held at most, walls of the scene, fetches, resident most, halo per step
+        awk -v np="$np" -v n="$n" -F'[:,]' '
+            /"rank":/ { r = $2 + 0 }
+            /"walls_held_max":/ { wm[r] = $2 + 0 }
+            /"walls_of_scene":/ { ws = $2 + 0 }
+            /"wall_window_fetches":/ { fe += $2 }
+            /"halo_particles_per_step":/ { h[r] = $2 + 0 }
+            /"resident_particles_max":/ { res[r] = $2 + 0 }
+            END {
+                fewer = 0; bad = 0
+                for (q = 1; q < np; q++) {
+                    if (wm[q] < ws) fewer++
+                    lim = 1.5 * n / np + 2 * h[q] + ws
+                    if (res[q] > lim) { bad = 1; printf "FAIL: rank %d holds %d particles, over %d\n", q, res[q], lim }
+                }
+                if (!fewer) { print "FAIL: every rank holds every wall"; bad = 1 }
+                if (!fe) { print "FAIL: the root sent no wall window"; bad = 1 }
+                if (!bad) printf "ok: -np %d: %d ranks hold fewer walls than the %d of the scene, %d windows sent\n", np, fewer, ws, fe
+                exit bad
+            }' "$TMP/np$np/summary.json" || exit 1
     done
     ;;
 resume)
