@@ -20,6 +20,9 @@
  * wall, bubble. A homogeneous cluster is assumed (the same byte order and pfsph_real). */
 #define REC (((PFSPH_NFIELDS + 1) * sizeof(pfsph_real) + 7 + 7) & ~(size_t)7)
 
+/* particles per message of the frame gather (its buffers: 3 MB) */
+#define GATHER_RUN ((size_t)65536)
+
 static int grow(char **buf, size_t *cap, size_t n)
 {
     if (n <= *cap) return PFSPH_OK;
@@ -130,8 +133,8 @@ static int fit(pfsph_decomp *D, pfsph_particles *f, size_t n)
  * Every rank samples the whole scene; the walls are sorted once by cell (the boundary grid).
  * Rank q needs the walls of the cells within off of the cells it holds (twice a walk's reach
  * from its own). Each step every rank works out every rank's window the same way: when q's
- * need leaves its window, or the window is over twice the need, the window becomes the need
- * widened by a quarter each side (PFSPH_MPI_WALL_SLACK, percent: the tests set 0 to move it
+ * need leaves its window, or the window is larger than a move would make it, the window becomes
+ * the need widened by a quarter each side (PFSPH_MPI_WALL_SLACK, percent: the tests set 0 to move it
  * every step); inside the old window q cuts its arrays down itself, else the
  * root, which keeps every wall, sends the new window's walls (one contiguous run of its sorted
  * walls). Walks see the same walls in the same order as a serial run: byte-identical. */
@@ -176,8 +179,12 @@ static int walls_update(pfsph_decomp *D, pfsph_error *err)
         wall_need(D, q, &lo, &hi);
         const size_t wlo = D->wlo[q], whi = D->whi[q], s = (hi - lo) * D->wall_slack / 100;
         const int inside = lo >= wlo && hi <= whi;
-        if (inside && whi - wlo <= 2 * (hi - lo) + 2) continue;
-        const size_t nlo = lo > s ? lo - s : 0, nhi = hi + s < nc ? hi + s : nc;
+        if (inside && whi - wlo <= hi - lo + 2 * s + 2) continue; /* no larger than a move would make it */
+        size_t nlo = lo > s ? lo - s : 0, nhi = hi + s < nc ? hi + s : nc;
+        if (inside) { /* a cut within the walls q has: no more than those */
+            if (nlo < wlo) nlo = wlo;
+            if (nhi > whi) nhi = whi;
+        }
         D->wlo[q] = nlo;
         D->whi[q] = nhi;
         if (inside) { /* q cuts its own arrays down */
@@ -252,6 +259,11 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     pfsph_ctx *c = st->ctx;
     pfsph_particles *f = c->fluid;
     const pfsph_grid *g = c->grid;
+    if (D->gathered) { /* after a frame: the root's own slice again, the clock as the root has it */
+        if (D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
+        D->gathered = 0;
+        share_clock(D, st);
+    }
     if (D->root_all) share_clock(D, st);
     size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
     const size_t m = hi - lo, nc = D->ncells;
@@ -547,7 +559,7 @@ void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c) { MPI_Bcast(c, sizeof *
 
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
 {
-    if (D->root_all) return PFSPH_OK;
+    if (D->root_all || D->gathered) return PFSPH_OK;
     pfsph_mpi_fig mine = {D->steps,
                           D->d.own_hi - D->d.own_lo,
                           D->own_min,
@@ -578,9 +590,8 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
     pfsph_particles *f = c->fluid;
     const size_t lo = D->d.own_lo, m = D->d.own_hi - D->d.own_lo, N = D->d.nglobal;
     uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
-    if (!key || grow(&D->sbuf, &D->scap, m * REC)) MPI_Abort(D->comm, 1); /* the root waits in the gather */
+    if (!key) MPI_Abort(D->comm, 1); /* the root waits in the gather */
     D->key = key;
-    for (size_t i = 0; i < m; i++) pack(D->sbuf + i * REC, f, c->nd, lo + i);
     /* the cells of this step's sort (the particles have moved since): the root's grid for the
      * frame's walks (surface layers, pressures) */
     const pfsph_grid *g = c->grid;
@@ -594,19 +605,26 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
     }
     if (D->rank == 0 && !(allkey = malloc((N ? N : 1) * sizeof(uint32_t)))) MPI_Abort(D->comm, 1);
     MPI_Gatherv(key, (int)m, MPI_UINT32_T, allkey, kcount, kdispl, MPI_UINT32_T, 0, D->comm);
-    size_t tot = 0;
-    for (int q = 0; q < D->size; q++) {
-        D->rcount[q] = (int)((D->gofs[q + 1] - D->gofs[q]) * REC);
-        D->rdispl[q] = (int)tot;
-        tot += (size_t)D->rcount[q];
-    }
-    if (D->rank == 0 && (tot > (size_t)INT32_MAX || grow(&D->rbuf, &D->rcap, tot)))
-        MPI_Abort(D->comm, 1); /* the others wait in the gather: no clean way out */
-    MPI_Gatherv(D->sbuf, (int)(m * REC), MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, 0, D->comm);
+    /* the particles, rank by rank in runs of at most GATHER_RUN through one bounded buffer: no
+     * copy of the whole fluid besides the root's arrays. The root's own particles are already in
+     * their global places (its slice starts at global index 0). */
+    if (grow(D->rank == 0 ? &D->rbuf : &D->sbuf, D->rank == 0 ? &D->rcap : &D->scap, GATHER_RUN * REC))
+        MPI_Abort(D->comm, 1);
     if (D->rank == 0) {
-        int rc = sim->st.reserve(&sim->st, N, err);
-        if (rc) MPI_Abort(D->comm, 1);
-        for (size_t i = 0; i < N; i++) unpack(D->rbuf + i * REC, f, c->nd, i);
+        pfsph_real *keep = NULL; /* the number density of the root's own particles, if the reserve moves it */
+        const size_t own = D->d.own_hi;
+        if (N > f->cap && !(keep = malloc((own ? own : 1) * sizeof(pfsph_real)))) MPI_Abort(D->comm, 1);
+        if (keep) memcpy(keep, c->nd, own * sizeof(pfsph_real));
+        if (sim->st.reserve(&sim->st, N, err)) MPI_Abort(D->comm, 1);
+        if (keep) memcpy(c->nd, keep, own * sizeof(pfsph_real));
+        free(keep);
+        for (int q = 1; q < D->size; q++)
+            for (uint64_t o = D->gofs[q]; o < D->gofs[q + 1]; o += GATHER_RUN) {
+                const size_t k = D->gofs[q + 1] - o < GATHER_RUN ? (size_t)(D->gofs[q + 1] - o) : GATHER_RUN;
+                MPI_Recv(D->rbuf, (int)(k * REC), MPI_BYTE, q, 30, D->comm, MPI_STATUS_IGNORE);
+                for (size_t i = 0; i < k; i++) unpack(D->rbuf + i * REC, f, c->nd, (size_t)o + i);
+            }
+        D->root_own_hi = own;
         f->n = N;
         uint32_t *start = c->grid->start;
         memset(start, 0, (D->ncells + 1) * sizeof(uint32_t));
@@ -616,10 +634,15 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         D->d.own_lo = 0;
         D->d.own_hi = N;
     } else {
-        f->n = 0;
-        D->d.own_lo = D->d.own_hi = 0;
+        for (size_t o = 0; o < m; o += GATHER_RUN) {
+            const size_t k = m - o < GATHER_RUN ? m - o : GATHER_RUN;
+            for (size_t i = 0; i < k; i++) pack(D->sbuf + i * REC, f, c->nd, lo + o + i);
+            MPI_Send(D->sbuf, (int)(k * REC), MPI_BYTE, 0, 30, D->comm);
+        }
     }
-    D->root_all = 1;
+    /* every rank keeps its slice: the next exchange goes on from it (the root's own particles
+     * are untouched at the front of its arrays), only the clock is shared again */
+    D->gathered = 1;
     return PFSPH_OK;
 }
 

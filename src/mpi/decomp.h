@@ -33,8 +33,10 @@ typedef struct pfsph_decomp {
     MPI_Comm comm;
     int rank, size;
     pfsph_sim *sim;
-    int root_all; /* the root holds every particle (the start, after a frame gather, a resume) */
-    int failed;   /* a stage failed on some rank: the other ranks left their command loop */
+    int root_all;       /* the root holds every particle (the start, after a frame gather, a resume) */
+    int failed;         /* a stage failed on some rank: the other ranks left their command loop */
+    int gathered;       /* the root holds every particle for a frame, the others still their slices */
+    size_t root_own_hi; /* the root's own particles [0, root_own_hi) before the frame gather */
     size_t ncells;
     size_t off;                             /* cells of key distance that a walk of the grid's reach can span */
     pfsph_cut C;                            /* the step's cut (src/mpi/cut.c); the four below point into it */
