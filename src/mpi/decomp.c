@@ -248,36 +248,14 @@ static int check_cut(pfsph_decomp *D, const uint32_t *key, size_t m, pfsph_error
     return PFSPH_OK;
 }
 
-/* The stage before the grid sort: the particles each rank owned (all on the root after a
- * frame) go to every rank that holds their new cell. Each rank sends its particles in its
- * order, the receivers take them in rank order, so the grid's stable sort then gives them the
- * serial order: by cell, ties by the previous step's order. */
-static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+/* Every step but the first: each rank sends each particle it owns, rank by rank, each in its
+ * order, to every rank that holds its new cell (one Alltoallv); n: the particles received. */
+static int exchange_slices(pfsph_decomp *D, pfsph_step *st, const uint32_t *key, size_t lo, size_t m, size_t *out,
+                           pfsph_error *err)
 {
-    (void)bad;
-    pfsph_decomp *D = state;
-    pfsph_ctx *c = st->ctx;
-    pfsph_particles *f = c->fluid;
-    const pfsph_grid *g = c->grid;
-    if (D->gathered) { /* after a frame: the root's own slice again, the clock as the root has it */
-        if (D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
-        D->gathered = 0;
-        share_clock(D, st);
-    }
-    if (D->root_all) share_clock(D, st);
-    size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
-    const size_t m = hi - lo, nc = D->ncells;
-    int rc;
-    uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
-    if (!key) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange's keys");
-    D->key = key;
-    for (size_t i = 0; i < m; i++) key[i] = cell_key(g, f, lo + i);
-    if (pfsph_cut_compute(&D->C, D->comm, key, m, nc, D->off))
-        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the cut"); /* every rank returns it */
-    if (D->check_cut && (rc = check_cut(D, key, m, err))) return rc;
-    if (D->trim_walls && (rc = walls_update(D, err))) return rc;
-    const uint64_t total = D->C.total;
-    int q;
+    pfsph_particles *f = st->ctx->fluid;
+    int q, rc;
+    size_t n;
     /* pack, rank by rank, each in this rank's order */
     size_t bytes = 0;
     for (q = 0; q < D->size; q++) {
@@ -308,7 +286,7 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     }
     if (grow(&D->rbuf, &D->rcap, rbytes)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange");
     MPI_Alltoallv(D->sbuf, D->scount, D->sdispl, MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, D->comm);
-    const size_t n = rbytes / REC;
+    n = rbytes / REC;
     if (n != D->lend[D->rank] - D->lofs[D->rank])
         return pfsph_fail(err, PFSPH_EIO, "exchange: rank %d received %zu particles for a slice of %llu", D->rank, n,
                           (unsigned long long)(D->lend[D->rank] - D->lofs[D->rank]));
@@ -316,6 +294,95 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     if (!rc && fit(D, f, n)) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory fitting the slice's arrays");
     if (rc) return rc;
     for (size_t i = 0; i < n; i++) unpack(D->rbuf + i * REC, f, NULL, i);
+    *out = n;
+    return PFSPH_OK;
+}
+
+/* A start or a resume: the root alone holds every particle. It sends each other rank its
+ * slice in runs of GATHER_RUN particles through one bounded buffer (no copy of the whole
+ * fluid), then keeps its own in place, in its order: what the Alltoallv would give. */
+static int scatter_root(pfsph_decomp *D, pfsph_step *st, const uint32_t *key, size_t m, size_t *out, pfsph_error *err)
+{
+    pfsph_particles *f = st->ctx->fluid;
+    const size_t n = (size_t)(D->lend[D->rank] - D->lofs[D->rank]);
+    for (int q = 0; q < D->size; q++) D->scount[q] = 0;
+    if (D->rank == 0) {
+        if (grow(&D->sbuf, &D->scap, GATHER_RUN * REC)) MPI_Abort(D->comm, 1); /* the others wait */
+        for (int q = 1; q < D->size; q++) {
+            size_t a, b, k = 0, sent = 0;
+            held_cells(D, q, &a, &b);
+            for (size_t i = 0; i <= m; i++) {
+                if (i < m && key[i] >= a && key[i] < b) pack(D->sbuf + k++ * REC, f, NULL, i);
+                if (k == GATHER_RUN || (i == m && k)) {
+                    MPI_Send(D->sbuf, (int)(k * REC), MPI_BYTE, q, 31, D->comm);
+                    sent += k;
+                    k = 0;
+                }
+            }
+            D->scount[q] = (int)(sent * REC);
+        }
+        size_t a, b, k = 0;
+        held_cells(D, 0, &a, &b);
+        for (size_t i = 0; i < m; i++)
+            if (key[i] >= a && key[i] < b) {
+                if (k != i) {
+                    for (int j = 0; j < PFSPH_NFIELDS; j++) f->f[j][k] = f->f[j][i];
+                    f->id[k] = f->id[i];
+                    f->phase[k] = f->phase[i];
+                    f->wall[k] = f->wall[i];
+                    f->bubble[k] = f->bubble[i];
+                }
+                k++;
+            }
+        if (k != n) MPI_Abort(D->comm, 1); /* the cut's count and the keys disagree: a bug */
+    } else {
+        int rc = st->reserve(st, n, err);
+        if (!rc && fit(D, f, n)) rc = PFSPH_ENOMEM;
+        if (rc || grow(&D->rbuf, &D->rcap, GATHER_RUN * REC)) MPI_Abort(D->comm, 1); /* the root is sending */
+        for (size_t o = 0; o < n; o += GATHER_RUN) {
+            const size_t k = n - o < GATHER_RUN ? n - o : GATHER_RUN;
+            MPI_Recv(D->rbuf, (int)(k * REC), MPI_BYTE, 0, 31, D->comm, MPI_STATUS_IGNORE);
+            for (size_t i = 0; i < k; i++) unpack(D->rbuf + i * REC, f, NULL, o + i);
+        }
+    }
+    (void)err;
+    *out = n;
+    return PFSPH_OK;
+}
+
+/* The stage before the grid sort: the particles each rank owned (all on the root after a
+ * frame) go to every rank that holds their new cell. Each rank sends its particles in its
+ * order, the receivers take them in rank order, so the grid's stable sort then gives them the
+ * serial order: by cell, ties by the previous step's order. */
+static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)bad;
+    pfsph_decomp *D = state;
+    pfsph_ctx *c = st->ctx;
+    pfsph_particles *f = c->fluid;
+    const pfsph_grid *g = c->grid;
+    if (D->gathered) { /* after a frame: the root's own slice again, the clock as the root has it */
+        if (D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
+        D->gathered = 0;
+        share_clock(D, st);
+    }
+    if (D->root_all) share_clock(D, st);
+    size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
+    const size_t m = hi - lo, nc = D->ncells;
+    int rc;
+    uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
+    if (!key) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange's keys");
+    D->key = key;
+    for (size_t i = 0; i < m; i++) key[i] = cell_key(g, f, lo + i);
+    if (pfsph_cut_compute(&D->C, D->comm, key, m, nc, D->off))
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the cut"); /* every rank returns it */
+    if (D->check_cut && (rc = check_cut(D, key, m, err))) return rc;
+    if (D->trim_walls && (rc = walls_update(D, err))) return rc;
+    const uint64_t total = D->C.total;
+    int q;
+    size_t n = 0;
+    rc = D->root_all ? scatter_root(D, st, key, m, &n, err) : exchange_slices(D, st, key, lo, m, &n, err);
+    if (rc) return rc;
     f->n = n;
     if (n + c->boundary->n > D->resident_max) D->resident_max = n + c->boundary->n;
     /* particles that left the domain: counted once, and the speed the next step's CFL needs is

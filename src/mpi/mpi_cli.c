@@ -64,7 +64,7 @@ static void report(pfsph_dist *d, void *json)
     cJSON *m = cJSON_AddObjectToObject(json, "mpi");
     if (!m) return;
     cJSON_AddNumberToObject(m, "ranks", D->size);
-    cJSON_AddStringToObject(m, "output", "gathered to rank 0, written by it");
+    cJSON_AddStringToObject(m, "output", "gathered to rank 0 rank by rank through a bounded buffer, written by it");
     cJSON *cut = cJSON_AddObjectToObject(m, "cut"); /* src/mpi/cut.c: the histogram of occupied cells */
     if (cut) {
         cJSON_AddNumberToObject(cut, "coarse_buckets", (double)D->C.buckets);
