@@ -153,7 +153,7 @@ refuse)
     echo "ok: exit status $rc and one message: $(grep '^pfsph: ' "$TMP/err")"
     ;;
 *)
-    echo "usage: mpi_test.sh compare|resume|refuse ..."
+    echo "usage: mpi_test.sh compare|cutcheck|walls|resume|kill|refuse ..."
     exit 2
     ;;
 esac
