@@ -20,6 +20,9 @@
  * wall, bubble. A homogeneous cluster is assumed (the same byte order and pfsph_real). */
 #define REC (((PFSPH_NFIELDS + 1) * sizeof(pfsph_real) + 7 + 7) & ~(size_t)7)
 
+/* particles per message of the frame gather (its buffers: 3 MB) */
+#define GATHER_RUN ((size_t)65536)
+
 static int grow(char **buf, size_t *cap, size_t n)
 {
     if (n <= *cap) return PFSPH_OK;
@@ -126,47 +129,133 @@ static int fit(pfsph_decomp *D, pfsph_particles *f, size_t n)
     return pfsph__sim_alloc_scratch(D->sim, cap);
 }
 
-/* The stage before the grid sort: the particles each rank owned (all on the root after a
- * frame) go to every rank that holds their new cell. Each rank sends its particles in its
- * order, the receivers take them in rank order, so the grid's stable sort then gives them the
- * serial order: by cell, ties by the previous step's order. */
-static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+/* ---- static walls: a rank other than the root keeps those its slice's walks can reach ----
+ * Every rank samples the whole scene; the walls are sorted once by cell (the boundary grid).
+ * Rank q needs the walls of the cells within off of the cells it holds (twice a walk's reach
+ * from its own). Each step every rank works out every rank's window the same way: when q's
+ * need leaves its window, or the window is larger than a move would make it, the window becomes
+ * the need widened by a quarter each side (PFSPH_MPI_WALL_SLACK, percent: the tests set 0 to move it
+ * every step); inside the old window q cuts its arrays down itself, else the
+ * root, which keeps every wall, sends the new window's walls (one contiguous run of its sorted
+ * walls). Walks see the same walls in the same order as a serial run: byte-identical. */
+static int walls_resize(pfsph_particles *b, size_t n)
 {
-    (void)bad;
-    pfsph_decomp *D = state;
-    pfsph_ctx *c = st->ctx;
-    pfsph_particles *f = c->fluid;
-    const pfsph_grid *g = c->grid;
-    if (D->root_all) share_clock(D, st);
-    size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
-    const size_t m = hi - lo, nc = D->ncells;
-    uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
-    if (!key) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange's keys");
-    D->key = key;
-    memset(D->hist, 0, (nc + 1) * sizeof(uint32_t));
-    for (size_t i = 0; i < m; i++) {
-        key[i] = cell_key(g, f, lo + i);
-        if (key[i] == UINT32_MAX) D->hist[nc]++;
-        else D->hist[key[i]]++;
+    const size_t cap = n ? n : 1;
+    for (int k = 0; k < PFSPH_NFIELDS; k++) {
+        void *q = realloc(b->f[k], cap * sizeof(pfsph_real));
+        if (!q) return PFSPH_ENOMEM;
+        b->f[k] = q;
     }
-    MPI_Allreduce(MPI_IN_PLACE, D->hist, (int)(nc + 1), MPI_UINT32_T, MPI_SUM, D->comm);
-    D->pre[0] = 0;
-    for (size_t k = 0; k < nc; k++) D->pre[k + 1] = D->pre[k] + D->hist[k];
-    const uint64_t total = D->pre[nc], P = (uint64_t)D->size;
-    /* the cut: rank q's first cell is the first with q / size of the particles before it */
-    D->cut[0] = 0;
-    int q = 1;
-    for (size_t k = 0; k <= nc && q < D->size; k++)
-        while (q < D->size && D->pre[k] * P >= (uint64_t)q * total) D->cut[q++] = (uint32_t)k;
-    D->cut[D->size] = (uint32_t)nc;
-    for (q = 0; q < D->size; q++) {
-        size_t a, b;
-        held_cells(D, q, &a, &b);
-        D->gofs[q] = D->pre[D->cut[q]];
-        D->lofs[q] = D->pre[a];
-        D->lend[q] = D->pre[b];
+    void *q;
+    if (!(q = realloc(b->phase, cap))) return PFSPH_ENOMEM;
+    b->phase = q;
+    if (!(q = realloc(b->wall, cap))) return PFSPH_ENOMEM;
+    b->wall = q;
+    if (!(q = realloc(b->bubble, cap))) return PFSPH_ENOMEM;
+    b->bubble = q;
+    if (!(q = realloc(b->id, cap * sizeof(uint32_t)))) return PFSPH_ENOMEM;
+    b->id = q;
+    b->cap = cap;
+    return PFSPH_OK;
+}
+
+static void wall_need(const pfsph_decomp *D, int q, size_t *lo, size_t *hi)
+{
+    size_t a, b;
+    held_cells(D, q, &a, &b);
+    *lo = a > D->off ? a - D->off : 0;
+    *hi = b + D->off < D->ncells ? b + D->off : D->ncells;
+}
+
+static int walls_update(pfsph_decomp *D, pfsph_error *err)
+{
+    pfsph_ctx *c = &D->sim->ctx;
+    pfsph_particles *b = c->boundary;
+    uint32_t *st = c->bgrid->start;
+    const size_t nc = D->ncells;
+    int rc = PFSPH_OK;
+    for (int q = 1; q < D->size; q++) {
+        size_t lo, hi;
+        wall_need(D, q, &lo, &hi);
+        const size_t wlo = D->wlo[q], whi = D->whi[q], s = (hi - lo) * D->wall_slack / 100;
+        const int inside = lo >= wlo && hi <= whi;
+        if (inside && whi - wlo <= hi - lo + 2 * s + 2) continue; /* no larger than a move would make it */
+        size_t nlo = lo > s ? lo - s : 0, nhi = hi + s < nc ? hi + s : nc;
+        if (inside) { /* a cut within the walls q has: no more than those */
+            if (nlo < wlo) nlo = wlo;
+            if (nhi > whi) nhi = whi;
+        }
+        D->wlo[q] = nlo;
+        D->whi[q] = nhi;
+        if (inside) { /* q cuts its own arrays down */
+            if (q != D->rank) continue;
+            const size_t i0 = st[nlo], cnt = st[nhi] - i0;
+            for (int k = 0; k < PFSPH_NFIELDS; k++) memmove(b->f[k], b->f[k] + i0, cnt * sizeof(pfsph_real));
+            memmove(b->phase, b->phase + i0, cnt);
+            memmove(b->wall, b->wall + i0, cnt);
+            memmove(b->bubble, b->bubble + i0, cnt);
+            memmove(b->id, b->id + i0, cnt * sizeof(uint32_t));
+            for (size_t k = nlo; k <= nhi; k++) st[k] -= (uint32_t)i0;
+            for (size_t k = 0; k < nlo; k++) st[k] = 0;
+            for (size_t k = nhi + 1; k <= nc; k++) st[k] = (uint32_t)cnt;
+            b->n = cnt;
+            if (walls_resize(b, cnt)) rc = PFSPH_ENOMEM; /* a shrink: cannot fail in practice */
+            D->wall_trims++;
+        } else if (D->rank == 0) { /* the root sends the window's walls */
+            const size_t i0 = st[nlo], cnt = st[nhi] - i0;
+            if (cnt * REC > (size_t)INT32_MAX || grow(&D->sbuf, &D->scap, cnt * REC)) MPI_Abort(D->comm, 1);
+            for (size_t i = 0; i < cnt; i++) pack(D->sbuf + i * REC, b, NULL, i0 + i);
+            MPI_Send(D->sbuf, (int)(cnt * REC), MPI_BYTE, q, 29, D->comm);
+            D->wall_bytes += cnt * REC;
+        } else if (q == D->rank) {
+            MPI_Status ms;
+            int bytes;
+            MPI_Probe(0, 29, D->comm, &ms);
+            MPI_Get_count(&ms, MPI_BYTE, &bytes);
+            if (grow(&D->rbuf, &D->rcap, (size_t)bytes)) MPI_Abort(D->comm, 1);
+            MPI_Recv(D->rbuf, bytes, MPI_BYTE, 0, 29, D->comm, MPI_STATUS_IGNORE);
+            const size_t cnt = (size_t)bytes / REC;
+            if (walls_resize(b, cnt)) MPI_Abort(D->comm, 1);
+            memset(st, 0, (nc + 1) * sizeof(uint32_t));
+            for (size_t i = 0; i < cnt; i++) {
+                unpack(D->rbuf + i * REC, b, NULL, i);
+                st[cell_key(c->bgrid, b, i) + 1]++;
+            }
+            for (size_t k = 0; k < nc; k++) st[k + 1] += st[k];
+            b->n = cnt;
+            D->wall_fetches++;
+        }
     }
-    D->gofs[D->size] = total;
+    if (D->rank && b->n > D->walls_max) D->walls_max = b->n;
+    if (rc) return pfsph_fail(err, rc, "out of memory cutting the walls down");
+    return PFSPH_OK;
+}
+
+/* PFSPH_MPI_CHECK_CUT=1 (the tests): every step's cut against the dense histogram's */
+static int check_cut(pfsph_decomp *D, const uint32_t *key, size_t m, pfsph_error *err)
+{
+    pfsph_cut E;
+    if (pfsph_cut_init(&E, D->size, 1)) MPI_Abort(D->comm, 1); /* a check's allocation */
+    pfsph_cut_dense(&E, D->comm, key, m, D->ncells, D->off);
+    int bad = E.removed != D->C.removed || E.total != D->C.total;
+    for (int q = 0; q <= D->size; q++) bad |= E.cut[q] != D->cut[q] || E.gofs[q] != D->gofs[q];
+    for (int q = 0; q < D->size; q++) bad |= E.lofs[q] != D->lofs[q] || E.lend[q] != D->lend[q];
+    pfsph_cut_free(&E);
+    if (bad)
+        return pfsph_fail(err, PFSPH_EIO, "the sparse cut differs from the dense histogram's at step %llu",
+                          (unsigned long long)D->steps);
+    D->cuts_checked++;
+    return PFSPH_OK;
+}
+
+/* Every step but the first: each rank sends each particle it owns, rank by rank, each in its
+ * order, to every rank that holds its new cell (one Alltoallv); n: the particles received. */
+static int exchange_slices(pfsph_decomp *D, pfsph_step *st, const uint32_t *key, size_t lo, size_t m, size_t *out,
+                           pfsph_error *err)
+{
+    pfsph_particles *f = st->ctx->fluid;
+    int q, rc;
+    size_t n;
     /* pack, rank by rank, each in this rank's order */
     size_t bytes = 0;
     for (q = 0; q < D->size; q++) {
@@ -197,19 +286,109 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     }
     if (grow(&D->rbuf, &D->rcap, rbytes)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange");
     MPI_Alltoallv(D->sbuf, D->scount, D->sdispl, MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, D->comm);
-    const size_t n = rbytes / REC;
+    n = rbytes / REC;
     if (n != D->lend[D->rank] - D->lofs[D->rank])
         return pfsph_fail(err, PFSPH_EIO, "exchange: rank %d received %zu particles for a slice of %llu", D->rank, n,
                           (unsigned long long)(D->lend[D->rank] - D->lofs[D->rank]));
-    int rc = st->reserve(st, n, err);
+    rc = st->reserve(st, n, err);
     if (!rc && fit(D, f, n)) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory fitting the slice's arrays");
     if (rc) return rc;
     for (size_t i = 0; i < n; i++) unpack(D->rbuf + i * REC, f, NULL, i);
+    *out = n;
+    return PFSPH_OK;
+}
+
+/* A start or a resume: the root alone holds every particle. It sends each other rank its
+ * slice in runs of GATHER_RUN particles through one bounded buffer (no copy of the whole
+ * fluid), then keeps its own in place, in its order: what the Alltoallv would give. */
+static int scatter_root(pfsph_decomp *D, pfsph_step *st, const uint32_t *key, size_t m, size_t *out, pfsph_error *err)
+{
+    pfsph_particles *f = st->ctx->fluid;
+    const size_t n = (size_t)(D->lend[D->rank] - D->lofs[D->rank]);
+    for (int q = 0; q < D->size; q++) D->scount[q] = 0;
+    if (D->rank == 0) {
+        if (grow(&D->sbuf, &D->scap, GATHER_RUN * REC)) MPI_Abort(D->comm, 1); /* the others wait */
+        for (int q = 1; q < D->size; q++) {
+            size_t a, b, k = 0, sent = 0;
+            held_cells(D, q, &a, &b);
+            for (size_t i = 0; i <= m; i++) {
+                if (i < m && key[i] >= a && key[i] < b) pack(D->sbuf + k++ * REC, f, NULL, i);
+                if (k == GATHER_RUN || (i == m && k)) {
+                    MPI_Send(D->sbuf, (int)(k * REC), MPI_BYTE, q, 31, D->comm);
+                    sent += k;
+                    k = 0;
+                }
+            }
+            D->scount[q] = (int)(sent * REC);
+        }
+        size_t a, b, k = 0;
+        held_cells(D, 0, &a, &b);
+        for (size_t i = 0; i < m; i++)
+            if (key[i] >= a && key[i] < b) {
+                if (k != i) {
+                    for (int j = 0; j < PFSPH_NFIELDS; j++) f->f[j][k] = f->f[j][i];
+                    f->id[k] = f->id[i];
+                    f->phase[k] = f->phase[i];
+                    f->wall[k] = f->wall[i];
+                    f->bubble[k] = f->bubble[i];
+                }
+                k++;
+            }
+        if (k != n) MPI_Abort(D->comm, 1); /* the cut's count and the keys disagree: a bug */
+    } else {
+        int rc = st->reserve(st, n, err);
+        if (!rc && fit(D, f, n)) rc = PFSPH_ENOMEM;
+        if (rc || grow(&D->rbuf, &D->rcap, GATHER_RUN * REC)) MPI_Abort(D->comm, 1); /* the root is sending */
+        for (size_t o = 0; o < n; o += GATHER_RUN) {
+            const size_t k = n - o < GATHER_RUN ? n - o : GATHER_RUN;
+            MPI_Recv(D->rbuf, (int)(k * REC), MPI_BYTE, 0, 31, D->comm, MPI_STATUS_IGNORE);
+            for (size_t i = 0; i < k; i++) unpack(D->rbuf + i * REC, f, NULL, o + i);
+        }
+    }
+    (void)err;
+    *out = n;
+    return PFSPH_OK;
+}
+
+/* The stage before the grid sort: the particles each rank owned (all on the root after a
+ * frame) go to every rank that holds their new cell. Each rank sends its particles in its
+ * order, the receivers take them in rank order, so the grid's stable sort then gives them the
+ * serial order: by cell, ties by the previous step's order. */
+static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)bad;
+    pfsph_decomp *D = state;
+    pfsph_ctx *c = st->ctx;
+    pfsph_particles *f = c->fluid;
+    const pfsph_grid *g = c->grid;
+    if (D->gathered) { /* after a frame: the root's own slice again, the clock as the root has it */
+        if (D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
+        D->gathered = 0;
+        share_clock(D, st);
+    }
+    if (D->root_all) share_clock(D, st);
+    size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
+    const size_t m = hi - lo, nc = D->ncells;
+    int rc;
+    uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
+    if (!key) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange's keys");
+    D->key = key;
+    for (size_t i = 0; i < m; i++) key[i] = cell_key(g, f, lo + i);
+    if (pfsph_cut_compute(&D->C, D->comm, key, m, nc, D->off))
+        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the cut"); /* every rank returns it */
+    if (D->check_cut && (rc = check_cut(D, key, m, err))) return rc;
+    if (D->trim_walls && (rc = walls_update(D, err))) return rc;
+    const uint64_t total = D->C.total;
+    int q;
+    size_t n = 0;
+    rc = D->root_all ? scatter_root(D, st, key, m, &n, err) : exchange_slices(D, st, key, lo, m, &n, err);
+    if (rc) return rc;
     f->n = n;
+    if (n + c->boundary->n > D->resident_max) D->resident_max = n + c->boundary->n;
     /* particles that left the domain: counted once, and the speed the next step's CFL needs is
      * then the largest of those that stay (the serial grid and timestep stages) */
-    if (D->hist[nc]) {
-        st->removed += D->hist[nc];
+    if (D->C.removed) {
+        st->removed += D->C.removed;
         size_t worst;
         double v = n ? pfsph__max_speed(f, &worst) : 0;
         MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_MAX, D->comm);
@@ -447,7 +626,7 @@ void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c) { MPI_Bcast(c, sizeof *
 
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
 {
-    if (D->root_all) return PFSPH_OK;
+    if (D->root_all || D->gathered) return PFSPH_OK;
     pfsph_mpi_fig mine = {D->steps,
                           D->d.own_hi - D->d.own_lo,
                           D->own_min,
@@ -457,6 +636,12 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
                           D->bytes_sent,
                           D->migr_bytes,
                           D->messages,
+                          D->sim->boundary.n,
+                          D->walls_max,
+                          D->wall_trims,
+                          D->wall_fetches,
+                          D->wall_bytes,
+                          D->resident_max,
                           0,
                           0};
     struct rusage ru;
@@ -471,31 +656,60 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
     const size_t lo = D->d.own_lo, m = D->d.own_hi - D->d.own_lo, N = D->d.nglobal;
-    if (grow(&D->sbuf, &D->scap, m * REC)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the gather");
-    for (size_t i = 0; i < m; i++) pack(D->sbuf + i * REC, f, c->nd, lo + i);
-    size_t tot = 0;
+    uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
+    if (!key) MPI_Abort(D->comm, 1); /* the root waits in the gather */
+    D->key = key;
+    /* the cells of this step's sort (the particles have moved since): the root's grid for the
+     * frame's walks (surface layers, pressures) */
+    const pfsph_grid *g = c->grid;
+    for (size_t k = D->cut[D->rank]; k < D->cut[D->rank + 1]; k++)
+        for (uint32_t i = g->start[k]; i < g->start[k + 1]; i++) key[i - lo] = (uint32_t)k;
+    uint32_t *allkey = NULL;
+    int *kcount = D->scount, *kdispl = D->sdispl;
     for (int q = 0; q < D->size; q++) {
-        D->rcount[q] = (int)((D->gofs[q + 1] - D->gofs[q]) * REC);
-        D->rdispl[q] = (int)tot;
-        tot += (size_t)D->rcount[q];
+        kcount[q] = (int)(D->gofs[q + 1] - D->gofs[q]);
+        kdispl[q] = (int)D->gofs[q];
     }
-    if (D->rank == 0 && (tot > (size_t)INT32_MAX || grow(&D->rbuf, &D->rcap, tot)))
-        MPI_Abort(D->comm, 1); /* the others wait in the gather: no clean way out */
-    MPI_Gatherv(D->sbuf, (int)(m * REC), MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, 0, D->comm);
+    if (D->rank == 0 && !(allkey = malloc((N ? N : 1) * sizeof(uint32_t)))) MPI_Abort(D->comm, 1);
+    MPI_Gatherv(key, (int)m, MPI_UINT32_T, allkey, kcount, kdispl, MPI_UINT32_T, 0, D->comm);
+    /* the particles, rank by rank in runs of at most GATHER_RUN through one bounded buffer: no
+     * copy of the whole fluid besides the root's arrays. The root's own particles are already in
+     * their global places (its slice starts at global index 0). */
+    if (grow(D->rank == 0 ? &D->rbuf : &D->sbuf, D->rank == 0 ? &D->rcap : &D->scap, GATHER_RUN * REC))
+        MPI_Abort(D->comm, 1);
     if (D->rank == 0) {
-        int rc = sim->st.reserve(&sim->st, N, err);
-        if (rc) MPI_Abort(D->comm, 1);
-        for (size_t i = 0; i < N; i++) unpack(D->rbuf + i * REC, f, c->nd, i);
+        pfsph_real *keep = NULL; /* the number density of the root's own particles, if the reserve moves it */
+        const size_t own = D->d.own_hi;
+        if (N > f->cap && !(keep = malloc((own ? own : 1) * sizeof(pfsph_real)))) MPI_Abort(D->comm, 1);
+        if (keep) memcpy(keep, c->nd, own * sizeof(pfsph_real));
+        if (sim->st.reserve(&sim->st, N, err)) MPI_Abort(D->comm, 1);
+        if (keep) memcpy(c->nd, keep, own * sizeof(pfsph_real));
+        free(keep);
+        for (int q = 1; q < D->size; q++)
+            for (uint64_t o = D->gofs[q]; o < D->gofs[q + 1]; o += GATHER_RUN) {
+                const size_t k = D->gofs[q + 1] - o < GATHER_RUN ? (size_t)(D->gofs[q + 1] - o) : GATHER_RUN;
+                MPI_Recv(D->rbuf, (int)(k * REC), MPI_BYTE, q, 30, D->comm, MPI_STATUS_IGNORE);
+                for (size_t i = 0; i < k; i++) unpack(D->rbuf + i * REC, f, c->nd, (size_t)o + i);
+            }
+        D->root_own_hi = own;
         f->n = N;
-        /* the grid of this step's sort, for the frame's walks (surface layers, pressures) */
-        for (size_t k = 0; k <= D->ncells; k++) c->grid->start[k] = (uint32_t)D->pre[k];
+        uint32_t *start = c->grid->start;
+        memset(start, 0, (D->ncells + 1) * sizeof(uint32_t));
+        for (size_t i = 0; i < N; i++) start[allkey[i] + 1]++;
+        for (size_t k = 0; k < D->ncells; k++) start[k + 1] += start[k];
+        free(allkey);
         D->d.own_lo = 0;
         D->d.own_hi = N;
     } else {
-        f->n = 0;
-        D->d.own_lo = D->d.own_hi = 0;
+        for (size_t o = 0; o < m; o += GATHER_RUN) {
+            const size_t k = m - o < GATHER_RUN ? m - o : GATHER_RUN;
+            for (size_t i = 0; i < k; i++) pack(D->sbuf + i * REC, f, c->nd, lo + o + i);
+            MPI_Send(D->sbuf, (int)(k * REC), MPI_BYTE, 0, 30, D->comm);
+        }
     }
-    D->root_all = 1;
+    /* every rank keeps its slice: the next exchange goes on from it (the root's own particles
+     * are untouched at the front of its arrays), only the clock is shared again */
+    D->gathered = 1;
     return PFSPH_OK;
 }
 
@@ -509,16 +723,18 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     MPI_Comm_size(comm, &D->size);
     if (D->size > 64) return PFSPH_EINPUT;
     const size_t P = (size_t)D->size;
-    D->cut = calloc(P + 1, sizeof(uint32_t));
-    D->gofs = calloc(P + 1, sizeof(uint64_t));
-    D->lofs = calloc(P, sizeof(uint64_t));
-    D->lend = calloc(P, sizeof(uint64_t));
+    const char *b = getenv("PFSPH_MPI_CUT_BUCKETS"), *chk = getenv("PFSPH_MPI_CHECK_CUT");
+    D->check_cut = chk && atoi(chk) > 0;
+    if (pfsph_cut_init(&D->C, D->size, b && atoll(b) > 0 ? (uint64_t)atoll(b) : 0)) return PFSPH_ENOMEM;
+    D->cut = D->C.cut;
+    D->gofs = D->C.gofs;
+    D->lofs = D->C.lofs;
+    D->lend = D->C.lend;
     D->scount = calloc(P, sizeof(int));
     D->sdispl = calloc(P, sizeof(int));
     D->rcount = calloc(P, sizeof(int));
     D->rdispl = calloc(P, sizeof(int));
-    if (!D->cut || !D->gofs || !D->lofs || !D->lend || !D->scount || !D->sdispl || !D->rcount || !D->rdispl)
-        return PFSPH_ENOMEM;
+    if (!D->scount || !D->sdispl || !D->rcount || !D->rdispl) return PFSPH_ENOMEM;
     D->d.halo = halo;
     D->d.sum = sum;
     D->d.agree = agree;
@@ -545,14 +761,17 @@ static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err)
     const size_t R = (size_t)(g->reach_far > g->reach ? g->reach_far : g->reach) + 1;
     const size_t nx = (size_t)g->nc[0], ny = (size_t)g->nc[1];
     D->off = R * (1 + nx + (g->dim == 3 ? nx * ny : 0));
-    D->hist = calloc(D->ncells + 1, sizeof(uint32_t));
-    D->pre = calloc(D->ncells + 1, sizeof(uint64_t));
-    int rc = PFSPH_OK;
-    if (!D->hist || !D->pre) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the decomposition");
-    if (!rc) rc = pfsph_sim_insert_stage(sim, "grid", 0, &stage_exchange, D, err);
+    int rc = pfsph_sim_insert_stage(sim, "grid", 0, &stage_exchange, D, err);
     if (!rc) rc = pfsph_sim_insert_stage(sim, "density", 1, &stage_halo_density, D, err);
     if (!rc) rc = pfsph_sim_insert_stage(sim, "integrate", 1, &stage_stats, D, err);
     if (!rc && sim->st.pw) rc = pfsph_sim_insert_stage(sim, "shift", 1, &stage_halo_pos, D, err);
+    /* every rank holds every wall after the set-up; PFSPH_MPI_WALLS=all keeps them so */
+    const char *wv = getenv("PFSPH_MPI_WALLS");
+    D->trim_walls = !(wv && !strcmp(wv, "all")) && !sim->scene.nbodies;
+    for (int q = 0; q < D->size; q++) D->wlo[q] = 0, D->whi[q] = D->ncells;
+    const char *sl = getenv("PFSPH_MPI_WALL_SLACK");
+    D->wall_slack = sl && atoi(sl) >= 0 ? (size_t)atoi(sl) : 25;
+    D->walls_total = sim->boundary.n;
     D->root_all = 1;
     D->d.own_lo = 0;
     D->d.own_hi = D->rank == 0 ? sim->fluid.n : 0;

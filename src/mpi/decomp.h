@@ -7,6 +7,7 @@
 #include <mpi.h>
 #include <stdint.h>
 
+#include "mpi/cut.h"
 #include "pfsph/dist.h"
 #include "pfsph/sim.h"
 
@@ -21,6 +22,8 @@ typedef struct pfsph_mpi_cmd {
 /* One rank's figures, gathered by the root at every frame (summary.json). */
 typedef struct pfsph_mpi_fig {
     uint64_t steps, owned, own_min, own_max, halo_particles, halo_calls, bytes_sent, migr_bytes, messages;
+    uint64_t walls, walls_max, wall_trims, wall_fetches, wall_bytes; /* static walls held, their moves */
+    uint64_t resident_max;                                           /* fluid (own + halo) + walls, most */
     uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
     uint64_t rss_kb;      /* its resident memory at the frame */
 } pfsph_mpi_fig;
@@ -30,12 +33,14 @@ typedef struct pfsph_decomp {
     MPI_Comm comm;
     int rank, size;
     pfsph_sim *sim;
-    int root_all; /* the root holds every particle (the start, after a frame gather, a resume) */
-    int failed;   /* a stage failed on some rank: the other ranks left their command loop */
+    int root_all;       /* the root holds every particle (the start, after a frame gather, a resume) */
+    int failed;         /* a stage failed on some rank: the other ranks left their command loop */
+    int gathered;       /* the root holds every particle for a frame, the others still their slices */
+    size_t root_own_hi; /* the root's own particles [0, root_own_hi) before the frame gather */
     size_t ncells;
     size_t off;                             /* cells of key distance that a walk of the grid's reach can span */
-    uint32_t *hist;                         /* ncells + 1: particles per cell of this step's sort, then removed */
-    uint64_t *pre;                          /* ncells + 1: particles in the cells before c (the serial grid start) */
+    pfsph_cut C;                            /* the step's cut (src/mpi/cut.c); the four below point into it */
+    int check_cut;                          /* PFSPH_MPI_CHECK_CUT=1: compare every cut with the dense one */
     uint32_t *key;                          /* per sent particle */
     uint32_t *cut;                          /* size + 1: rank q owns cells [cut[q], cut[q + 1]) */
     uint64_t *gofs;                         /* size + 1: rank q owns global indices [gofs[q], gofs[q + 1]) */
@@ -44,6 +49,12 @@ typedef struct pfsph_decomp {
     char *sbuf, *rbuf;
     size_t scap, rcap;
     /* figures for summary.json */
+    uint64_t cuts_checked; /* PFSPH_MPI_CHECK_CUT */
+    /* the static walls this rank keeps: cells [wlo[q], whi[q]) for rank q (the root: all) */
+    int trim_walls;
+    size_t wall_slack; /* percent of the need added each side when a window moves */
+    size_t wlo[64], whi[64];
+    uint64_t walls_total, walls_max, wall_trims, wall_fetches, wall_bytes, resident_max;
     uint64_t steps, halo_calls, bytes_sent, messages, migr_bytes, halo_particles;
     size_t own_min, own_max; /* owned particles of this rank over the run */
     pfsph_mpi_fig fig[64];   /* the root: every rank's, as of the last frame */

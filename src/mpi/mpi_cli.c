@@ -64,7 +64,15 @@ static void report(pfsph_dist *d, void *json)
     cJSON *m = cJSON_AddObjectToObject(json, "mpi");
     if (!m) return;
     cJSON_AddNumberToObject(m, "ranks", D->size);
-    cJSON_AddStringToObject(m, "output", "gathered to rank 0, written by it");
+    cJSON_AddStringToObject(m, "output", "gathered to rank 0 rank by rank through a bounded buffer, written by it");
+    cJSON *cut = cJSON_AddObjectToObject(m, "cut"); /* src/mpi/cut.c: the histogram of occupied cells */
+    if (cut) {
+        cJSON_AddNumberToObject(cut, "coarse_buckets", (double)D->C.buckets);
+        cJSON_AddNumberToObject(cut, "grid_cells", (double)D->ncells);
+        cJSON_AddNumberToObject(cut, "reductions_last_step", D->C.rounds);
+        cJSON_AddNumberToObject(cut, "counters_last_step", (double)D->C.hist_counters);
+        cJSON_AddNumberToObject(cut, "checked_against_dense", (double)D->cuts_checked);
+    }
     cJSON *ranks = cJSON_AddArrayToObject(m, "per_rank");
     for (int q = 0; q < D->size && ranks; q++) {
         const pfsph_mpi_fig *f = &D->fig[q];
@@ -80,6 +88,13 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(r, "halo_bytes_sent_per_step", (double)f->bytes_sent / st);
         cJSON_AddNumberToObject(r, "exchange_bytes_sent_per_step", (double)f->migr_bytes / st);
         cJSON_AddNumberToObject(r, "messages_sent_per_step", (double)f->messages / st);
+        cJSON_AddNumberToObject(r, "walls_held", (double)f->walls);
+        cJSON_AddNumberToObject(r, "walls_held_max", (double)f->walls_max);
+        cJSON_AddNumberToObject(r, "walls_of_scene", (double)D->walls_total);
+        cJSON_AddNumberToObject(r, "wall_window_cuts", (double)f->wall_trims);
+        cJSON_AddNumberToObject(r, "wall_window_fetches", (double)f->wall_fetches);
+        cJSON_AddNumberToObject(r, "wall_bytes_sent", (double)f->wall_bytes);
+        cJSON_AddNumberToObject(r, "resident_particles_max", (double)f->resident_max);
         cJSON_AddNumberToObject(r, "rss_mib_at_last_frame", (double)f->rss_kb / 1024.0);
         cJSON_AddNumberToObject(r, "peak_rss_mib", (double)f->peak_rss_kb / 1024.0);
         cJSON_AddItemToArray(ranks, r);

@@ -5,6 +5,13 @@
 #                                          the same bytes as an uninterrupted serial run to T2
 #   mpi_test.sh kill SCENE END NP1 NP2     kill -9 one rank of NP1 once checkpoints exist, resume on
 #                                          NP2 ranks: the same bytes as an uninterrupted serial run
+#   mpi_test.sh cutcheck SCENE END NP...  as compare, with the cut's coarse histogram cut to 16
+#                                          buckets (every cut refined in a second round) and
+#                                          checked against the dense histogram's every step
+#   mpi_test.sh walls SCENE END NP...     as compare, with no slack in the wall windows (they move
+#                                          every step): some rank holds fewer walls than the scene,
+#                                          the root sent some windows, the fluid and walls a rank
+#                                          holds stay under 1.5 N / NP + halo + walls of the scene
 #   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
 #                                          STATUS (default 2) from mpirun
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
@@ -56,6 +63,54 @@ compare)
             { echo "FAIL: no per-rank figures in summary.json"; exit 1; }
     done
     ;;
+cutcheck)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    export PFSPH_MPI_CUT_BUCKETS=16 PFSPH_MPI_CHECK_CUT=1
+    for np in "$@"; do
+        "$MPIRUN" $ROOTOPT --oversubscribe -x PFSPH_MPI_CUT_BUCKETS -x PFSPH_MPI_CHECK_CUT -np "$np" "$BIN" run \
+            "$scene" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        grep -Eq '"reductions_last_step":[[:space:]]*2' "$TMP/np$np/summary.json" ||
+            { echo "FAIL: the cut was not refined in a second round"; exit 1; }
+        grep -Eq '"checked_against_dense":[[:space:]]*[1-9]' "$TMP/np$np/summary.json" ||
+            { echo "FAIL: no cut was checked against the dense one"; exit 1; }
+        echo "ok: -np $np: $(grep -Eo '"checked_against_dense":[[:space:]]*[0-9]+' "$TMP/np$np/summary.json")"
+    done
+    ;;
+walls)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    export PFSPH_MPI_WALL_SLACK=0
+    for np in "$@"; do
+        "$MPIRUN" $ROOTOPT --oversubscribe -x PFSPH_MPI_WALL_SLACK -np "$np" "$BIN" run \
+            "$scene" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        n=$(tail -n 1 "$TMP/serial/stats.csv" | cut -d, -f5)
+        # per rank: walls held at most, walls of the scene, fetches, resident most, halo per step
+        awk -v np="$np" -v n="$n" -F'[:,]' '
+            /"rank":/ { r = $2 + 0 }
+            /"walls_held_max":/ { wm[r] = $2 + 0 }
+            /"walls_of_scene":/ { ws = $2 + 0 }
+            /"wall_window_fetches":/ { fe += $2 }
+            /"halo_particles_per_step":/ { h[r] = $2 + 0 }
+            /"resident_particles_max":/ { res[r] = $2 + 0 }
+            END {
+                fewer = 0; bad = 0
+                for (q = 1; q < np; q++) {
+                    if (wm[q] < ws) fewer++
+                    lim = 1.5 * n / np + 2 * h[q] + ws
+                    if (res[q] > lim) { bad = 1; printf "FAIL: rank %d holds %d particles, over %d\n", q, res[q], lim }
+                }
+                if (!fewer) { print "FAIL: every rank holds every wall"; bad = 1 }
+                if (!fe) { print "FAIL: the root sent no wall window"; bad = 1 }
+                if (!bad) printf "ok: -np %d: %d ranks hold fewer walls than the %d of the scene, %d windows sent\n", np, fewer, ws, fe
+                exit bad
+            }' "$TMP/np$np/summary.json" || exit 1
+    done
+    ;;
 resume)
     scene=$SRC/$1 t1=$2 t2=$3 np1=$4 np2=$5
     "$BIN" run "$scene" -o "$TMP/serial" --end "$t2" --quiet || { echo "FAIL: the serial run"; exit 1; }
@@ -98,7 +153,7 @@ refuse)
     echo "ok: exit status $rc and one message: $(grep '^pfsph: ' "$TMP/err")"
     ;;
 *)
-    echo "usage: mpi_test.sh compare|resume|refuse ..."
+    echo "usage: mpi_test.sh compare|cutcheck|walls|resume|kill|refuse ..."
     exit 2
     ;;
 esac
