@@ -161,8 +161,8 @@ static const double angle_deg2[] = {180.0, 176.8, 151.4, 132.8, 117.8, 102.7, 83
  * 2 degrees). Unlike 2D the 3D drops wet a little more than Eq. 21 (0.8-11 degrees at 120-60);
  * r = 0 (no adhesion) is 180 degrees by definition, not measured; beyond r = 0.75 the last
  * segment is extended. */
-static const double angle_r3[] = {0.0, 0.25, 0.5, 0.75};
-static const double angle_deg3[] = {180.0, 119.2, 82.9, 48.6};
+static const double angle_r3[] = {0.0, 0.1, 0.15, 0.2, 0.25, 0.5, 0.75};
+static const double angle_deg3[] = {180.0, 151.1, 138.0, 127.6, 119.2, 82.9, 48.6};
 
 typedef struct {
     const double *r, *deg;
