@@ -155,14 +155,18 @@ double pfm_drop_angle_cap(const pfsph_ctx *c, double x0, double x1)
 {
     const pfsph_particles *f = c->fluid;
     const double d = c->spacing;
-    double sy = 0;
-    int n = 0;
+    double sy = 0, ylo = 1e30, s1 = 0;
+    int n = 0, n1 = 0;
     if (c->dim != 3) return NAN;
     for (size_t i = 0; i < f->n; i++)
-        if (f->x[i] >= x0 && f->x[i] < x1) sy += f->y[i], n++;
+        if (f->x[i] >= x0 && f->x[i] < x1) sy += f->y[i], n++, ylo = fmin(ylo, f->y[i]);
     if (n < 20) return NAN;
+    /* the first layer: the particles within d/2 of the lowest; it stands for the slab [0, d) */
+    for (size_t i = 0; i < f->n; i++)
+        if (f->x[i] >= x0 && f->x[i] < x1 && f->y[i] < ylo + 0.5 * d) s1 += f->y[i], n1++;
+    const double base = s1 / n1 - 0.5 * d; /* where the liquid's cells start: 0 on a lattice */
     /* each particle stands for d^3 of liquid (its centre is its cell's centroid) */
-    const double g = sy / n / cbrt(n * d * d * d);
+    const double g = (sy / n - base) / cbrt(n * d * d * d);
     double lo = 1e-4, hi = PI; /* cap_centroid rises with theta: bisection */
     if (g <= cap_centroid(lo)) return 0;
     if (g >= cap_centroid(hi)) return 180;
@@ -231,7 +235,8 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
     print_message("%zu fluid particles, %zu boundary particles\n", c->fluid->n,
                   c->boundary ? c->boundary->n : (size_t)0);
     /* [0]: the angle checked (cfg->cap: the centroid's, else the outline fit's), [1]: the other */
-    double sum[2][PFM_MAXDROP] = {{0}}, sum2[2][PFM_MAXDROP] = {{0}}, th[2][PFM_MAXDROP], low[PFM_MAXDROP];
+    double sum[2][PFM_MAXDROP] = {{0}}, sum2[2][PFM_MAXDROP] = {{0}}, th[2][PFM_MAXDROP], low[PFM_MAXDROP],
+           top[PFM_MAXDROP];
     int cnt[2][PFM_MAXDROP] = {{0}};
     for (int k = 1; k <= cfg->nsamples; k++) {
         const int rc = pfsph_sim_advance(sim, cfg->dt_s * k, &err);
@@ -241,10 +246,12 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
             const double fit = pfm_drop_angle(c, q * P, q * P + P), cap = pfm_drop_angle_cap(c, q * P, q * P + P);
             th[0][q] = cfg->cap ? cap : fit;
             th[1][q] = cfg->cap ? fit : cap;
-            low[q] = 1e30;
+            low[q] = 1e30, top[q] = -1e30;
             for (size_t i = 0; i < c->fluid->n; i++)
-                if (c->fluid->x[i] >= q * P && c->fluid->x[i] < (q + 1) * P)
+                if (c->fluid->x[i] >= q * P && c->fluid->x[i] < (q + 1) * P) {
                     low[q] = fmin(low[q], c->fluid->y[i] / c->spacing);
+                    top[q] = fmax(top[q], c->fluid->y[i] / c->spacing + 0.5);
+                }
             for (int w = 0; w < 2; w++)
                 if (k > cfg->avg_after && isfinite(th[w][q]))
                     sum[w][q] += th[w][q], sum2[w][q] += th[w][q] * th[w][q], cnt[w][q]++;
@@ -253,8 +260,27 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
             char line[512];
             int l = snprintf(line, sizeof line, "t = %.2f s:", pfsph_sim_time(sim));
             for (int q = 0; q < nd; q++)
-                l += snprintf(line + l, sizeof line - (size_t)l, " %6.1f [%5.1f] (%.1f d)", th[0][q], th[1][q], low[q]);
+                l += snprintf(line + l, sizeof line - (size_t)l, " %6.1f [%5.1f] (%.1f-%.1f d)", th[0][q], th[1][q],
+                              low[q], top[q]);
             print_message("%s\n", line);
+            if (getenv("PF_LAYERS")) /* the first two layers: count and disc radius sqrt(2 <r^2>) [d] */
+                for (int q = 0; q < nd; q++) {
+                    double cx = 0, cz = 0, r2[2] = {0, 0};
+                    int m = 0, nl[2] = {0, 0};
+                    for (size_t i = 0; i < c->fluid->n; i++)
+                        if (c->fluid->x[i] >= q * P && c->fluid->x[i] < (q + 1) * P)
+                            cx += c->fluid->x[i], cz += c->dim == 3 ? c->fluid->z[i] : 0, m++;
+                    cx /= m, cz /= m;
+                    for (size_t i = 0; i < c->fluid->n; i++) {
+                        const int L = (int)floor(c->fluid->y[i] / c->spacing);
+                        if (c->fluid->x[i] < q * P || c->fluid->x[i] >= (q + 1) * P || L < 0 || L > 1) continue;
+                        const double dx = c->fluid->x[i] - cx, dz = c->dim == 3 ? c->fluid->z[i] - cz : 0;
+                        r2[L] += dx * dx + dz * dz, nl[L]++;
+                    }
+                    print_message("  drop %d: layer 1: %d, radius %.1f d; layer 2: %d, radius %.1f d\n", q, nl[0],
+                                  sqrt(2 * r2[0] / fmax(nl[0], 1)) / c->spacing, nl[1],
+                                  sqrt(2 * r2[1] / fmax(nl[1], 1)) / c->spacing);
+                }
         }
     }
     assert_int_equal(pfsph_sim_removed(sim), 0);
