@@ -140,6 +140,44 @@ double pfm_drop_angle(const pfsph_ctx *c, double x0, double x1)
     return acos(cs) * 180.0 / PI;
 }
 
+/* A spherical cap of contact angle theta (plate face y = 0): its centroid height over V^(1/3).
+ * With c = cos theta and the sphere's radius R, V = pi R^3 (1 - c)^2 (2 + c) / 3 and the
+ * centroid sits at R (3 (1 + c)^2 / (4 (2 + c)) - c) above the face (3 R / 8 at 90 degrees, R at
+ * 180); 1 - c = 2 sin^2(theta / 2) keeps thin caps exact. */
+static double cap_centroid(double theta)
+{
+    const double c = cos(theta), omc = 2 * sin(0.5 * theta) * sin(0.5 * theta);
+    const double v = PI * omc * omc * (2 + c) / 3; /* V / R^3 */
+    return (3 * (1 + c) * (1 + c) / (4 * (2 + c)) - c) / cbrt(v);
+}
+
+double pfm_drop_angle_cap(const pfsph_ctx *c, double x0, double x1)
+{
+    const pfsph_particles *f = c->fluid;
+    const double d = c->spacing;
+    double sy = 0, ylo = 1e30, s1 = 0;
+    int n = 0, n1 = 0;
+    if (c->dim != 3) return NAN;
+    for (size_t i = 0; i < f->n; i++)
+        if (f->x[i] >= x0 && f->x[i] < x1) sy += f->y[i], n++, ylo = fmin(ylo, f->y[i]);
+    if (n < 20) return NAN;
+    /* the first layer: the particles within d/2 of the lowest; it stands for the slab [0, d) */
+    for (size_t i = 0; i < f->n; i++)
+        if (f->x[i] >= x0 && f->x[i] < x1 && f->y[i] < ylo + 0.5 * d) s1 += f->y[i], n1++;
+    const double base = s1 / n1 - 0.5 * d; /* where the liquid's cells start: 0 on a lattice */
+    /* each particle stands for d^3 of liquid (its centre is its cell's centroid) */
+    const double g = (sy / n - base) / cbrt(n * d * d * d);
+    double lo = 1e-4, hi = PI; /* cap_centroid rises with theta: bisection */
+    if (g <= cap_centroid(lo)) return 0;
+    if (g >= cap_centroid(hi)) return 180;
+    for (int it = 0; it < 50; it++) {
+        const double mid = 0.5 * (lo + hi);
+        if (cap_centroid(mid) < g) lo = mid;
+        else hi = mid;
+    }
+    return 0.5 * (lo + hi) * 180.0 / PI;
+}
+
 /* The scene of nd drops (see pfm_contact) into json[cap]. */
 static void contact_scene(const pfm_contact *cfg, const double *target, const double *ratio, int nd, char *json,
                           size_t cap)
@@ -196,40 +234,75 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     print_message("%zu fluid particles, %zu boundary particles\n", c->fluid->n,
                   c->boundary ? c->boundary->n : (size_t)0);
-    double sum[PFM_MAXDROP] = {0}, sum2[PFM_MAXDROP] = {0}, th[PFM_MAXDROP], low[PFM_MAXDROP];
-    int cnt[PFM_MAXDROP] = {0};
+    /* [0]: the angle checked (cfg->cap: the centroid's, else the outline fit's), [1]: the other */
+    double sum[2][PFM_MAXDROP] = {{0}}, sum2[2][PFM_MAXDROP] = {{0}}, th[2][PFM_MAXDROP], low[PFM_MAXDROP],
+           top[PFM_MAXDROP];
+    int cnt[2][PFM_MAXDROP] = {{0}};
     for (int k = 1; k <= cfg->nsamples; k++) {
         const int rc = pfsph_sim_advance(sim, cfg->dt_s * k, &err);
         if (rc) print_message("%s\n", err.msg);
         assert_int_equal(rc, PFSPH_OK);
         for (int q = 0; q < nd; q++) {
-            th[q] = pfm_drop_angle(c, q * P, q * P + P);
-            low[q] = 1e30;
+            const double fit = pfm_drop_angle(c, q * P, q * P + P), cap = pfm_drop_angle_cap(c, q * P, q * P + P);
+            th[0][q] = cfg->cap ? cap : fit;
+            th[1][q] = cfg->cap ? fit : cap;
+            low[q] = 1e30, top[q] = -1e30;
             for (size_t i = 0; i < c->fluid->n; i++)
-                if (c->fluid->x[i] >= q * P && c->fluid->x[i] < (q + 1) * P)
+                if (c->fluid->x[i] >= q * P && c->fluid->x[i] < (q + 1) * P) {
                     low[q] = fmin(low[q], c->fluid->y[i] / c->spacing);
-            if (k > cfg->avg_after && isfinite(th[q])) sum[q] += th[q], sum2[q] += th[q] * th[q], cnt[q]++;
+                    top[q] = fmax(top[q], c->fluid->y[i] / c->spacing + 0.5);
+                }
+            for (int w = 0; w < 2; w++)
+                if (k > cfg->avg_after && isfinite(th[w][q]))
+                    sum[w][q] += th[w][q], sum2[w][q] += th[w][q] * th[w][q], cnt[w][q]++;
         }
         if (k % 10 == 0) {
             char line[512];
             int l = snprintf(line, sizeof line, "t = %.2f s:", pfsph_sim_time(sim));
             for (int q = 0; q < nd; q++)
-                l += snprintf(line + l, sizeof line - (size_t)l, " %6.1f (%.1f d)", th[q], low[q]);
+                l += snprintf(line + l, sizeof line - (size_t)l, " %6.1f [%5.1f] (%.1f-%.1f d)", th[0][q], th[1][q],
+                              low[q], top[q]);
             print_message("%s\n", line);
+            if (getenv("PF_LAYERS")) /* the first two layers: count and disc radius sqrt(2 <r^2>) [d] */
+                for (int q = 0; q < nd; q++) {
+                    double cx = 0, cz = 0, r2[2] = {0, 0};
+                    int m = 0, nl[2] = {0, 0};
+                    for (size_t i = 0; i < c->fluid->n; i++)
+                        if (c->fluid->x[i] >= q * P && c->fluid->x[i] < (q + 1) * P)
+                            cx += c->fluid->x[i], cz += c->dim == 3 ? c->fluid->z[i] : 0, m++;
+                    cx /= m, cz /= m;
+                    for (size_t i = 0; i < c->fluid->n; i++) {
+                        const int L = (int)floor(c->fluid->y[i] / c->spacing);
+                        if (c->fluid->x[i] < q * P || c->fluid->x[i] >= (q + 1) * P || L < 0 || L > 1) continue;
+                        const double dx = c->fluid->x[i] - cx, dz = c->dim == 3 ? c->fluid->z[i] - cz : 0;
+                        r2[L] += dx * dx + dz * dz, nl[L]++;
+                    }
+                    print_message("  drop %d: layer 1: %d, radius %.1f d; layer 2: %d, radius %.1f d\n", q, nl[0],
+                                  sqrt(2 * r2[0] / fmax(nl[0], 1)) / c->spacing, nl[1],
+                                  sqrt(2 * r2[1] / fmax(nl[1], 1)) / c->spacing);
+                }
         }
     }
     assert_int_equal(pfsph_sim_removed(sim), 0);
+    const char *name[2] = {cfg->cap ? "centroid" : "outline fit", cfg->cap ? "outline fit" : "centroid"};
+    double mean[PFM_MAXDROP];
     for (int q = 0; q < nd; q++) {
-        assert_true(cnt[q] > 0);
-        const double mean = sum[q] / cnt[q], sd = sqrt(fmax(0, sum2[q] / cnt[q] - mean * mean));
-        print_message("target %5.1f deg%s: measured %6.1f deg (sd %.1f over %d samples, %.2f-%.2f s)\n", target[q],
-                      ratio ? " (Eq. 21 of the ratio)" : "", mean, sd, cnt[q], cfg->t_avg0, cfg->t_avg1);
-        th[q] = mean;
-        pfm_csv_row("contact_angles.csv", "dim,target_deg,measured_deg,sd_deg,samples", "%d,%g,%.2f,%.2f,%d", cfg->dim,
-                    target[q], mean, sd, cnt[q]);
+        assert_true(cnt[0][q] > 0);
+        for (int w = 0; w < 2; w++) {
+            if (!cnt[w][q]) continue; /* 2D: no centroid angle */
+            const double m = cnt[w][q] ? sum[w][q] / cnt[w][q] : NAN;
+            const double sd = cnt[w][q] ? sqrt(fmax(0, sum2[w][q] / cnt[w][q] - m * m)) : NAN;
+            print_message("target %5.1f deg%s: %s %6.1f deg (sd %.1f over %d samples, %.2f-%.2f s)\n", target[q],
+                          ratio ? " (Eq. 21 of the ratio)" : "", name[w], m, sd, cnt[w][q], cfg->t_avg0, cfg->t_avg1);
+            if (w == 0) {
+                mean[q] = m;
+                pfm_csv_row("contact_angles.csv", "dim,target_deg,measured_deg,sd_deg,samples", "%d,%g,%.2f,%.2f,%d",
+                            cfg->dim, target[q], m, sd, cnt[0][q]);
+            }
+        }
     }
     for (int q = 0; q < nd; q++) assert_true(low[q] < 1.0);
-    for (int q = 0; q < nd; q++) assert_true(fabs(th[q] - target[q]) <= cfg->tol);
+    for (int q = 0; q < nd; q++) assert_true(fabs(mean[q] - target[q]) <= cfg->tol);
     pfsph_sim_destroy(sim);
 }
 
@@ -249,12 +322,18 @@ int pfm_contact_knobs(double *target, double *ratio, int nd)
 
 void pfm_contact_angles(int dim, const double *targets, int nd)
 {
+    pfm_contact_drops(dim, targets, nd, dim == 2 ? 0.08 : 0.03, dim == 2 ? 0.7 : 0.26, 0);
+}
+
+void pfm_contact_drops(int dim, const double *targets, int nd, double half, double pitch, int cap)
+{
     double target[PFM_MAXDROP], ratio[PFM_MAXDROP];
     memcpy(target, targets, (size_t)nd * sizeof *target);
     nd = pfm_contact_knobs(target, ratio, nd);
     pfm_contact cfg = {.dim = dim,
-                       .pitch = dim == 2 ? 0.7 : 0.26,
-                       .half = tu_env_num("PF_HALF", dim == 2 ? 0.08 : 0.03),
+                       .pitch = tu_env_num("PF_PITCH", pitch),
+                       .half = tu_env_num("PF_HALF", half),
+                       .cap = (int)tu_env_num("PF_CAP", cap),
                        .top = dim == 2 ? 0.4 : 0.3,
                        .k = tu_env_num("PF_K", 1.7),
                        .seed = (int)tu_env_num("PF_SEED", 11),

@@ -29,6 +29,14 @@ void pfm_csv_row(const char *name, const char *header, const char *fmt, ...)
  * by d/2 (particle centres sit half a spacing inside the free surface). With the centre at
  * height y_c above the face and radius R_c the cap meets the plate at cos(theta) = -y_c / R_c. */
 double pfm_drop_angle(const struct pfsph_ctx *c, double x0, double x1);
+/* The same drop's angle from its centroid height y_c and its volume V = n d^3 alone (3D; NAN in
+ * 2D): the spherical cap of volume V whose centroid is y_c above the liquid's base. The base is
+ * the mean height of the first layer (particles within d/2 of the lowest) less d/2: on a wetting
+ * plate the first layer sits below d/2. Needs no outline, so it gives a figure for caps only a
+ * few spacings high, where the fit above 1.5 d has too few points (it saturates near 50 degrees
+ * there); it assumes rest density and one cap without a foot. A study figure, printed beside
+ * the fit's; no test checks it (docs/pairwise.md, "Contact angles at temperature in 3D"). */
+double pfm_drop_angle_cap(const struct pfsph_ctx *c, double x0, double x1);
 
 /* Drops without gravity, each on its own plate (3 layers, face at y = 0) of `pitch` along x
  * (and across z in 3D), starting as the same square (cube) of half side `half` centred on it;
@@ -46,6 +54,7 @@ typedef struct pfm_contact {
     int avg_after;         /* samples 1..avg_after are not averaged */
     double t_avg0, t_avg1; /* the averaging window, for the report */
     double tol;            /* |mean - target| allowed [deg] */
+    int cap;               /* 3D: check pfm_drop_angle_cap's angle (else pfm_drop_angle's); both are printed */
 } pfm_contact;
 
 /* Run nd drops to their targets [deg] (ratio != NULL: with c_wa = ratio[q] c_aa given directly,
@@ -65,6 +74,10 @@ int pfm_contact_knobs(double *target, double *ratio, int nd);
  * keys), PF_ANG ("a,b,c": targets), PF_RATIO ("a,b,c": Eq. 21 adhesion ratios given as
  * coefficients, bypassing the table; the calibration runs, which in 3D then check nothing). */
 void pfm_contact_angles(int dim, const double *targets, int nd);
+/* The same with drops of half side `half` on plates `pitch` apart, the angle checked that of
+ * pfm_drop_angle_cap when cap is 1 (knobs: PF_HALF, PF_PITCH, PF_CAP; PF_LAYERS prints the first
+ * two layers' counts and radii with each report line). */
+void pfm_contact_drops(int dim, const double *targets, int nd, double half, double pitch, int cap);
 
 /* ---- Laplace's law (test_pf_laplace.c, test_pf_laplace_3d.c) ---- */
 
