@@ -6,25 +6,27 @@
 
 #include "core/stage.h"
 
-extern const pfsph_stage_ops pfsph_stage_grid;               /* core/grid.c: sort, removal */
-extern const pfsph_stage_ops pfsph_stage_shift;              /* physics/pairwise.c: particle shifting */
-extern const pfsph_stage_ops pfsph_stage_film;               /* physics/film.c: bubbles' surface and film */
-extern const pfsph_stage_ops pfsph_stage_density;            /* physics/density.c: Eq. 23 (+ lists) */
-extern const pfsph_stage_ops pfsph_stage_pair_density;       /* physics/pairwise.c: Eq. 23 in the pair walk */
-extern const pfsph_stage_ops pfsph_stage_pair_density_lists; /* physics/pairwise.c: and the h lists */
-extern const pfsph_stage_ops pfsph_stage_timestep;           /* physics/timestep.c: dt */
-extern const pfsph_stage_ops pfsph_stage_divergence;         /* physics/solver.c: the solver's pre_forces */
-extern const pfsph_stage_ops pfsph_stage_forces;             /* physics/viscosity.c: gravity, viscosity */
-extern const pfsph_stage_ops pfsph_stage_forces_eos;         /* physics/viscosity.c: the same + EOS pressure */
-extern const pfsph_stage_ops pfsph_stage_pairwise;           /* physics/pairwise.c: the pair pass */
-extern const pfsph_stage_ops pfsph_stage_pairwise_add;       /* physics/pairwise.c: pair_a into ax.. */
-extern const pfsph_stage_ops pfsph_stage_pressure;           /* physics/solver.c: solve */
-extern const pfsph_stage_ops pfsph_stage_pressure_report;    /* physics/solver.c: after forces_eos */
-extern const pfsph_stage_ops pfsph_stage_body_forces;        /* physics/body_stages.c: fluid on bodies */
-extern const pfsph_stage_ops pfsph_stage_integrate;          /* physics/integrate.c: symplectic Euler */
-extern const pfsph_stage_ops pfsph_stage_diffuse;            /* physics/diffuse.c: spray, foam, bubbles */
-extern const pfsph_stage_ops pfsph_stage_bodies;             /* physics/body_stages.c: ODE step */
-extern const pfsph_stage_ops pfsph_stage_emit;               /* physics/emitter.c: new fluid */
+extern const pfsph_stage_ops pfsph_stage_grid;            /* core/grid.c: sort, removal */
+extern const pfsph_stage_ops pfsph_stage_shift;           /* physics/pairwise.c: particle shifting */
+extern const pfsph_stage_ops pfsph_stage_film;            /* physics/film.c: bubbles' surface and film */
+extern const pfsph_stage_ops pfsph_stage_density;         /* physics/density.c: Eq. 23 (+ lists) */
+extern const pfsph_stage_ops pfsph_stage_pair_density;    /* physics/pairwise.c: Eq. 23 in the pair walk */
+extern const pfsph_stage_ops pfsph_stage_timestep;        /* physics/timestep.c: dt */
+extern const pfsph_stage_ops pfsph_stage_divergence;      /* physics/solver.c: the solver's pre_forces */
+extern const pfsph_stage_ops pfsph_stage_forces;          /* physics/viscosity.c: gravity, viscosity */
+extern const pfsph_stage_ops pfsph_stage_forces_eos;      /* physics/viscosity.c: the same + EOS pressure */
+extern const pfsph_stage_ops pfsph_stage_pairwise;        /* physics/pairwise.c: the pair pass */
+extern const pfsph_stage_ops pfsph_stage_pairwise_add;    /* physics/pairwise.c: pair_a into ax.. */
+extern const pfsph_stage_ops pfsph_stage_pressure;        /* physics/solver.c: solve */
+extern const pfsph_stage_ops pfsph_stage_pressure_report; /* physics/solver.c: after forces_eos */
+extern const pfsph_stage_ops pfsph_stage_body_forces;     /* physics/body_stages.c: fluid on bodies */
+extern const pfsph_stage_ops pfsph_stage_integrate;       /* physics/integrate.c: symplectic Euler */
+extern const pfsph_stage_ops pfsph_stage_diffuse;         /* physics/diffuse.c: spray, foam, bubbles */
+extern const pfsph_stage_ops pfsph_stage_bodies;          /* physics/body_stages.c: ODE step */
+extern const pfsph_stage_ops pfsph_stage_emit;            /* physics/emitter.c: new fluid */
+
+/* physics/pairwise.c: Eq. 23 and the lists within h in the pair walk (the interactive PCISPH) */
+extern const pfsph_stage_ops pfsph_stage_pair_density_lists;
 
 /* Output stages: fields a frame carries that the step does not keep, computed when a frame is
  * written (pfsph_sim_output) into the step's output buffers (out_layer, out_mech_p). */
