@@ -484,12 +484,15 @@ static void build_schedule(pfsph_sim *sim)
                df = s->diffuse.enabled, em = s->nemitters > 0;
     /* the density in the pair walk (one k h walk instead of an h walk and a k h walk) */
     const bool fused = pw && !solver->neighbour_lists && !solver->pre_forces && !sim->st.lists;
+    /* the same for the interactive PCISPH, whose lists (within h) the pair walk also fills */
+    const bool fused_lists = pw && !solver->neighbour_lists && !solver->pre_forces && sim->st.lists;
     int n = 0;
 #define ADD(stage) sim->stages[n++] = (pfsph__sched){&(stage), NULL, 0}
     ADD(pfsph_stage_grid);
     if (pw) ADD(pfsph_stage_shift);
     if (film) ADD(pfsph_stage_film);
     if (fused) ADD(pfsph_stage_pair_density);
+    else if (fused_lists) ADD(pfsph_stage_pair_density_lists);
     else ADD(pfsph_stage_density);
     ADD(pfsph_stage_timestep);
     if (solver->pre_forces) ADD(pfsph_stage_divergence);
@@ -498,7 +501,7 @@ static void build_schedule(pfsph_sim *sim)
     const bool eos = solver->eos && !pw;
     if (eos) ADD(pfsph_stage_forces_eos);
     else ADD(pfsph_stage_forces);
-    if (fused) ADD(pfsph_stage_pairwise_add);
+    if (fused || fused_lists) ADD(pfsph_stage_pairwise_add);
     else if (pw) ADD(pfsph_stage_pairwise);
     if (eos) ADD(pfsph_stage_pressure_report);
     else ADD(pfsph_stage_pressure);

@@ -128,7 +128,13 @@ static double nlist_neighbours(const pfsph_scene *s)
 static double nlist_bytes_per_particle(const pfsph_scene *s)
 {
     const double full = nlist_neighbours(s);
-    return pfsph_nlist_bytes_per_particle(1.25 * full, 1) + pfsph_nlist_bytes_per_particle(0.5 * full, 1);
+    double b = pfsph_nlist_bytes_per_particle(1.25 * full, 1) + pfsph_nlist_bytes_per_particle(0.5 * full, 1);
+    /* the interactive PCISPH's pairs of an iteration: x_ij and dW/r per entry, 1/8 slack
+     * (pcisph_lists.h, pfsph_pcisph_pairs) */
+    const pfsph_solver_ops *ops = pfsph_solver_find(pfsph_scene_solver_name(s));
+    if (ops && s->mode == PFSPH_MODE_INTERACTIVE && !strcmp(ops->name, "pcisph"))
+        b += 1.125 * 4 * sizeof(pfsph_real) * (1.25 + 0.5) * full;
+    return b;
 }
 
 static double physical_memory(void)

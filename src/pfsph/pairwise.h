@@ -37,6 +37,12 @@ void pfsph_pairwise_apply(pfsph_pairwise *pw, const pfsph_ctx *ctx);
  * in one walk of the k h neighbourhood (sim.c). With pair forces disabled the accelerations are
  * 0 and nd is still computed. */
 void pfsph_pairwise_apply_density(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd, pfsph_real *const acc[3]);
+/* The same, and (the interactive PCISPH) the walk's pairs within h listed into l (fluid, j != i)
+ * and lb (boundary) with their dW/r, as density.c's one-walk build lists them (guess: fluid
+ * neighbours per particle for a first plan). PFSPH_OK or PFSPH_ENOMEM. */
+int pfsph_pairwise_apply_density_lists(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd,
+                                       pfsph_real *const acc[3], struct pfsph_nlist *l, struct pfsph_nlist *lb,
+                                       double guess);
 /* The largest pair-force acceleration |F_i^int / m_i| of the last apply [m/s^2] (0 for NULL). */
 double pfsph_pairwise_amax(const pfsph_pairwise *pw);
 

@@ -5,10 +5,12 @@
 #include "pfsph/pairwise.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/hits.h"
+#include "core/nlist.h"
 #include "pfsph/eigen.h"
 #include "pfsph/film.h"
 #include "physics/pair_terms.h"
@@ -178,6 +180,14 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx, bool sorted)
     J->hits = pfsph_hits_select();
 }
 
+/* Where a walk also lists its pairs within h (the interactive PCISPH's lists, pcisph_lists.h):
+ * idx and dw entries from pos while they fit before re; pos counts on past re. */
+typedef struct pw_sink {
+    uint32_t *idx;
+    pfsph_real *dw;
+    size_t pos, re;
+} pw_sink;
+
 /* One thread's buffers: the hits of a walk, their cos(U_R r) / r and their pair scalars. */
 typedef struct pw_scratch {
     pfsph_hits H;
@@ -187,7 +197,7 @@ typedef struct pw_scratch {
 /* Adds the pairs in W->H (targets in ps) to P's four-lane sums (pair_terms.h): sc = c m_j f(r) / r
  * (Eq. 3 divided by m_i, times x_ij) and, if J->filter, the kernel w of Eq. 7 (NOTES item 2). */
 static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scratch *W, int pa, double ai, int bi,
-                            bool want_vir, pfsph_pair_sums *P, pfsph_real *ds)
+                            bool want_vir, pfsph_pair_sums *P, pfsph_real *ds, pw_sink *sk)
 {
     pfsph_hits *H = &W->H;
     const double *coef = J->coef[pa];
@@ -203,6 +213,20 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
         else
             for (int e = 0; e < n; e++) s += ps->aux[H->j[e]] * H->t1[e];
         *ds = s;
+        if (sk) { /* the pairs within h, as density.c lists them (dW/r of each) */
+            const pfsph_real h2 = J->ctx->kern.h * J->ctx->kern.h;
+            pfsph__terms_dwr(&J->ctx->kern, n16, H->r2, H->t2);
+            size_t pos = sk->pos;
+            for (int e = 0; e < n; e++)
+                if (H->r2[e] < h2) {
+                    if (pos < sk->re) {
+                        sk->idx[pos] = H->j[e];
+                        sk->dw[pos] = H->t2[e];
+                    }
+                    pos++;
+                }
+            sk->pos = pos;
+        }
     }
     if (!J->two_phase) {
         /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0); r = 0: no
@@ -242,19 +266,19 @@ static inline double lanes(const double l[4]) { return (l[0] + l[1]) + (l[2] + l
  * k h of a grid walk, filtered in SIMD (core/hits.h), in the walk's order. */
 static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g, size_t self, pfsph_real xi,
                            pfsph_real yi, pfsph_real zi, int pa, double ai, int bi, bool want_vir, pfsph_pair_sums *P,
-                           pw_scratch *W, pfsph_real *ds)
+                           pw_scratch *W, pfsph_real *ds, pw_sink *sk)
 {
     pfsph_ranges rg;
     if (J->trim) pfsph_grid_ranges_radius(g, xi, yi, zi, J->R, &rg);
     else pfsph_grid_ranges_far(g, xi, yi, zi, &rg);
     PFSPH_HITS_WALK(J->hits, &W->H, rg, ps->x, ps->y, ps->z, xi, yi, zi, J->R2, (uint32_t)self,
-                    sum_hits(J, ps, W, pa, ai, bi, want_vir, P, ds));
+                    sum_hits(J, ps, W, pa, ai, bi, want_vir, P, ds, sk));
 }
 
 /* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial,
  * T_i itself and (nd not NULL) the number density delta_i of Eq. 23 into nd[i]. */
 static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir, double *vir, double Tout[9],
-                            double Wout[9], pw_scratch *W, pfsph_real *nd)
+                            double Wout[9], pw_scratch *W, pfsph_real *nd, pw_sink *sk, pw_sink *skb)
 {
     const pfsph_ctx *ctx = J->ctx;
     const pfsph_particles *f = ctx->fluid;
@@ -266,12 +290,12 @@ static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_
     const int bi = J->two_phase ? f->bubble[i] : 0;
     /* the density as density.c sums it, self term first, walls apart and scaled by 1 / V0 */
     pfsph_real s = nd ? pfsph_kernel_w0(&ctx->kern) : 0, sb = 0;
-    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, want_vir, &P, W, nd ? &s : NULL);
+    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, want_vir, &P, W, nd ? &s : NULL, sk);
     /* most of a liquid has no wall within k h: its empty walk (rows, flush) cost ~5 % of the pass;
      * the flags cover k h >= h, so the density's wall term is 0 where they skip */
     if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0 && pfsph_grid_near_far(ctx->bgrid, xi, yi, zi))
         sum_set(J, ctx->boundary, ctx->bgrid, (size_t)UINT32_MAX, xi, yi, zi, pa, ai, bi, want_vir, &P, W,
-                nd ? &sb : NULL);
+                nd ? &sb : NULL, skb);
     if (nd) nd[i] = s + sb * J->inv_v0;
     /* the lanes' totals; the filter's d = x_j - x_i = -x_ij */
     double S[6], sx[3], sxx[6];
@@ -342,7 +366,7 @@ static void apply(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd, pfsp
 #pragma omp for schedule(dynamic, 256) reduction(max : a2max)
         for (size_t i = 0; i < n; i++) {
             double acc[3];
-            particle(&J, i, acc, false, NULL, NULL, NULL, &W, nd);
+            particle(&J, i, acc, false, NULL, NULL, NULL, &W, nd, NULL, NULL);
             if (add) {
                 ax[i] += (pfsph_real)acc[0];
                 ay[i] += (pfsph_real)acc[1];
@@ -372,6 +396,67 @@ void pfsph_pairwise_apply_density(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsp
     apply(pw, ctx, nd, acc, false);
 }
 
+/* One thread's particles [i0, i1) of pfsph_pairwise_apply_density_lists. */
+static double apply_lists_block(const pw_job *J, pw_scratch *W, size_t i0, size_t i1, pfsph_real *nd,
+                                pfsph_real *const out[3], pfsph_nlist *l, pfsph_nlist *lb, pw_sink *sk, pw_sink *skb)
+{
+    uint32_t *cnt = l->start + 1, *bcnt = lb->start + 1;
+    double a2max = 0;
+    for (size_t i = i0; i < i1; i++) {
+        double acc[3];
+        const size_t p0 = sk->pos, b0 = skb->pos;
+        particle(J, i, acc, false, NULL, NULL, NULL, W, nd, sk, skb);
+        cnt[i] = (uint32_t)(sk->pos - p0);
+        bcnt[i] = (uint32_t)(skb->pos - b0);
+        out[0][i] = (pfsph_real)acc[0];
+        out[1][i] = (pfsph_real)acc[1];
+        out[2][i] = (pfsph_real)acc[2];
+        const double a2 = acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2];
+        if (a2 > a2max) a2max = a2;
+    }
+    return a2max;
+}
+
+int pfsph_pairwise_apply_density_lists(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd,
+                                       pfsph_real *const acc[3], pfsph_nlist *l, pfsph_nlist *lb, double guess)
+{
+    pw->amax = 0;
+    pw_job J;
+    job_init(&J, ctx, true);
+    if (!ctx->pairwise->enabled)
+        for (int a = 0; a < PFSPH_MAX_PHASES; a++)
+            for (int b = 0; b < PFSPH_MAX_PHASES; b++) J.coef[a][b] = 0;
+    const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
+    const pfsph_real h2 = ctx->kern.h * ctx->kern.h;
+    const size_t n = f->n;
+    int T = omp_get_max_threads();
+    if (T > PFSPH_NLIST_MAX_THREADS) T = PFSPH_NLIST_MAX_THREADS;
+    int rc = pfsph_nlist_plan(l, n, T, guess), rcb = pfsph_nlist_plan(lb, n, T, guess / 4);
+    if (rc == PFSPH_ENOMEM || rcb == PFSPH_ENOMEM) return PFSPH_ENOMEM;
+    int over = rc != PFSPH_OK, bover = rcb != PFSPH_OK;
+    double a2max = 0;
+    /* contiguous blocks in order, one per thread, as the lists' plan has them (density.c) */
+#pragma omp parallel num_threads(T) reduction(| : over, bover) reduction(max : a2max)
+    {
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
+        const size_t rb = l->rbeg[t], re = nt == T ? l->rbeg[t + 1] : rb;
+        const size_t brb = lb->rbeg[t], bre = nt == T ? lb->rbeg[t + 1] : brb;
+        pw_sink sk = {l->idx, l->dw, rb, re}, skb = {lb->idx, lb->dw, brb, bre};
+        pw_scratch W;
+        a2max = apply_lists_block(&J, &W, i0, i1, nd, acc, l, lb, &sk, &skb);
+        if (nt != T || sk.pos > re) over = 1;
+        else l->used[t] = sk.pos - rb;
+        if (nt != T || skb.pos > bre) bover = 1;
+        else lb->used[t] = skb.pos - brb;
+    }
+    pw->amax = sqrt(a2max);
+    const pfsph_nlist_sets S = {ctx->grid, f->x, f->y, f->z, f->x, f->y, f->z, n, 1, h2, &ctx->kern};
+    const pfsph_nlist_sets SB = {ctx->bgrid, b->x, b->y, b->z, f->x, f->y, f->z, n, 0, h2, &ctx->kern};
+    rc = pfsph_nlist_finish(l, over, &S);
+    return rc ? rc : pfsph_nlist_finish(lb, bover, &SB);
+}
+
 double pfsph_pairwise_amax(const pfsph_pairwise *pw) { return pw ? pw->amax : 0; }
 
 void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T)
@@ -395,7 +480,7 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
 #pragma omp for schedule(dynamic, 256)
         for (size_t i = 0; i < n; i++) {
             double acc[3], v = 0;
-            particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws, NULL);
+            particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws, NULL, NULL, NULL);
             if (vir) vir[i] = v;
         }
     }
@@ -507,6 +592,32 @@ static int pairwise_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     pfsph_pairwise_apply(st->pw, st->ctx);
     return PFSPH_OK;
 }
+
+/* The same with neighbour lists (the interactive PCISPH, st->lists): the pairs within h of the
+ * pair walk listed as the density stage lists them (pcisph_lists.h), one k h walk instead of an
+ * h walk and a k h walk (docs/interactive.md, "Profile"). */
+static int pair_density_lists_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)state;
+    pfsph_ctx *c = st->ctx;
+    c->nlist = c->nlist_b = NULL;
+    const double q = (double)c->h / (double)c->spacing; /* as density.c guesses */
+    const double guess = 1.25 * (c->dim == 2 ? 3.14159 * q * q : 4.18879 * q * q * q);
+    int rc = pfsph_pairwise_apply_density_lists(st->pw, c, c->nd, st->pair_a, st->nlist, st->nlist_b, guess);
+    if (rc)
+        return pfsph_fail(err, rc, "cannot build the neighbour lists (%s)",
+                          rc == PFSPH_ENOMEM ? "out of memory" : "internal error");
+    c->nlist = st->nlist;
+    c->nlist_b = st->nlist_b;
+    return pfsph__density_check(st, bad);
+}
+
+const pfsph_stage_ops pfsph_stage_pair_density_lists = {.name = "density",
+                                                        .slot = PFSPH_STAGE_PAIRWISE,
+                                                        .reads =
+                                                            PFSPH_D_POS | PFSPH_D_ORDER | PFSPH_D_VEL | PFSPH_D_FILM,
+                                                        .writes = PFSPH_D_DENSITY | PFSPH_D_PAIR_ACC | PFSPH_D_NLIST,
+                                                        .run = pair_density_lists_run};
 
 const pfsph_stage_ops pfsph_stage_pairwise = {.name = "pairwise",
                                               .slot = PFSPH_STAGE_PAIRWISE,

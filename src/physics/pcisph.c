@@ -35,6 +35,7 @@ typedef struct pcisph {
     int min_iter, max_iter;
     /* the interactive mode's once-per-step neighbour lists (pcisph_lists.h) */
     pfsph_nlist l, lb;
+    pfsph_pcisph_pairs cf, cb; /* and an iteration's pairs, density pass to pressure pass */
 } pcisph;
 
 /* PCISPH scaling: |sum grad W|^2 + sum |grad W|^2 over a full lattice neighbourhood. */
@@ -60,6 +61,8 @@ static void destroy(void *state)
     if (!p) return;
     pfsph_nlist_free(&p->l);
     pfsph_nlist_free(&p->lb);
+    pfsph__pcisph_pairs_free(&p->cf);
+    pfsph__pcisph_pairs_free(&p->cb);
     free(p);
 }
 
@@ -78,6 +81,9 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
         if (pfsph__pcisph_lists(c, &P->l, &P->lb) != PFSPH_OK) L = LB = NULL;
     }
     const int lists = c->interactive && L && LB;
+    /* the pairs kept from each density pass for its pressure pass; the list walks when out of memory */
+    const int pairs = lists && pfsph__pcisph_pairs_reserve(&P->cf, L->start[n]) == PFSPH_OK &&
+        pfsph__pcisph_pairs_reserve(&P->cb, LB->start[n]) == PFSPH_OK;
     const double dt = c->dt;
     pfsph_real *apx = ap[0], *apy = ap[1], *apz = ap[2];
     pfsph_real *xp = scr[XP], *yp = scr[YP], *zp = scr[ZP], *ndp = scr[NDP], *er = scr[ERR];
@@ -110,7 +116,8 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
         }
         pfsph_real *const pred[3] = {xp, yp, zp};
         pfsph__halo(c, pred, 3); /* a distributed run: the owners' predictions of halo particles */
-        if (lists) pfsph__pcisph_density(c, L, LB, xp, yp, zp, ndp);
+        if (pairs) pfsph__pcisph_density_pairs(c, L, LB, xp, yp, zp, ndp, &P->cf, &P->cb);
+        else if (lists) pfsph__pcisph_density(c, L, LB, xp, yp, zp, ndp);
         else pfsph__number_density(c, xp, yp, zp, ndp);
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
@@ -123,7 +130,8 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
         pfsph__halo(c, dens, 2);
         const size_t nall = pfsph__fluid_count(c);
         avg = nall ? pfsph__fluid_sum(c, er) / (double)nall : 0; /* the serial sum on any rank count */
-        if (lists) pfsph__pcisph_pressure(c, L, LB, xp, yp, zp, ndp, f->p, apx, apy, apz);
+        if (pairs) pfsph__pcisph_pressure_pairs(c, L, LB, ndp, f->p, &P->cf, &P->cb, apx, apy, apz);
+        else if (lists) pfsph__pcisph_pressure(c, L, LB, xp, yp, zp, ndp, f->p, apx, apy, apz);
         else pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
         it++;
         if (it >= P->min_iter && avg <= P->tol) break;

@@ -5,6 +5,7 @@
 #include "physics/pcisph_lists.h"
 
 #include <omp.h>
+#include <stdlib.h>
 
 #include "core/hits.h"
 #include "physics/pair_terms.h"
@@ -187,5 +188,128 @@ void pfsph__pcisph_pressure(const pfsph_ctx *ctx, const pfsph_nlist *l, const pf
             apy[i] = inv_m * ay;
             apz[i] = inv_m * az;
         }
+    }
+}
+
+int pfsph__pcisph_pairs_reserve(pfsph_pcisph_pairs *c, size_t m)
+{
+    if (m <= c->cap) return PFSPH_OK;
+    const size_t cap = m + m / 8 + 64;
+    pfsph_real **arr[4] = {&c->dx, &c->dy, &c->dz, &c->dw};
+    for (int a = 0; a < 4; a++) {
+        pfsph_real *q = realloc(*arr[a], cap * sizeof(pfsph_real));
+        if (!q) return PFSPH_ENOMEM; /* the grown ones stay grown; cap unchanged */
+        *arr[a] = q;
+    }
+    c->cap = cap;
+    return PFSPH_OK;
+}
+
+void pfsph__pcisph_pairs_free(pfsph_pcisph_pairs *c)
+{
+    free(c->dx);
+    free(c->dy);
+    free(c->dz);
+    free(c->dw);
+    *c = (pfsph_pcisph_pairs){0};
+}
+
+/* The entries [e0, e1) of point (x, y, z) against targets (tx, ty, tz): x_ij and dW/r into C
+ * (0 beyond h), W into w (0 beyond h) for the caller's sum; chunks of the hits' room. As
+ * gather + pfsph__terms_w / _dwr: the same values for the pairs within h, zeros for the rest. */
+static inline void pairs_block(const pfsph_kernel *k, pfsph_real h2, pfsph_hits *H, const uint32_t *idx, uint32_t e0,
+                               uint32_t e1, const pfsph_real *tx, const pfsph_real *ty, const pfsph_real *tz,
+                               pfsph_real x, pfsph_real y, pfsph_real z, pfsph_pcisph_pairs *C)
+{
+    pfsph_real *restrict cx = C->dx + e0, *restrict cy = C->dy + e0, *restrict cz = C->dz + e0;
+    const int m = (int)(e1 - e0);
+    for (int q = 0; q < m; q++) {
+        const uint32_t j = idx[e0 + (uint32_t)q];
+        const pfsph_real dx = x - tx[j], dy = y - ty[j], dz = z - tz[j];
+        cx[q] = dx;
+        cy[q] = dy;
+        cz[q] = dz;
+        H->r2[q] = dx * dx + dy * dy + dz * dz;
+    }
+    pfsph__terms_w(k, m, H->r2, H->t0);
+    pfsph__terms_dwr(k, m, H->r2, C->dw + e0);
+    pfsph_real *restrict cw = C->dw + e0;
+    for (int q = 0; q < m; q++)
+        if (!(H->r2[q] < h2)) H->t0[q] = cw[q] = 0;
+}
+
+void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb, const pfsph_real *x,
+                                 const pfsph_real *y, const pfsph_real *z, pfsph_real *nd, pfsph_pcisph_pairs *cf,
+                                 pfsph_pcisph_pairs *cb)
+{
+    const pfsph_kernel *k = &ctx->kern;
+    const pfsph_real h2 = k->h * k->h, w0 = pfsph_kernel_w0(k);
+    const pfsph_particles *b = ctx->boundary;
+    const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
+    const size_t n = ctx->fluid->n;
+#pragma omp parallel
+    {
+        pfsph_hits H;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real xi = x[i], yi = y[i], zi = z[i];
+            /* the terms in the list's order, zeros for the pairs beyond h: pfsph__pcisph_density's sum */
+            pfsph_real s = w0;
+            for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end;) {
+                const uint32_t e1 = end - e > PFSPH_HITS_CAP ? e + PFSPH_HITS_CAP : end;
+                pairs_block(k, h2, &H, l->idx, e, e1, x, y, z, xi, yi, zi, cf);
+                for (uint32_t q = 0; q < e1 - e; q++) s += H.t0[q];
+                e = e1;
+            }
+            pfsph_real sb = 0;
+            for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end;) {
+                const uint32_t e1 = end - e > PFSPH_HITS_CAP ? e + PFSPH_HITS_CAP : end;
+                pairs_block(k, h2, &H, lb->idx, e, e1, b->x, b->y, b->z, xi, yi, zi, cb);
+                for (uint32_t q = 0; q < e1 - e; q++) sb += b->aux[lb->idx[e + q]] * H.t0[q];
+                e = e1;
+            }
+            nd[i] = s + sb * inv_v0;
+        }
+    }
+}
+
+void pfsph__pcisph_pressure_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb,
+                                  const pfsph_real *nd, const pfsph_real *p, const pfsph_pcisph_pairs *cf,
+                                  const pfsph_pcisph_pairs *cb, pfsph_real *apx, pfsph_real *apy, pfsph_real *apz)
+{
+    const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
+    const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
+    const size_t n = f->n;
+    const pfsph_real *restrict cx = cf->dx, *restrict cy = cf->dy, *restrict cz = cf->dz, *restrict cw = cf->dw;
+    const pfsph_real *restrict bxs = cb->dx, *restrict bys = cb->dy, *restrict bzs = cb->dz, *restrict bws = cb->dw;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        const pfsph_real pi = p[i] / (nd[i] * nd[i]);
+        pfsph_real ax = 0, ay = 0, az = 0;
+        /* pfsph__pcisph_pressure's terms in its order; a pair beyond h adds s = 0 times x_ij */
+        for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end; e++) {
+            const uint32_t j = l->idx[e];
+            const pfsph_real s = (pi + p[j] / (nd[j] * nd[j])) * cw[e];
+            ax += s * cx[e];
+            ay += s * cy[e];
+            az += s * cz[e];
+        }
+        if (pi > 0) {
+            pfsph_real bx = 0, by = 0, bz = 0;
+            for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end; e++) {
+                const pfsph_real s = b->aux[lb->idx[e]] * bws[e];
+                bx += s * bxs[e];
+                by += s * bys[e];
+                bz += s * bzs[e];
+            }
+            const pfsph_real wb = pi * inv_v0;
+            ax += wb * bx;
+            ay += wb * by;
+            az += wb * bz;
+        }
+        const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
+        apx[i] = inv_m * ax;
+        apy[i] = inv_m * ay;
+        apz[i] = inv_m * az;
     }
 }

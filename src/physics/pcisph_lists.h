@@ -23,4 +23,27 @@ void pfsph__pcisph_pressure(const pfsph_ctx *ctx, const pfsph_nlist *l, const pf
                             const pfsph_real *y, const pfsph_real *z, const pfsph_real *nd, const pfsph_real *p,
                             pfsph_real *apx, pfsph_real *apy, pfsph_real *apz);
 
+/* The pairs of one iteration at the predicted positions, kept from the density pass for the
+ * pressure pass (same positions): per list entry x_ij (dx, dy, dz) and dW/r, 0 beyond h. The
+ * pressure pass then streams them instead of gathering positions and evaluating the kernel
+ * again (docs/interactive.md, "Profile"). */
+typedef struct pfsph_pcisph_pairs {
+    pfsph_real *dx, *dy, *dz, *dw;
+    size_t cap;
+} pfsph_pcisph_pairs;
+
+/* Room for m entries: PFSPH_OK or PFSPH_ENOMEM (the arrays are then as before). */
+int pfsph__pcisph_pairs_reserve(pfsph_pcisph_pairs *c, size_t m);
+void pfsph__pcisph_pairs_free(pfsph_pcisph_pairs *c);
+
+/* pfsph__pcisph_density (the same bits), filling cf and cb (room for l's and lb's entries). */
+void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb, const pfsph_real *x,
+                                 const pfsph_real *y, const pfsph_real *z, pfsph_real *nd, pfsph_pcisph_pairs *cf,
+                                 pfsph_pcisph_pairs *cb);
+
+/* pfsph__pcisph_pressure at the positions cf and cb were filled at (the same bits). */
+void pfsph__pcisph_pressure_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb,
+                                  const pfsph_real *nd, const pfsph_real *p, const pfsph_pcisph_pairs *cf,
+                                  const pfsph_pcisph_pairs *cb, pfsph_real *apx, pfsph_real *apy, pfsph_real *apz);
+
 #endif

@@ -25,6 +25,9 @@ extern const pfsph_stage_ops pfsph_stage_diffuse;         /* physics/diffuse.c: 
 extern const pfsph_stage_ops pfsph_stage_bodies;          /* physics/body_stages.c: ODE step */
 extern const pfsph_stage_ops pfsph_stage_emit;            /* physics/emitter.c: new fluid */
 
+/* physics/pairwise.c: Eq. 23 and the lists within h in the pair walk (the interactive PCISPH) */
+extern const pfsph_stage_ops pfsph_stage_pair_density_lists;
+
 /* Output stages: fields a frame carries that the step does not keep, computed when a frame is
  * written (pfsph_sim_output) into the step's output buffers (out_layer, out_mech_p). */
 extern const pfsph_stage_ops pfsph_stage_surface_layers;      /* core/surface_detect.c */

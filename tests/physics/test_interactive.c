@@ -81,6 +81,20 @@ static void test_wetting(void **state)
             if (dts * k > t_end - 1 + 1e-9 && isfinite(th)) sum[q] += th, cnt[q]++;
             l += snprintf(line + l, sizeof line - (size_t)l, " %6.1f", th);
         }
+        /* a second reading, not asserted: the angle of the spherical cap of the drop's height H
+         * (top particle + d/2) and volume V = N d^3, 2 atan(H / a) with a^2 = (6 V / (pi H) - H^2) / 3
+         * (thin caps: the outline fit above 1.5 d sees few points there) */
+        l += snprintf(line + l, sizeof line - (size_t)l, " | cap:");
+        for (int q = 0; q < nd; q++) {
+            double top = -1e30;
+            size_t cntq = 0;
+            for (size_t i = 0; i < c->fluid->n; i++)
+                if (c->fluid->x[i] >= x0[q] && c->fluid->x[i] < x1[q]) top = fmax(top, c->fluid->y[i]), cntq++;
+            const double H = top + 0.5 * c->spacing, V = (double)cntq * pow(c->spacing, 3);
+            const double a2 = (6 * V / (3.14159265358979323846 * H) - H * H) / 3;
+            l += snprintf(line + l, sizeof line - (size_t)l, " %5.1f",
+                          a2 > 0 ? 2 * atan(H / sqrt(a2)) * 180 / 3.14159265358979323846 : NAN);
+        }
         print_message("%s\n", line);
     }
     assert_int_equal(pfsph_sim_removed(sim), 0);
