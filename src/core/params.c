@@ -117,7 +117,7 @@ static const double visc_y3[] = {0.219, 0.361, 1.036};
  * viscosity.md, "2D at theta 0.04"): nu_morris 3e-4 / 1e-3 / 3e-3 / 1e-2 m^2/s read 1.62 / 1.92 /
  * 3.12 / 8.98e-3 (means of 2 / 2 / 4 / 6 seeds; sd at 1e-2 3.1e-3, where the mode lives 0.3 s).
  * The liquid is Newtonian there and flows with about the Morris viscosity plus an excess of its
- * own that matters below 1e-3, so 2D applies the viscosity as set and uses this table only for
+ * own that matters below about 2e-3, so 2D applies the viscosity as set and uses this table only for
  * what `pfsph check` expects. */
 static const double visc_x2[] = {0.0474, 0.158, 0.474, 1.581};
 static const double visc_y2[] = {0.256, 0.303, 0.493, 1.420};
