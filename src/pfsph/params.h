@@ -60,10 +60,9 @@ enum pfsph_pw_center {
 #define PFSPH_THERMO_REDUCED_DEFAULT 0.01
 /* The 2D default. At 0.01 the 2D liquid, 1.7x above its melting point, is a shear-thinning soft
  * glass with an apparent yield stress (drops stay elongated and ring at 4x Lamb's damping); at
- * 0.04 it is Newtonian and a drop rings with the set viscosity (docs/viscosity.md). Raising it
- * is the remedy, but the 2D bubble, film, shape and thermostat tests were tuned at 0.01 and fail
- * at 0.04 (docs/viscosity.md, "Open"): kept at 0.01 until they are re-derived. */
-#define PFSPH_THERMO_REDUCED_DEFAULT_2D 0.01
+ * 0.04 it is Newtonian and flows with the set viscosity, the Morris viscosity applied as set
+ * (wall-free slab 1.04-1.15x, drops 0.90-1.05x; docs/viscosity.md). */
+#define PFSPH_THERMO_REDUCED_DEFAULT_2D 0.04
 /* The default reduced temperature of a dim-dimensional scene. */
 static inline double pfsph_thermo_reduced_default(int dim)
 {
@@ -109,11 +108,14 @@ typedef struct pfsph_pairwise_params {
      * Morris viscosity it is given. 3D: measured wall-free as nu_eff(nu_morris)
      * (pfsph_pairwise_visc_eff); with `viscosity_correction` on (the default in a 3D "pairwise"
      * block) each pair-force phase's Morris viscosity becomes the one that gives its
-     * `viscosity`, at least nu_floor. 2D (opt-in, docs/thermostat.md): the box calibration,
+     * `viscosity`, at least nu_floor. 2D: applied as set (at the 2D default temperature the
+     * liquid flows as set); opt-in, docs/thermostat.md: the box calibration,
      * max((nu - nu_struct) / gain, nu_floor). */
     bool visc_correct;                  /* scene key; 3D: on in a "pairwise" block unless it says false */
     double nu_morris[PFSPH_MAX_PHASES]; /* the viscosity the step applies [m^2/s] */
-    double nu_struct[PFSPH_MAX_PHASES]; /* 3D: expected bulk viscosity; 2D: structural estimate (0: no table) */
+    double nu_struct[PFSPH_MAX_PHASES]; /* expected bulk viscosity (wall-free table); 2D with the
+                                           box correction or off its default temperature: the
+                                           box's structural estimate (0: no table) */
     double nu_floor[PFSPH_MAX_PHASES];  /* smallest Morris viscosity applied */
 } pfsph_pairwise_params;
 
@@ -159,8 +161,9 @@ double pfsph_pairwise_visc_struct(int dim, double theta);
 /* The bulk viscosity of the hot pair-force liquid, nu_eff / nu_0, for the Morris viscosity
  * x = nu_morris / nu_0 (nu_0 = sqrt(sigma d / rho), sigma the phase's own tension at temperature,
  * d the spacing, rho its rest density), measured wall-free at the default temperature of
- * dimension dim (docs/viscosity.md); NAN where no table applies (2D, where the Morris viscosity
- * is applied as set, or theta more than 25 % from the default). pfsph_pairwise_visc_morris is its inverse: the x that gives nu_eff / nu_0 = y. */
+ * dimension dim (docs/viscosity.md; 2D applies the Morris viscosity as set and uses its table
+ * only for the expectation); NAN where no table applies (theta more than 25 % from the
+ * default). pfsph_pairwise_visc_morris is its inverse: the x that gives nu_eff / nu_0 = y. */
 double pfsph_pairwise_visc_eff(int dim, double theta, double x);
 double pfsph_pairwise_visc_morris(int dim, double theta, double y);
 /* The smallest Morris viscosity the correction applies, in units of sqrt(sigma d / rho): the

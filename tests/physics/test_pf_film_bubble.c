@@ -48,17 +48,24 @@
 
 static const double PI = 3.14159265358979323846;
 
-/* Phases, pair coefficients; FILM_NU, FILM_SIGMA_GAS, FILM_V override (studies, docs/film.md). */
+/* Phases, pair coefficients; FILM_NU, FILM_SIGMA_GAS, FILM_V, FILM_THETA override (studies,
+ * docs/film.md). The temperature is set to 0.01, the 2D default these bounds were measured at:
+ * at the 2D default since issue 31, 0.04, the film breaks (docs/viscosity.md, "Open"): the
+ * bubble at rest loses 2.95 % of its gas (bound 2 %) and reads a moment ratio of 0.840 (bound
+ * 0.88), and the blown bubble does not hold the emitted gas (116 emitted particles outside it,
+ * growth 427 % off the blown volume). That is the film model failing in a hotter liquid, not a
+ * bound to re-derive; until the film is fixed for it, film scenes need 0.01. */
 static const char *phases_and_pairs(void)
 {
     static char buf[1024];
-    const char *nu = getenv("FILM_NU"), *sg = getenv("FILM_SIGMA_GAS");
+    const char *nu = getenv("FILM_NU"), *sg = getenv("FILM_SIGMA_GAS"), *th = getenv("FILM_THETA");
     snprintf(buf, sizeof buf,
              "\"phases\": [{\"name\": \"soap\", \"kind\": \"fluid\", \"rest_density\": 1000, \"viscosity\": %s},"
              " {\"name\": \"air\", \"kind\": \"gas\", \"rest_density\": 1000, \"viscosity\": %s}],"
-             " \"pairwise\": {\"k\": 1.633, \"coefficients\": [{\"phases\": [\"soap\", \"soap\"], \"sigma\": 4},"
+             " \"pairwise\": {\"k\": 1.633, \"thermostat\": {\"reduced_temperature\": %s},"
+             " \"coefficients\": [{\"phases\": [\"soap\", \"soap\"], \"sigma\": 4},"
              " {\"phases\": [\"air\", \"air\"], \"sigma\": %s}, {\"phases\": [\"soap\", \"air\"], \"sigma\": 0}]}",
-             nu ? nu : "0.005", nu ? nu : "0.005", sg ? sg : "2");
+             nu ? nu : "0.005", nu ? nu : "0.005", th ? th : "0.01", sg ? sg : "2");
     return buf;
 }
 

@@ -105,7 +105,8 @@ static void relax(int dim, int N, const char *k, double t_end, double ratio_min)
                  " \"time\": {\"dt_max\": 0.002},"
                  " \"phases\": [{\"name\": \"water\", \"viscosity\": 0.003}],"
                  " \"fluid\": [{\"shape\": \"box\", \"min\": [%g, %g], \"max\": [%g, %g]}],"
-                 " \"pairwise\": {\"k\": %s, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}}",
+                 " \"pairwise\": {\"k\": %s, \"thermostat\": {\"reduced_temperature\": 0.01},"
+                 " \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}}",
                  -a, -a, a, a, k);
     else
         snprintf(json, sizeof json,
@@ -156,7 +157,14 @@ static void relax(int dim, int N, const char *k, double t_end, double ratio_min)
     pfsph_sim_destroy(sim);
 }
 
-/* 20 x 20 square, 400 particles. Outline spread 0.42-0.49 d from 0.9 s on (0.54-0.66 d at 1-3 s
+/* 2D at theta 0.01 (set in the scene), the temperature these bounds were measured at. At the 2D
+ * default since issue 31, 0.04, this square reads over the second half a spread of 1.58 d and a
+ * moment ratio of 0.839, with 0.8 % of the particles closer than d/2 and a closest pair of
+ * 0.26 d: the outline's thermal roughness grows as sqrt(theta) (rms radius sqrt(3 theta d R /
+ * (4 pi)) over the modes n >= 2: 0.16 d at 0.01, 0.33 d at 0.04 for R = 11.3 d), so the
+ * one-spacing spread bound holds only for the colder liquid; the ratio 0.839 is also below
+ * the equipartition mean at 0.04 (0.907). A bound re-derived for 0.04 is open (docs/viscosity.md).
+ * 20 x 20 square, 400 particles. Outline spread 0.42-0.49 d from 0.9 s on (0.54-0.66 d at 1-3 s
  * with nu 1e-3 / 3e-3 and 256 / 400 / 576 particles, unjittered). The moment ratio settles at
  * 0.948 from 1.7 s to 4 s: a frozen elongation of 2.6 % (0.3 d on the semi-axes), just short
  * of the issue's 0.95; the bound here (0.9) only guards against regressions. */

@@ -41,7 +41,7 @@
  * Writes validation/hysing_case{1,2}.csv (t, yc, vy, circularity) in the working directory for
  * tools/validation_plots.py. Under AddressSanitizer it skips (tu_release_only).
  * Study knobs: PF_N (particles per diameter, 16), PF_CASES ("1,2"), PF_PW (pairwise text),
- * PF_SOLVER (both cases' solver text), PF_T (end, 3 s). */
+ * PF_SOLVER (both cases' solver text), PF_T (end, 3 s), PF_SWG (factor on the water-gas tension, 1). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -96,16 +96,11 @@ static void run_case(int cs, int n, series *r)
     char json[8192];
     snprintf(json, sizeof json, SCENE, 0.5 * d, -w - d, -w - d, 1 + w + d, 2 + w + d,
              tu_env("PF_SOLVER", cs == 1 ? "pcisph" : "wcsph\", \"pressure_scale\": \"common"), h->rho_g, h->nu_g, -w,
-             -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma, h->sigma);
-    static pfsph_scene sc;
+             -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma,
+             h->sigma * tu_env_num("PF_SWG", 1));
+    pfsph_sim *sim = tu_sim_from_json(json, "hysing case");
     pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&sc, json, "hysing case", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim;
-    rc = pfsph_sim_create(&sim, &sc, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    int rc;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     memset(r, 0, sizeof *r);
     pfm_bubble s;

@@ -111,15 +111,9 @@ static void run(int n, double t_end, int rest, run_result *r)
     snprintf(json, sizeof json, SCENE, 0.5 * d, rest ? 0.0 : -0.98, -w - d, -w - d, 1 + w + d, 2 + w + d,
              getenv("PF_SOLVER") ? getenv("PF_SOLVER") : "pcisph", nu, nu, -w, -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w,
              getenv("PF_VCORR") ? getenv("PF_VCORR") : "true", getenv("PF_PW") ? getenv("PF_PW") : "");
-    static pfsph_scene sc;
+    pfsph_sim *sim = tu_sim_from_json(json, "hysing bubble");
     pfsph_error err = {0};
-    int rc = pfsph_scene_parse(&sc, json, "hysing bubble", &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
-    pfsph_sim *sim;
-    rc = pfsph_sim_create(&sim, &sc, &err);
-    if (rc) fprintf(stderr, "%s\n", err.msg);
-    assert_int_equal(rc, PFSPH_OK);
+    int rc;
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     memset(r, 0, sizeof *r);
     r->n = n;
