@@ -113,7 +113,7 @@ double pfsph_pairwise_visc_struct(int dim, double theta)
 static const double visc_x3[] = {0.0475, 0.158, 0.475};
 static const double visc_y3[] = {0.219, 0.361, 1.036};
 
-/* 2D at its default temperature, theta 0.04 (k 1.7, H = 30 d, the same slab, A 0.1 m/s; docs/
+/* 2D at theta 0.04, PFSPH_VISC_TABLE_THETA_2D (k 1.7, H = 30 d, the same slab, A 0.1 m/s; docs/
  * viscosity.md, "2D at theta 0.04"): nu_morris 3e-4 / 1e-3 / 3e-3 / 1e-2 m^2/s read 1.62 / 1.92 /
  * 3.12 / 8.98e-3 (means of 2 / 2 / 4 / 6 seeds; sd at 1e-2 3.1e-3, where the mode lives 0.3 s).
  * The liquid is Newtonian there and flows with about the Morris viscosity plus an excess of its
@@ -124,8 +124,9 @@ static const double visc_y2[] = {0.256, 0.303, 0.493, 1.420};
 
 static bool visc_table(int dim, double theta, const double **x, const double **y, size_t *n)
 {
-    /* measured at the default temperature only: within 25 % of it */
-    if ((dim != 2 && dim != 3) || !(fabs(theta / pfsph_thermo_reduced_default(dim) - 1) <= 0.25)) return false;
+    /* measured at one temperature each (3D: its default; 2D: 0.04): within 25 % of it */
+    const double theta_table = dim == 2 ? PFSPH_VISC_TABLE_THETA_2D : pfsph_thermo_reduced_default(dim);
+    if ((dim != 2 && dim != 3) || !(fabs(theta / theta_table - 1) <= 0.25)) return false;
     *x = dim == 2 ? visc_x2 : visc_x3;
     *y = dim == 2 ? visc_y2 : visc_y3;
     *n = dim == 2 ? sizeof visc_x2 / sizeof visc_x2[0] : sizeof visc_x3 / sizeof visc_x3[0];

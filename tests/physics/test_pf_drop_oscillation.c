@@ -10,6 +10,11 @@
 #include "pf_drop.h"
 #include "testutil.h"
 
+/* 2D runs at theta 0.04, not the 2D default 0.01: at 0.01 the 2D liquid is a shear-thinning soft
+ * glass and the drop rings at about 4x Lamb's damping (docs/viscosity.md); the default stays
+ * 0.01 until the 2D bubble and shape tests are re-derived for 0.04. */
+#define THETA_2D "\"thermostat\": {\"reduced_temperature\": 0.04},"
+
 static void drop_2d(void **state)
 {
     (void)state;
@@ -24,7 +29,7 @@ static void drop_2d(void **state)
                          tu_env_num("PF_MELT", 0.3),
                          (int)tu_env_num("PF_SEED", 1),
                          (int)tu_env_num("PF_SEEDS", 3),
-                         NULL};
+                         THETA_2D};
     pfm_osc_result r;
     const int rc = pfm_oscillation(&cfg, &r);
     pfm_osc_report(&cfg, &r, "2d_coarse");

@@ -12,6 +12,11 @@
 #include "pf_drop.h"
 #include "testutil.h"
 
+/* 2D runs at theta 0.04, not the 2D default 0.01: at 0.01 the 2D liquid is a shear-thinning soft
+ * glass and the drop rings at about 4x Lamb's damping (docs/viscosity.md); the default stays
+ * 0.01 until the 2D bubble and shape tests are re-derived for 0.04. */
+#define THETA_2D "\"thermostat\": {\"reduced_temperature\": 0.04},"
+
 static void run_case(int dim, double R, double d, const char *tag)
 {
     const char *sel = tu_env("PF_CASES", "");
@@ -30,7 +35,7 @@ static void run_case(int dim, double R, double d, const char *tag)
                          tu_env_num("PF_MELT", 0.3),
                          (int)tu_env_num("PF_SEED", 1),
                          (int)tu_env_num("PF_SEEDS", dim == 2 ? 3 : 1),
-                         NULL};
+                         dim == 2 ? THETA_2D : NULL};
     pfm_osc_result r;
     const int rc = pfm_oscillation(&cfg, &r);
     pfm_osc_report(&cfg, &r, tag + 2);
