@@ -130,6 +130,7 @@ typedef struct pfsph_vopts {
     const char *press;     /* keys pressed, one per drawn frame after the first (tests, demos) */
     int samples;           /* 0: automatic */
     double bench;
+    double max_fps; /* most frames drawn per second in a window (0: no limit; default 60) */
 } pfsph_vopts;
 
 /* The whole viewer: options, scene, the source of the frames, camera, GL state and input. */

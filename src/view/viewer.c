@@ -22,7 +22,7 @@ const char *const pfsph_view_help =
     "                  [--threads N] [--paused] [--screenshot FILE.png --frames N]\n"
     "                  [--dump DIR] [--hide walls,bodies,diffuse] [--no-overlay]\n"
     "                  [--samples 1|2] [--bench SECONDS] [--particles] [--all-walls]\n"
-    "                  [--surface-budget MS] [--press KEYS]\n"
+    "                  [--surface-budget MS] [--press KEYS] [--max-fps N]\n"
     "\n"
     "Live mode (SCENE, a JSON file; none: the embedded default scene): the scene is simulated\n"
     "in the window, step by step, as `pfsph run` does. Replay mode (RUN_DIR, a run directory):\n"
@@ -47,6 +47,9 @@ const char *const pfsph_view_help =
     "  --surface-budget MS  live: the time one rebuild of the surface may take (default\n"
     "                     33.3, a 1/30 s frame; a screenshot: no limit, the finest cell)\n"
     "  --press KEYS       press these keys, one per frame drawn after the first (M, G, ...)\n"
+    "  --max-fps N        draw at most N frames a second in the window (default 60; 0: no\n"
+    "                     limit): on a software renderer every frame drawn is CPU taken\n"
+    "                     from the simulation\n"
     "  --all-walls        3D: keep the walls that face the camera (default: cut away)\n"
     "\n"
     "Mouse: left drag orbits (2D: pans), right or middle drag (or shift + left) pans, wheel\n"
@@ -77,6 +80,7 @@ static int parse_opts(int argc, char **argv, pfsph_vopts *o)
     memset(o, 0, sizeof *o);
     o->frame = -1;
     o->frames = 1;
+    o->max_fps = 60;
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -112,6 +116,12 @@ static int parse_opts(int argc, char **argv, pfsph_vopts *o)
             o->bench = v ? strtod(v, &end) : -1;
             if (!v || *end || !(o->bench > 0 && o->bench <= 3600))
                 return usage("--bench: '%s' is not 0..3600 seconds", v ? v : "");
+            i++;
+        } else if (!strcmp(a, "--max-fps")) {
+            char *end = NULL;
+            o->max_fps = v ? strtod(v, &end) : -1;
+            if (!v || *end || !(o->max_fps >= 0 && o->max_fps <= 1000))
+                return usage("--max-fps: '%s' is not 0..1000 frames per second", v ? v : "");
             i++;
         } else if (!strcmp(a, "--surface-budget")) {
             char *end = NULL;

@@ -135,7 +135,7 @@ int pfsph_vwindow_run(pfsph_vapp *A)
     glfwSetWindowUserPointer(A->win, A);
     pfsph_vinput_attach(A->win);
     int status = 0, drawn = 0, fps_frames = 0;
-    double fps_t0 = glfwGetTime(), bench_t0 = fps_t0;
+    double fps_t0 = glfwGetTime(), bench_t0 = fps_t0, last_draw = -1e30;
     uint64_t bench_steps0 = A->shown->steps;
     const double fps_play = A->scene->fps > 0 ? A->scene->fps : 25;
     A->dirty = true;
@@ -182,7 +182,17 @@ int pfsph_vwindow_run(pfsph_vapp *A)
             if (A->R.cur + 1 < A->R.fluid.n) pfsph_vreplay_goto(A, A->R.cur + 1);
             else A->R.playing = false;
         }
-        if (A->dirty || headless || o->bench > 0) {
+        /* at most max_fps frames a second in a window: with a software renderer each frame
+         * drawn is CPU the simulation's threads do not get, and live mode has a new snapshot
+         * after every step (1-9 a frame) */
+        const bool want = A->dirty || headless || o->bench > 0;
+        const double wait = headless || !(o->max_fps > 0) ? 0 : last_draw + 1.0 / o->max_fps - glfwGetTime();
+        if (want && wait > 0) {
+            glfwWaitEventsTimeout(wait);
+            continue;
+        }
+        if (want) {
+            last_draw = glfwGetTime();
             A->dirty = false;
             pfsph_vframe_draw(A);
             if (!headless) {

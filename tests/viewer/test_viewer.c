@@ -486,6 +486,9 @@ static void test_bad_input(void **state)
     snprintf(cmd, sizeof cmd, "%s view --surface-budget 0", tu_pfsph_bin());
     assert_int_equal(tu_run(cmd, out, sizeof out), 2);
     assert_non_null(strstr(out, "--surface-budget"));
+    snprintf(cmd, sizeof cmd, "%s view --max-fps -5", tu_pfsph_bin());
+    assert_int_equal(tu_run(cmd, out, sizeof out), 2);
+    assert_non_null(strstr(out, "--max-fps"));
     snprintf(cmd, sizeof cmd, "%s view --hide water", tu_pfsph_bin());
     assert_int_equal(tu_run(cmd, out, sizeof out), 2);
     assert_non_null(strstr(out, "water"));
