@@ -11,6 +11,27 @@
 
 #include "pfsph.h"
 
+/* The exact cut from the cells' prefix counts pre[0..nc] (pre[k]: particles before cell k):
+ * rank q starts at the first cell whose prefix reaches q / size of the total; its global
+ * offset and its halo window's local bounds, off cells either side. */
+static void cut_from_prefix(pfsph_cut *C, const uint64_t *pre, size_t nc, int size, size_t off)
+{
+    const uint64_t total = pre[nc], P = (uint64_t)size;
+    C->cut[0] = 0;
+    int q = 1;
+    for (size_t k = 0; k <= nc && q < size; k++)
+        while (q < size && pre[k] * P >= (uint64_t)q * total) C->cut[q++] = (uint32_t)k;
+    C->cut[size] = (uint32_t)nc;
+    for (q = 0; q < size; q++) {
+        const size_t a = C->cut[q] > off ? C->cut[q] - off : 0;
+        const size_t b = C->cut[q + 1] + off < nc ? C->cut[q + 1] + off : nc;
+        C->gofs[q] = pre[C->cut[q]];
+        C->lofs[q] = pre[a];
+        C->lend[q] = pre[b];
+    }
+    C->gofs[size] = total;
+}
+
 int pfsph_cut_init(pfsph_cut *C, int size, uint64_t buckets)
 {
     memset(C, 0, sizeof *C);
@@ -133,16 +154,7 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
         return PFSPH_OK;
     }
     if (w == 1) { /* exact already: the dense cut */
-        int q = 1;
-        for (size_t k = 0; k <= nb && q < size; k++)
-            while (q < size && pre[k] * P >= (uint64_t)q * total) C->cut[q++] = (uint32_t)k;
-        for (q = 0; q < size; q++) {
-            const size_t a = C->cut[q] > off ? C->cut[q] - off : 0;
-            const size_t b = C->cut[q + 1] + off < nc ? C->cut[q + 1] + off : nc;
-            C->gofs[q] = pre[C->cut[q]];
-            C->lofs[q] = pre[a];
-            C->lend[q] = pre[b];
-        }
+        cut_from_prefix(C, pre, nc, size, off);
         return PFSPH_OK;
     }
     /* round 2: per cut q, the bucket (a, b] it falls in and the windows of its halo bounds */
@@ -202,22 +214,9 @@ int pfsph_cut_dense(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m, 
     MPI_Allreduce(MPI_IN_PLACE, hist, (int)(nc + 1), MPI_UINT32_T, MPI_SUM, comm);
     pre[0] = 0;
     for (size_t k = 0; k < nc; k++) pre[k + 1] = pre[k] + hist[k];
-    const uint64_t total = pre[nc], P = (uint64_t)size;
     C->removed = hist[nc];
-    C->total = total;
-    C->cut[0] = 0;
-    int q = 1;
-    for (size_t k = 0; k <= nc && q < size; k++)
-        while (q < size && pre[k] * P >= (uint64_t)q * total) C->cut[q++] = (uint32_t)k;
-    C->cut[size] = (uint32_t)nc;
-    for (q = 0; q < size; q++) {
-        const size_t a = C->cut[q] > off ? C->cut[q] - off : 0;
-        const size_t b = C->cut[q + 1] + off < nc ? C->cut[q + 1] + off : nc;
-        C->gofs[q] = pre[C->cut[q]];
-        C->lofs[q] = pre[a];
-        C->lend[q] = pre[b];
-    }
-    C->gofs[size] = total;
+    C->total = pre[nc];
+    cut_from_prefix(C, pre, nc, size, off);
     free(hist);
     free(pre);
     return PFSPH_OK;
