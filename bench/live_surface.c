@@ -15,6 +15,7 @@
 
 #include <omp.h>
 
+#include "bench_util.h"
 #include "cli/omp_env.h"
 #include "pfsph/scene.h"
 #include "pfsph/sim.h"
@@ -25,17 +26,6 @@ static double now(clockid_t c)
     struct timespec t;
     clock_gettime(c, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double load_average(void)
-{
-    double l = -1;
-    FILE *f = fopen("/proc/loadavg", "r");
-    if (f) {
-        if (fscanf(f, "%lf", &l) != 1) l = -1;
-        fclose(f);
-    }
-    return l;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -87,7 +77,7 @@ int main(int argc, char **argv)
     if (!x) return 1;
     for (size_t i = 0; i < ps->n; i++) x[3 * i] = ps->x[i], x[3 * i + 1] = ps->y[i], x[3 * i + 2] = ps->z[i];
     printf("%s at t = %.3f s: %zu fluid particles, load average %.1f\n", argv[1], pfsph_sim_time(sim), ps->n,
-           load_average());
+           bench_load_average());
     omp_set_num_threads(1); /* the viewer's surface thread runs serial */
     /* the viewer's cells (vsurf.c), then isotropic kernels (no PCA) for comparison */
     const double cells[] = {0.5, 0.75, 1.0, 1.25, 1.0, 1.25};
@@ -119,7 +109,7 @@ int main(int argc, char **argv)
                cells[k], o.isotropic ? " isotropic" : "", ntris, 1e3 * wall[reps / 2], 1e3 * wall[0],
                1e3 * cpu[reps / 2], 1e3 * cpu[0], 1e3 * part[0], 1e3 * part[1], 1e3 * part[2], 1e3 * part[3]);
     }
-    printf("load average after: %.1f\n", load_average());
+    printf("load average after: %.1f\n", bench_load_average());
     free(x);
     pfsph_sim_destroy(sim);
     return 0;
