@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "core/reduce.h"
 #include "physics/neighbours.h"
 #include "physics/solver.h"
@@ -87,6 +88,10 @@ typedef struct dfsph {
     size_t nnear, near_cap;
     double *part; /* the mean residual's sum per block of PFSPH_SUM_BLOCK particles */
     size_t part_cap;
+    /* a distributed run without lists (core/dist.h): each particle's compression, for the global
+     * sum of the mean residual */
+    pfsph_real *dbuf;
+    size_t dbuf_cap;
 } dfsph;
 
 static int create(void **state, const pfsph_ctx *ctx, const pfsph_solver_config *cfg, pfsph_error *err)
@@ -114,6 +119,7 @@ static void destroy(void *state)
     free(D->near);
     free(D->nearb);
     free(D->part);
+    free(D->dbuf);
     free(D);
 }
 
@@ -217,6 +223,29 @@ static inline pfsph_real updated(const pfsph_ctx *c, int divergence, const pfsph
     return (pfsph_real)(pn > 0 ? pn : 0);
 }
 
+/* A distributed run: the Jacobi update (with upd) of every particle, then the halo copies of p
+ * from their owners (a halo particle's own residual misses the neighbours beyond the halo), so
+ * that the pass after it reads each neighbour's p as the serial run has it. That is the one
+ * refresh an iteration needs: the halo holds every cell within a walk's reach + 1 of the owned
+ * ones (src/mpi/decomp.c), so the corrected velocity of a neighbour of an owned particle is made
+ * of the refreshed p within its reach and its own a_np, both as in the serial run; the rates of
+ * the owned particles, all the mean residual sums, follow. (Without it, tests/data/mpi/
+ * dam_2d_dfsph.json differs from the serial run at its second frame.) Returns the upd the pass
+ * after it still has to do: none here, upd in a serial run (one parallel region, as before). */
+static int halo_updated(const pfsph_ctx *c, int upd, int divergence, const pfsph_real *rate, const pfsph_real *fac,
+                        pfsph_real *p)
+{
+    if (!c->dist) return upd;
+    if (upd) {
+        const size_t n = c->fluid->n;
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) p[i] = updated(c, divergence, rate, fac, p, i);
+    }
+    pfsph_real *const a[1] = {p};
+    pfsph__halo(c, a, 1);
+    return 0;
+}
+
 /* With upd, first the Jacobi update of p from the last residual (rate, fac); then a = a_p(p)
  * (PF Eq. 4 in the number-density form with the Akinci wall term, as pfsph__pressure_accel
  * computes it, over the lists, with p_j / delta_j^2 computed once per particle into lane 3 of
@@ -236,6 +265,7 @@ static void corrected_velocity(const pfsph_ctx *c, int upd, int divergence, cons
     const pfsph_kernel *k = &c->kern;
     const pfsph_real h2 = k->h * k->h;
     const pfsph_hits_fn hits = pfsph_hits_select();
+    upd = halo_updated(c, upd, divergence, rate, fac, p);
 #pragma omp parallel
     {
         pfsph_hits H; /* grid walks (no lists) */
@@ -400,6 +430,7 @@ static void corrected_walk(const dfsph *D, const pfsph_ctx *c, int upd, int dive
     const pfsph_kernel *k = &c->kern;
     const pfsph_real h2 = k->h * k->h;
     const pfsph_hits_fn hits = pfsph_hits_select();
+    upd = halo_updated(c, upd, divergence, R, fac, p);
 #pragma omp parallel
     {
         pfsph_hits H;
@@ -460,8 +491,8 @@ static inline void velocity_of(const pfsph_particles *f, int kept, pfsph_real dt
 /* density_rate over grid walks, for particles [i0, i1): the rates into R; returns the sum of the
  * compressions as pfsph__sum adds them within one block. */
 static inline double rate_block(const dfsph *D, const pfsph_ctx *c, int divergence, const pfsph_real *const in[3],
-                                const pfsph_real *fac, pfsph_real *R, pfsph_hits *H, pfsph_hits_fn hits, size_t *kb,
-                                size_t i0, size_t i1)
+                                const pfsph_real *fac, pfsph_real *R, pfsph_real *E, pfsph_hits *H, pfsph_hits_fn hits,
+                                size_t *kb, size_t i0, size_t i1)
 {
     const pfsph_particles *f = c->fluid;
     const pfsph_real dt = (pfsph_real)c->dt;
@@ -487,18 +518,22 @@ static inline double rate_block(const dfsph *D, const pfsph_ctx *c, int divergen
         const pfsph_real sb = vxi * bx + vyi * by + vzi * bz - bc;
         R[i] = s + sb * inv_v0;
         double fi, res = residual_of(c, divergence, R, fac, i, &fi);
-        sum += (double)(pfsph_real)(res > 0 ? res / nd0 : 0);
+        const pfsph_real e = (pfsph_real)(res > 0 ? res / nd0 : 0);
+        if (E) E[i] = e;
+        sum += (double)e;
     }
     return sum;
 }
 
-/* All particles' rates; returns the sum of their compressions with pfsph__sum's bits. */
+/* All particles' rates; returns the sum of their compressions with pfsph__sum's bits (a
+ * distributed run: of the whole run's, from each particle's in D->dbuf). */
 static double rate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, const pfsph_real *const in[3],
                         const pfsph_real *fac, pfsph_real *R)
 {
     const size_t n = c->fluid->n, nb = (n + PFSPH_SUM_BLOCK - 1) / PFSPH_SUM_BLOCK;
     const pfsph_hits_fn hits = pfsph_hits_select();
     double *part = D->part;
+    pfsph_real *E = c->dist ? D->dbuf : NULL;
 #pragma omp parallel
     {
         pfsph_hits H;
@@ -507,10 +542,11 @@ static double rate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, cons
         for (size_t b = 0; b < nb; b++) {
             const size_t i0 = b * PFSPH_SUM_BLOCK, i1 = i0 + PFSPH_SUM_BLOCK < n ? i0 + PFSPH_SUM_BLOCK : n;
             /* the two modes as their own loops: the kept velocities or their expression */
-            part[b] = divergence ? rate_block(D, c, 1, in, fac, R, &H, hits, &kb, i0, i1)
-                                 : rate_block(D, c, 0, in, fac, R, &H, hits, &kb, i0, i1);
+            part[b] = divergence ? rate_block(D, c, 1, in, fac, R, E, &H, hits, &kb, i0, i1)
+                                 : rate_block(D, c, 0, in, fac, R, E, &H, hits, &kb, i0, i1);
         }
     }
+    if (E) return pfsph__fluid_sum(c, E);
     double total = 0;
     for (size_t b = 0; b < nb; b++) total += part[b];
     return total;
@@ -522,7 +558,7 @@ static int iterate_walk(const dfsph *D, const pfsph_ctx *c, int divergence, pfsp
                         const pfsph_real *fac, pfsph_real *R, double tol, int min_it, int max_it, double *avg)
 {
     const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay, *ez = divergence ? NULL : c->az;
-    const size_t n = c->fluid->n;
+    const size_t n = pfsph__fluid_count(c);
     const pfsph_real *const in[3] = {io[0], io[1], io[2]};
     for (int it = 0;; it++) {
         corrected_walk(D, c, it > 0, divergence, fac, p, R, ex, ey, ez, io);
@@ -540,13 +576,13 @@ static int iterate(const pfsph_ctx *c, int divergence, pfsph_real *p, pfsph_real
                    double tol, int min_it, int max_it, double *avg)
 {
     const pfsph_real *ex = divergence ? NULL : c->ax, *ey = divergence ? NULL : c->ay, *ez = divergence ? NULL : c->az;
-    const size_t n = c->fluid->n;
+    const size_t n = pfsph__fluid_count(c);
     pfsph_real *const bsum[4] = {scr[BX], scr[BY], scr[BZ], scr[BC]};
     for (int it = 0;; it++) {
         /* from the second pass on, the update of the last residual comes first */
         corrected_velocity(c, it > 0, divergence, scr[RATE], scr[FAC], p, ex, ey, ez, bsum, scr[XQ], ap, scr[V4]);
         density_rate(c, scr[XQ], scr[V4], bsum, scr[RATE], divergence, scr[FAC], scr[ERR]);
-        *avg = n ? pfsph__sum(scr[ERR], n) / (double)n : 0;
+        *avg = n ? pfsph__fluid_sum(c, scr[ERR]) / (double)n : 0; /* the serial sum on any rank count */
         if (it >= max_it || (it >= min_it && *avg <= tol)) return it;
     }
 }
@@ -561,6 +597,12 @@ static int pre_forces(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], 
     pfsph_particles *f = c->fluid;
     const size_t n = f->n;
     out->div_iterations = 0;
+    if (c->dist && D->walk && n > D->dbuf_cap) { /* this step's room for rate_walk's compressions */
+        pfsph_real *q = realloc(D->dbuf, n * sizeof *q);
+        if (!q) return PFSPH_ENOMEM;
+        D->dbuf = q;
+        D->dbuf_cap = n;
+    }
     if (D->walk) {
         pfsph_real *const tmp[4] = {ap[0], ap[1], ap[2], f->rho};
         factors(D, c, scr[W_FAC], tmp, NULL);
