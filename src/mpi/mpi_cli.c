@@ -44,7 +44,7 @@ int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
     if (g_size < 2) return PFSPH_OK;
     const char *no = NULL, *key = NULL;
     const char *solver = pfsph_scene_solver_name(s);
-    if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph") && strcmp(solver, "dfsph"))
+    if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph") && strcmp(solver, "dfsph") && strcmp(solver, "iisph"))
         no = "this solver", key = "$.solver.type";
     else if (s->diffuse.enabled) no = "diffuse particles", key = "$.diffuse";
     else if (s->nbodies) no = "rigid or keyframed bodies", key = "$.bodies";

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "core/dist.h"
 #include "core/reduce.h"
 #include "physics/neighbours.h"
 #include "physics/solver.h"
@@ -212,14 +213,24 @@ static int iterate(const iisph *S, const pfsph_ctx *c, pfsph_real *p, pfsph_real
     const pfsph_kernel *k = &c->kern;
     const pfsph_real h2 = k->h * k->h;
     const pfsph_hits_fn hits = pfsph_hits_select();
+    /* a distributed run: the halo copies of the updated p from their owners before lane 3 is made
+     * of them (a halo particle's own update misses the neighbours beyond the halo); the one
+     * refresh an iteration needs, as in DFSPH (docs/cluster.md, "DFSPH") */
+    const int dist = c->dist != NULL;
     for (int it = 0;; it++) {
+        if (it > 0 && dist) {
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++) p[i] = pn[i];
+            pfsph_real *const a[1] = {p};
+            pfsph__halo(c, a, 1);
+        }
 #pragma omp parallel
         {
             pfsph_hits H; /* grid walks (no lists) */
             if (it > 0) { /* the last pass's update (predict_advection filled lane 3 for the first) */
 #pragma omp for schedule(static)
                 for (size_t i = 0; i < n; i++) {
-                    p[i] = pn[i];
+                    if (!dist) p[i] = pn[i];
                     xq[4 * i + 3] = p[i] / (c->nd[i] * c->nd[i]);
                 }
             }
@@ -244,7 +255,8 @@ static int iterate(const iisph *S, const pfsph_ctx *c, pfsph_real *p, pfsph_real
                 pn[i] = (pfsph_real)(q > 0 ? q : 0);
             }
         }
-        *avg = n ? pfsph__sum(err, n) / (double)n : 0;
+        const size_t nall = pfsph__fluid_count(c);
+        *avg = nall ? pfsph__fluid_sum(c, err) / (double)nall : 0; /* the serial sum on any rank count */
         if (it >= S->max_iter || (it >= S->min_iter && *avg <= S->tol)) return it;
     }
 }
