@@ -23,6 +23,12 @@ static inline double pfsph__fluid_sum(const pfsph_ctx *c, const pfsph_real *a)
     return c->dist ? c->dist->sum(c->dist, a) : pfsph__sum(a, c->fluid->n);
 }
 
+/* k counters of the owned particles summed over the whole run (serial: as they are). */
+static inline void pfsph__count_sum(const pfsph_ctx *c, long *v, int k)
+{
+    if (c->dist) c->dist->count(c->dist, v, k);
+}
+
 /* The halo copies of k per-fluid-particle arrays refreshed from their owners (serial: nothing). */
 static inline void pfsph__halo(const pfsph_ctx *c, pfsph_real *const *a, int k)
 {

@@ -525,6 +525,11 @@ static double sum(pfsph_dist *d, const pfsph_real *a)
     return total;
 }
 
+static void count(pfsph_dist *d, long *v, int k)
+{
+    MPI_Allreduce(MPI_IN_PLACE, v, k, MPI_LONG, MPI_SUM, ((pfsph_decomp *)d)->comm);
+}
+
 /* ---- the stages between the physics' own ---- */
 
 static int halo_pos_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
@@ -737,6 +742,7 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     if (!D->scount || !D->sdispl || !D->rcount || !D->rdispl) return PFSPH_ENOMEM;
     D->d.halo = halo;
     D->d.sum = sum;
+    D->d.count = count;
     D->d.agree = agree;
     D->d.step_begin = step_begin;
     D->d.frame = frame;

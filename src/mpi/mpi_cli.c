@@ -49,7 +49,6 @@ int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
     else if (s->diffuse.enabled) no = "diffuse particles", key = "$.diffuse";
     else if (s->nbodies) no = "rigid or keyframed bodies", key = "$.bodies";
     else if (s->nemitters) no = "emitters", key = "$.emitters";
-    else if (s->film.nbubbles > 0) no = "bubbles in air (film particles)", key = "$.fluid[].bubble";
     else if (g_size > 64) no = "more than 64 ranks", key = "mpirun -np";
     if (!no) return PFSPH_OK;
     return pfsph_fail(err, PFSPH_EINPUT,

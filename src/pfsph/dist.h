@@ -20,6 +20,8 @@ struct pfsph_dist {
     void (*halo)(pfsph_dist *d, pfsph_real *const *a, int k);
     /* pfsph__sum of the global array whose owned part is a[own_lo, own_hi): the same bits */
     double (*sum)(pfsph_dist *d, const pfsph_real *a);
+    /* k counters, each the sum of every rank's (exact: integers) */
+    void (*count)(pfsph_dist *d, long *v, int k);
     /* every rank's status after a stage: the first failure (its message) on all ranks */
     int (*agree)(pfsph_dist *d, int rc, pfsph_error *err);
     /* a step begins (the root tells the other ranks to follow) */

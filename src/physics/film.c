@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "pfsph/surface_detect.h"
 #include "physics/stages.h"
 
@@ -39,8 +40,16 @@ static void detect(pfsph_film *fm, const pfsph_ctx *ctx)
     pfsph_surface_opts o = {.radius = 0, .layers = 1, .group = f->bubble, .boundary = true, .reach = 0};
     pfsph_surface_detect(ctx, &o, fm->layer, NULL);
     for (int k = 0; k < fm->nb; k++) fm->ns[k] = 0;
-    for (size_t i = 0; i < f->n; i++)
+    /* a distributed run: each rank counts the particles it owns, the counts summed over the
+     * ranks (without the sum, tests/data/mpi/double_bubble_2d.json differs from the serial run at
+     * its third frame). The layers need no refresh: the pair forces read the film of particles
+     * within their reach of an owned one, whose detection walks (one grid reach) stay inside
+     * what the rank holds (a walk's reach + 1 cells, src/mpi/decomp.c) */
+    size_t lo, hi;
+    pfsph__owned(ctx, &lo, &hi);
+    for (size_t i = lo; i < hi; i++)
         if (f->bubble[i] && fm->layer[i] == 1) fm->ns[f->bubble[i] - 1]++;
+    pfsph__count_sum(ctx, fm->ns, fm->nb);
 }
 
 int pfsph_film_create(pfsph_film **out, const pfsph_ctx *ctx, pfsph_film_params *fp, const char *source,
