@@ -29,31 +29,6 @@ static inline void pfsph__count_sum(const pfsph_ctx *c, long *v, int k)
     if (c->dist) c->dist->count(c->dist, v, k);
 }
 
-/* Whether this process computes what belongs to the point (x, y, z) (a boundary particle): the
- * rank that owns its grid cell (clamped into the grid), whose held fluid covers the point's
- * walks; always in a serial run. */
-static inline int pfsph__owns_point(const pfsph_ctx *c, pfsph_real x, pfsph_real y, pfsph_real z)
-{
-    if (!c->dist) return 1;
-    const pfsph_grid *g = c->grid;
-    const pfsph_real p[3] = {x, y, z};
-    size_t key = 0, stride = 1;
-    for (int a = 0; a < g->dim; a++) {
-        const pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
-        const int ca = !(t >= 0) ? 0 : t >= (pfsph_real)g->nc[a] ? g->nc[a] - 1 : (int)t;
-        key += (size_t)ca * stride;
-        stride *= (size_t)g->nc[a];
-    }
-    return key >= c->dist->cell_lo && key < c->dist->cell_hi;
-}
-
-/* v[0, n) whose entries each process computed for the points it owns (pfsph__owns_point) and
- * left +0 elsewhere: every entry from the process that computed it (serial: as they are). */
-static inline void pfsph__merge(const pfsph_ctx *c, double *v, size_t n)
-{
-    if (c->dist) c->dist->merge(c->dist, v, n);
-}
-
 /* The halo copies of k per-fluid-particle arrays refreshed from their owners (serial: nothing). */
 static inline void pfsph__halo(const pfsph_ctx *c, pfsph_real *const *a, int k)
 {

@@ -350,42 +350,6 @@ static int scatter_root(pfsph_decomp *D, pfsph_step *st, const uint32_t *key, si
     return PFSPH_OK;
 }
 
-/* A start or a resume with bodies: the root's body states and boundary particles on every rank
- * (a resume restored them from the checkpoint on the root only; the others built theirs from the
- * scene), so that the one body world, which every rank steps with the same merged forces, starts
- * the same everywhere. Every rank keeps every wall with bodies (trim_walls). */
-static int share_bodies(pfsph_decomp *D, pfsph_error *err)
-{
-    pfsph_sim *sim = D->sim;
-    pfsph_bodies *B = sim->st.bodies;
-    pfsph_particles *b = &sim->boundary;
-    const int nb = pfsph_bodies_count(B);
-    pfsph_body_state *s = malloc((size_t)(nb > 0 ? nb : 1) * sizeof *s);
-    uint64_t n = b->n;
-    int bad = !s || grow(D->rank == 0 ? &D->sbuf : &D->rbuf, D->rank == 0 ? &D->scap : &D->rcap, GATHER_RUN * REC);
-    MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, D->comm);
-    if (bad) {
-        free(s);
-        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sharing the bodies");
-    }
-    for (int i = 0; D->rank == 0 && i < nb; i++) pfsph_bodies_get_state(B, i, &s[i]);
-    MPI_Bcast(s, (int)((size_t)nb * sizeof *s), MPI_BYTE, 0, D->comm);
-    for (int i = 0; D->rank > 0 && i < nb; i++) pfsph_bodies_set_state(B, i, &s[i], b);
-    free(s);
-    MPI_Bcast(&n, 1, MPI_UINT64_T, 0, D->comm);
-    if (n != b->n) MPI_Abort(D->comm, 1); /* every rank built the scene's walls and bodies */
-    char *buf = D->rank == 0 ? D->sbuf : D->rbuf;
-    for (size_t o = 0; o < n; o += GATHER_RUN) {
-        const size_t k = n - o < GATHER_RUN ? n - o : GATHER_RUN;
-        for (size_t i = 0; D->rank == 0 && i < k; i++) pack(buf + i * REC, b, NULL, o + i);
-        MPI_Bcast(buf, (int)(k * REC), MPI_BYTE, 0, D->comm);
-        for (size_t i = 0; D->rank > 0 && i < k; i++) unpack(buf + i * REC, b, NULL, o + i);
-    }
-    if (D->rank > 0 && pfsph_grid_sort(&sim->bgrid, b, NULL))
-        return pfsph_fail(err, PFSPH_ENOMEM, "out of memory sorting the shared bodies");
-    return PFSPH_OK;
-}
-
 /* The stage before the grid sort: the particles each rank owned (all on the root after a
  * frame) go to every rank that holds their new cell. Each rank sends its particles in its
  * order, the receivers take them in rank order, so the grid's stable sort then gives them the
@@ -402,11 +366,10 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
         D->gathered = 0;
         share_clock(D, st);
     }
-    int rc;
     if (D->root_all) share_clock(D, st);
-    if (D->root_all && D->sim->st.bodies && (rc = share_bodies(D, err))) return rc;
     size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
     const size_t m = hi - lo, nc = D->ncells;
+    int rc;
     uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
     if (!key) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange's keys");
     D->key = key;
@@ -434,8 +397,6 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     D->d.own_lo = (size_t)(D->gofs[D->rank] - D->lofs[D->rank]);
     D->d.own_hi = (size_t)(D->gofs[D->rank + 1] - D->lofs[D->rank]);
     D->d.nglobal = (size_t)total;
-    D->d.cell_lo = D->cut[D->rank];
-    D->d.cell_hi = D->cut[D->rank + 1];
     D->root_all = 0;
     /* figures */
     const size_t own = D->d.own_hi - D->d.own_lo;
@@ -567,15 +528,6 @@ static double sum(pfsph_dist *d, const pfsph_real *a)
 static void count(pfsph_dist *d, long *v, int k)
 {
     MPI_Allreduce(MPI_IN_PLACE, v, k, MPI_LONG, MPI_SUM, ((pfsph_decomp *)d)->comm);
-}
-
-static void merge(pfsph_dist *d, double *v, size_t n)
-{
-    pfsph_decomp *D = (pfsph_decomp *)d;
-    for (size_t o = 0; o < n; o += (size_t)INT32_MAX) {
-        const size_t k = n - o < (size_t)INT32_MAX ? n - o : (size_t)INT32_MAX;
-        MPI_Allreduce(MPI_IN_PLACE, v + o, (int)k, MPI_DOUBLE, MPI_SUM, D->comm);
-    }
 }
 
 /* ---- the stages between the physics' own ---- */
@@ -791,7 +743,6 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.halo = halo;
     D->d.sum = sum;
     D->d.count = count;
-    D->d.merge = merge;
     D->d.agree = agree;
     D->d.step_begin = step_begin;
     D->d.frame = frame;

@@ -47,6 +47,7 @@ int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
     if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph") && strcmp(solver, "dfsph") && strcmp(solver, "iisph"))
         no = "this solver", key = "$.solver.type";
     else if (s->diffuse.enabled) no = "diffuse particles", key = "$.diffuse";
+    else if (s->nbodies) no = "rigid or keyframed bodies", key = "$.bodies";
     else if (s->nemitters) no = "emitters", key = "$.emitters";
     else if (g_size > 64) no = "more than 64 ranks", key = "mpirun -np";
     if (!no) return PFSPH_OK;

@@ -16,18 +16,12 @@ struct pfsph_dist {
      * then the particles this rank owns, [own_lo, own_hi), then halo copies again. */
     size_t own_lo, own_hi;
     size_t nglobal; /* fluid particles of all ranks */
-    /* the grid cells whose particles this rank owns, [cell_lo, cell_hi) of the serial cell
-     * order; the rank holds every fluid particle within a walk's reach + 1 cells of them */
-    size_t cell_lo, cell_hi;
     /* refresh the halo copies of k per-fluid-particle arrays from their owners */
     void (*halo)(pfsph_dist *d, pfsph_real *const *a, int k);
     /* pfsph__sum of the global array whose owned part is a[own_lo, own_hi): the same bits */
     double (*sum)(pfsph_dist *d, const pfsph_real *a);
     /* k counters, each the sum of every rank's (exact: integers) */
     void (*count)(pfsph_dist *d, long *v, int k);
-    /* n values of which each rank computed its own entries and left the others +0: every rank
-     * gets every entry (x + 0 = x: the computing rank's bits) */
-    void (*merge)(pfsph_dist *d, double *v, size_t n);
     /* every rank's status after a stage: the first failure (its message) on all ranks */
     int (*agree)(pfsph_dist *d, int rc, pfsph_error *err);
     /* a step begins (the root tells the other ranks to follow) */

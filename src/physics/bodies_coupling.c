@@ -7,7 +7,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "core/dist.h"
 #include "physics/bodies_internal.h"
 
 void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsph_real *p)
@@ -34,9 +33,6 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
 #pragma omp parallel for schedule(static)
     for (size_t j = 0; j < nb; j++) {
         if (b->id[j] < first) continue;
-        /* a distributed run: the rank that owns the particle's cell, which holds the fluid its
-         * walks reach (the sums in the serial order); the others leave it +0 for the merge */
-        if (!pfsph__owns_point(ctx, b->x[j], b->y[j], b->z[j])) continue;
         const uint32_t l = b->id[j] - first;
         const pfsph_real xj = b->x[j], yj = b->y[j], zj = b->z[j], vol = b->aux[j];
         double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
@@ -103,10 +99,7 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
         B->fp[3 * l + 1] = fy;
         B->fp[3 * l + 2] = fz;
     }
-    pfsph__merge(ctx, B->fp, 3 * (size_t)B->np);
-    /* sums in id order: the same bits for any thread count, particle order and rank count (the
-     * merge's +0 entries added to the computing rank's leave its bits; a force that is -0 there
-     * turns +0, which adds nothing different to a sum that starts at +0) */
+    /* sums in id order: the same bits for any thread count and particle order */
     for (int i = 0; i < B->nb; i++) {
         body *bd = &B->b[i];
         const dReal *Rm = dBodyGetRotation(bd->id);
