@@ -174,7 +174,9 @@ static const double angle_deg2[] = {180.0, 176.8, 151.4, 132.8, 117.8, 102.7, 83
  * non-wetting end less (151 at r 0.1 where Eq. 21 says 143). r = 0 (no adhesion) is 180 degrees
  * by definition, not measured; beyond r = 0.75 the last segment is extended, but 3D angles
  * below about 50 degrees are not measured: the fit saturates near 50 on thin caps and from r 0.8
- * on the drops spread into a film (docs/pairwise.md). */
+ * on drops of 343-1,000 particles spread into a film; drops of 4,096 stand as caps of 37.5
+ * (centroid) to 44.5 (outline) degrees at r 0.84, and more adhesion spreads their first layer
+ * from under the cap (docs/pairwise.md, "Big drops"). */
 static const double angle_r3[] = {0.0, 0.1, 0.15, 0.2, 0.25, 0.5, 0.75};
 static const double angle_deg3[] = {180.0, 151.1, 138.0, 127.6, 119.2, 82.9, 48.6};
 
