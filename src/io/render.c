@@ -73,7 +73,7 @@ static int render_frame(ctx *x, const pfsph_particles *fluid, const pfsph_partic
      * reads as a surface rather than a lattice with holes (spacing is 2r). */
     const int ssf = x->ss;
     pfsph_cutaway cw;
-    pfsph_cutaway_init(&cw, sc, x->all_walls ? NULL : bnd);
+    pfsph_cutaway_init(&cw, sc, x->all_walls ? NULL : bnd, fluid);
     double range[2] = {0, 1};
     if (bnd &&
         (rc = pfsph__splat_add_set(&x->sp, &x->c, bnd, d2 ? 0.9 * r : r, 1, 1, sc, PFSPH__COLOR_PHASE, 0, ssf, &cw,

@@ -155,9 +155,13 @@ bool pfsph__rcam_project(const cam *c, const double p[3], double rad, pfsph__spl
 
 /* The walls of a tank that face the camera (3D): particles within 5 particle radii of a face of
  * the walls' box on the camera's side, sideways or above (never the floor: "up" is the axis
- * gravity acts along), so that what stands inside the tank shows. Shared with the live viewer,
- * which asks again for every eye position as it orbits. */
-void pfsph_cutaway_init(pfsph_cutaway *cw, const pfsph_scene *s, const pfsph_particles *walls)
+ * gravity acts along), so that what stands inside the tank shows. Only where the walls rise
+ * beside the fluid (some fluid lies lower than the walls' top less the cut): drops standing on
+ * plates, or sauce on a tray, have nothing to look into, and the cut would take the plates away
+ * whole (the interactive wetting scene's five plates). Shared with the live viewer, which asks
+ * again for every eye position as it orbits. */
+void pfsph_cutaway_init(pfsph_cutaway *cw, const pfsph_scene *s, const pfsph_particles *walls,
+                        const pfsph_particles *fluid)
 {
     memset(cw, 0, sizeof *cw);
     cw->up = 1;
@@ -167,12 +171,18 @@ void pfsph_cutaway_init(pfsph_cutaway *cw, const pfsph_scene *s, const pfsph_par
     box_empty(&bb);
     box_add(&bb, walls);
     if (!(bb.lo[0] <= bb.hi[0])) return;
-    cw->on = true;
     cw->m = 5 * r;
     memcpy(cw->lo, bb.lo, sizeof cw->lo);
     memcpy(cw->hi, bb.hi, sizeof cw->hi);
     for (int a = 0; a < 3; a++)
         if (fabs(s->gravity[a]) > fabs(s->gravity[cw->up])) cw->up = a;
+    cw->on = true;
+    if (fluid && fluid->n) {
+        box3 fb;
+        box_empty(&fb);
+        box_add(&fb, fluid);
+        cw->on = fb.lo[cw->up] < bb.hi[cw->up] - cw->m;
+    }
 }
 
 bool pfsph_cutaway_hides(const pfsph_cutaway *cw, const double eye[3], const double p[3])

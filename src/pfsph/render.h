@@ -69,7 +69,8 @@ typedef struct pfsph_cutaway {
     double m;            /* depth of the cut [m] */
     int up;              /* the axis against gravity */
 } pfsph_cutaway;
-void pfsph_cutaway_init(pfsph_cutaway *cw, const struct pfsph_scene *s, const struct pfsph_particles *walls);
+void pfsph_cutaway_init(pfsph_cutaway *cw, const struct pfsph_scene *s, const struct pfsph_particles *walls,
+                        const struct pfsph_particles *fluid);
 bool pfsph_cutaway_hides(const pfsph_cutaway *cw, const double eye[3], const double p[3]);
 
 /* The colour walls of solid phase `phase` are drawn in (render and viewer): the phase's own

@@ -237,7 +237,7 @@ void pfsph_vframe_draw(pfsph_vapp *A)
     /* the renderer's cut-away, asked again for the eye of every frame drawn: orbiting round
      * the tank opens the side the camera is on */
     pfsph_cutaway cw;
-    pfsph_cutaway_init(&cw, sc, A->cut_walls ? &f->walls : NULL);
+    pfsph_cutaway_init(&cw, sc, A->cut_walls ? &f->walls : NULL, &f->fluid);
     if (A->show_walls) n = add_sprites(A, 0, &f->walls, d2 ? 0.9 * r : r, -4 * r, 1, 0, 1, &cw);
     pfsph_vdraw_sprites(A->draw, 1, A->spr, n);
     /* meshes instead of particles where the run has them, as `pfsph render` does */

@@ -476,6 +476,56 @@ static void test_wall_colors(void **state)
     free(s);
 }
 
+/* points on a box's surface (a wall set) or filling it (a fluid), spacing 0.02 */
+static void fill_box(pfsph_particles *ps, const double lo[3], const double hi[3], int shell)
+{
+    for (double x = lo[0]; x <= hi[0] + 1e-9; x += 0.02)
+        for (double y = lo[1]; y <= hi[1] + 1e-9; y += 0.02)
+            for (double z = lo[2]; z <= hi[2] + 1e-9; z += 0.02) {
+                const int edge = fabs(x - lo[0]) < 1e-9 || fabs(x - hi[0]) < 1e-9 || fabs(y - lo[1]) < 1e-9 ||
+                    fabs(z - lo[2]) < 1e-9 || fabs(z - hi[2]) < 1e-9;
+                if (shell && !edge) continue;
+                const pfsph_real p[3] = {(pfsph_real)x, (pfsph_real)y, (pfsph_real)z}, v[3] = {0, 0, 0};
+                assert_true(pfsph_particles_push(ps, p, v, 0) >= 0);
+            }
+}
+
+/* The cut-away of the walls facing the camera: on for a tank the fluid stands in, off for
+ * drops on a plate (it would take the plate away whole), and it hides the near wall of the
+ * tank only */
+static void test_cutaway(void **state)
+{
+    (void)state;
+    pfsph_scene *s = calloc(1, sizeof *s);
+    s->dim = 3;
+    s->particle_radius = 0.01;
+    s->gravity[1] = -9.81;
+    pfsph_particles walls, fluid;
+    assert_int_equal(pfsph_particles_init(&walls, 64), 0);
+    assert_int_equal(pfsph_particles_init(&fluid, 64), 0);
+    const double tlo[3] = {0, 0, 0}, thi[3] = {1, 0.5, 0.5}, flo[3] = {0.1, 0.04, 0.1}, fhi[3] = {0.4, 0.3, 0.4};
+    fill_box(&walls, tlo, thi, 1); /* an open tank: floor and four sides */
+    fill_box(&fluid, flo, fhi, 0);
+    pfsph_cutaway cw;
+    pfsph_cutaway_init(&cw, s, &walls, &fluid);
+    assert_true(cw.on);
+    const double eye[3] = {0.5, 1.5, 3.0}, near[3] = {0.5, 0.25, 0.5}, far[3] = {0.5, 0.25, 0.0};
+    assert_true(pfsph_cutaway_hides(&cw, eye, near));
+    assert_false(pfsph_cutaway_hides(&cw, eye, far));
+    /* a plate with a drop on it */
+    walls.n = fluid.n = 0;
+    const double plo[3] = {0, 0, 0}, phi[3] = {0.6, 0.04, 0.6}, dlo[3] = {0.2, 0.06, 0.2}, dhi[3] = {0.4, 0.2, 0.4};
+    fill_box(&walls, plo, phi, 0);
+    fill_box(&fluid, dlo, dhi, 0);
+    pfsph_cutaway_init(&cw, s, &walls, &fluid);
+    assert_false(cw.on);
+    const double top[3] = {0.3, 0.04, 0.6};
+    assert_false(pfsph_cutaway_hides(&cw, eye, top));
+    pfsph_particles_free(&walls);
+    pfsph_particles_free(&fluid);
+    free(s);
+}
+
 int main(int argc, char **argv)
 {
     tu_init(argc, argv);
@@ -484,6 +534,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_render_wall_color),
         cmocka_unit_test(test_render_key),
         cmocka_unit_test(test_wall_colors),
+        cmocka_unit_test(test_cutaway),
         cmocka_unit_test(test_render_3d_default_camera),
         cmocka_unit_test(test_render_3d_scene_camera),
         cmocka_unit_test(test_render_errors),
