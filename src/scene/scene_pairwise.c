@@ -185,8 +185,9 @@ static bool is_solid(const pfsph_scene *s, int a) { return s->phases[a].kind == 
  * Eq. 13's lambda times the factor of the tension at the pair's temperature, fab[a][b].
  * Coefficients the scene gave are kept. */
 static int convert_targets(pfsph_scene *s, double lam, const double (*fab)[PFSPH_MAX_PHASES], double theta,
-                           const double *rho, pfsph_error *err)
+                           const double *rho, pfsph_error *err, bool *over)
 {
+    *over = false;
     pfsph_pairwise_params *pp = &s->pairwise;
     const int np = s->nphases;
     /* 1. Cohesion from a surface tension against the (unsimulated) air: Eq. 13 with
@@ -214,13 +215,16 @@ static int convert_targets(pfsph_scene *s, double lam, const double (*fab)[PFSPH
             const double lam_t = fab[a][b] * lam;
             double self = pp->c[a][a] * rho[a] * rho[a] + pp->c[b][b] * rho[b] * rho[b];
             double cab = (self - pp->sigma[a][b] / lam_t) / (2.0 * rho[a] * rho[b]);
-            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]))
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
-                                  "more than their cohesions give with c = 0 (at most %g N/m); "
-                                  "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
-                                  pp->sigma[a][b], s->phases[a].name, s->phases[b].name, lam_t * self,
-                                  s->phases[a].name, s->phases[b].name);
+            /* beyond the c_ab = 0 limit: reported by the caller if it holds at the factors'
+             * fixed point (an earlier pass's factors may put a target at the limit beyond it) */
+            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]) && !*over)
+                *over = true,
+                pfsph_fail(err, PFSPH_EINPUT,
+                           "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
+                           "more than their cohesions give with c = 0 (at most %g N/m); "
+                           "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
+                           pp->sigma[a][b], s->phases[a].name, s->phases[b].name, lam_t * self, s->phases[a].name,
+                           s->phases[b].name);
             pp->c[a][b] = pp->c[b][a] = cab > 0 ? cab : 0.0;
         }
     /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. It is
@@ -287,7 +291,9 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
     for (int a = 0; a < np; a++)
         for (int b = 0; b < np; b++) fab[a][b] = f;
     for (int it = 0; it < 32; it++) {
-        int rc = convert_targets(s, lam, (const double(*)[PFSPH_MAX_PHASES])fab, theta, rho, err);
+        bool over;
+        int rc = convert_targets(s, lam, (const double(*)[PFSPH_MAX_PHASES])fab, theta, rho, err, &over);
+        if (!rc && over && it == 31) rc = PFSPH_EINPUT;
         if (rc) { /* "pairwise: ..." names the phases: add the file and the block's path */
             char msg[sizeof err->msg];
             snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
@@ -322,6 +328,11 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
                 fab[a][b] = fab[b][a] = tab > 0 ? pfsph_pairwise_sigma_factor(s->dim, tab) : f;
                 if (!(fabs(fab[a][b] - fo) <= 1e-12 * fab[a][b])) done = false;
             }
+        if (done && over) { /* a target beyond the c_ab = 0 limit at the fixed point */
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.pairwise: %s", s->source, msg);
+        }
         if (done) break;
     }
     for (int a = 0; a < np; a++)
