@@ -217,14 +217,15 @@ static int convert_targets(pfsph_scene *s, double lam, const double (*fab)[PFSPH
             double cab = (self - pp->sigma[a][b] / lam_t) / (2.0 * rho[a] * rho[b]);
             /* beyond the c_ab = 0 limit: reported by the caller if it holds at the factors'
              * fixed point (an earlier pass's factors may put a target at the limit beyond it) */
-            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]) && !*over)
-                *over = true,
+            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]) && !*over) {
+                *over = true;
                 pfsph_fail(err, PFSPH_EINPUT,
                            "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
                            "more than their cohesions give with c = 0 (at most %g N/m); "
                            "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
                            pp->sigma[a][b], s->phases[a].name, s->phases[b].name, lam_t * self, s->phases[a].name,
                            s->phases[b].name);
+            }
             pp->c[a][b] = pp->c[b][a] = cab > 0 ? cab : 0.0;
         }
     /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. It is
