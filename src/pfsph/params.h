@@ -109,6 +109,10 @@ typedef struct pfsph_pairwise_params {
     double lambda;       /* Eq. 13 constant for the cosine force [m^(dim+2)] */
     double theta;        /* reduced temperature kT / (sigma_ref d^(dim-1)); 0: thermostat off */
     double sigma_factor; /* measured tension / Eq. 13 at theta (pfsph_pairwise_sigma_factor) */
+    /* the same for each fluid pair at its own reduced temperature theta_ab = kT_ab /
+     * (sigma13_ab d^(dim-1)), kT_ab the pair's (the colder phase's) temperature; the factor its
+     * tension target was converted with (solid pairs: sigma_factor) */
+    double sigma_factor_ab[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     /* Viscosity correction (docs/viscosity.md): the hot pair-force liquid flows with more than the
      * Morris viscosity it is given. 3D: measured wall-free as nu_eff(nu_morris)
      * (pfsph_pairwise_visc_eff); with `viscosity_correction` on (the default in a 3D "pairwise"

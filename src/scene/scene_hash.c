@@ -152,6 +152,7 @@ TABLE(thermo_table, THERMO);
     X(S, shift) X(S, thermo) X(M, c, c_stated) X(A, c_set) X(A, sigma_set) X(A, sigma)              \
     X(A, angle_set) X(A, angle_deg)                                                                 \
     X(O, resolved) X(O, radius) X(O, lambda) X(O, theta) X(O, sigma_factor) /* derived (resolve) */ \
+    X(OA, sigma_factor_ab) /* derived (resolve) */                                                  \
     X(F, visc_correct)                                                                              \
     X(OA, nu_morris) X(OA, nu_struct) X(OA, nu_floor) /* derived (resolve) */
 TABLE(pairwise_table, PAIRWISE);

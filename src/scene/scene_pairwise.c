@@ -181,10 +181,13 @@ pfsph_real pfsph_pairwise_radius(const pfsph_scene *s, pfsph_real h)
 
 static bool is_solid(const pfsph_scene *s, int a) { return s->phases[a].kind == PFSPH_PHASE_SOLID; }
 
-/* Steps 1-3 of the conversion: targets -> coefficients with the tension constant lam_t (Eq. 13's
- * lambda times the factor of the tension at temperature). Coefficients the scene gave are kept. */
-static int convert_targets(pfsph_scene *s, double lam_t, double theta, const double *rho, pfsph_error *err)
+/* Steps 1-3 of the conversion: targets -> coefficients with the tension constant of each pair,
+ * Eq. 13's lambda times the factor of the tension at the pair's temperature, fab[a][b].
+ * Coefficients the scene gave are kept. */
+static int convert_targets(pfsph_scene *s, double lam, const double (*fab)[PFSPH_MAX_PHASES], double theta,
+                           const double *rho, pfsph_error *err, bool *over)
 {
+    *over = false;
     pfsph_pairwise_params *pp = &s->pairwise;
     const int np = s->nphases;
     /* 1. Cohesion from a surface tension against the (unsimulated) air: Eq. 13 with
@@ -196,6 +199,7 @@ static int convert_targets(pfsph_scene *s, double lam_t, double theta, const dou
                               "pairwise: surface tension target on phase \"%s\" needs a fluid "
                               "phase with rest_density > 0",
                               s->phases[a].name);
+        const double lam_t = fab[a][a] * lam;
         pp->c[a][a] = pp->sigma[a][a] / (lam_t * rho[a] * rho[a]);
     }
     /* 2. Interfacial tension between two fluids: Eq. 13 solved for c_ab. */
@@ -208,15 +212,20 @@ static int convert_targets(pfsph_scene *s, double lam_t, double theta, const dou
                                   "must be fluid phases with rest_density > 0 (use "
                                   "contact_angle for a solid)",
                                   s->phases[a].name, s->phases[b].name);
+            const double lam_t = fab[a][b] * lam;
             double self = pp->c[a][a] * rho[a] * rho[a] + pp->c[b][b] * rho[b] * rho[b];
             double cab = (self - pp->sigma[a][b] / lam_t) / (2.0 * rho[a] * rho[b]);
-            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]))
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
-                                  "more than their cohesions give with c = 0 (at most %g N/m); "
-                                  "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
-                                  pp->sigma[a][b], s->phases[a].name, s->phases[b].name, lam_t * self,
-                                  s->phases[a].name, s->phases[b].name);
+            /* beyond the c_ab = 0 limit: reported by the caller if it holds at the factors'
+             * fixed point (an earlier pass's factors may put a target at the limit beyond it) */
+            if (cab < -1e-9 * self / (2.0 * rho[a] * rho[b]) && !*over) {
+                *over = true;
+                pfsph_fail(err, PFSPH_EINPUT,
+                           "pairwise: surface tension %g N/m between \"%s\" and \"%s\" is "
+                           "more than their cohesions give with c = 0 (at most %g N/m); "
+                           "raise the cohesion c (or sigma) of \"%s\" or \"%s\"",
+                           pp->sigma[a][b], s->phases[a].name, s->phases[b].name, lam_t * self, s->phases[a].name,
+                           s->phases[b].name);
+            }
             pp->c[a][b] = pp->c[b][a] = cab > 0 ? cab : 0.0;
         }
     /* 3. Static contact angle of a fluid on a solid: Eq. 21 with cbar = n m c = rho c. It is
@@ -270,13 +279,22 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
 
     /* The tension at temperature is f(theta) lambda c rho^2 (docs/thermostat.md), so a target
      * sigma asks for c = sigma / (f lambda rho^2). theta = kT / (sigma_ref d^(dim-1)) with
-     * sigma_ref the largest Eq. 13 liquid-air tension of the coefficients: with the reduced
-     * temperature given, theta is known and one pass settles f; with kT given, theta depends
-     * on c and c on f(theta), a fixed point that a few passes reach (f varies slowly). */
+     * sigma_ref the largest Eq. 13 liquid-air tension of the coefficients. Each pair runs at its
+     * own temperature (thermostat.c: phase a at kT rho_a / rho_ref, a pair at the colder of its
+     * two phases), and its interface's reduced temperature compares that with its own Eq. 13
+     * tension: theta_ab = kT_ab / (sigma13_ab d^(dim-1)) (docs/viscosity.md, "A tension factor
+     * per phase pair"); for the reference liquid against air that is theta itself. theta_ab
+     * depends on c and c on f(theta_ab): a fixed point that a few passes reach (f varies slowly;
+     * with the reduced temperature given and one liquid, one pass settles it). */
     double theta = tp->enabled && tp->kT < 0 ? tp->reduced : 0.0;
     double f = pfsph_pairwise_sigma_factor(s->dim, theta);
-    for (int it = 0; it < 16; it++) {
-        int rc = convert_targets(s, f * lam, theta, rho, err);
+    double(*fab)[PFSPH_MAX_PHASES] = pp->sigma_factor_ab;
+    for (int a = 0; a < np; a++)
+        for (int b = 0; b < np; b++) fab[a][b] = f;
+    for (int it = 0; it < 32; it++) {
+        bool over;
+        int rc = convert_targets(s, lam, (const double(*)[PFSPH_MAX_PHASES])fab, theta, rho, err, &over);
+        if (!rc && over && it == 31) rc = PFSPH_EINPUT;
         if (rc) { /* "pairwise: ..." names the phases: add the file and the block's path */
             char msg[sizeof err->msg];
             snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
@@ -293,9 +311,29 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
             : tp->kT >= 0              ? (tp->sigma_ref > 0 ? tp->kT / (tp->sigma_ref * dd) : 0.0)
                                        : tp->reduced;
         const double fn = pfsph_pairwise_sigma_factor(s->dim, tn);
-        const bool done = fabs(fn - f) <= 1e-12 * fn && fabs(tn - theta) <= 1e-12 * tn;
+        bool done = fabs(fn - f) <= 1e-12 * fn && fabs(tn - theta) <= 1e-12 * tn;
         f = fn;
         theta = tn;
+        /* each fluid pair's factor: theta_ab = theta (kT_ab / kT) (sigma_ref / sigma13_ab), written
+         * so that the reference liquid's own pair gets theta bit for bit */
+        for (int a = 0; a < np; a++)
+            for (int b = a; b < np; b++) {
+                if (is_solid(s, a) || is_solid(s, b) || !(rho[a] > 0) || !(rho[b] > 0)) continue;
+                const double s13 = a == b ? lam * pp->c[a][a] * rho[a] * rho[a]
+                                          : lam *
+                        (pp->c[a][a] * rho[a] * rho[a] + pp->c[b][b] * rho[b] * rho[b] -
+                         2.0 * pp->c[a][b] * rho[a] * rho[b]);
+                const double ts = tp->rho_ref > 0 ? fmin(rho[a], rho[b]) / tp->rho_ref : 1.0;
+                const double tab = theta > 0 && s13 > 0 ? theta * ts * (tp->sigma_ref / s13) : 0.0;
+                const double fo = fab[a][b];
+                fab[a][b] = fab[b][a] = tab > 0 ? pfsph_pairwise_sigma_factor(s->dim, tab) : f;
+                if (!(fabs(fab[a][b] - fo) <= 1e-12 * fab[a][b])) done = false;
+            }
+        if (done && over) { /* a target beyond the c_ab = 0 limit at the fixed point */
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.pairwise: %s", s->source, msg);
+        }
         if (done) break;
     }
     for (int a = 0; a < np; a++)
@@ -489,7 +527,6 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
     if (!pp->resolved) return;
     /* what the liquid is expected to do at its temperature: Eq. 13's tension times the
      * measured factor f(theta) (docs/thermostat.md) */
-    double lam = pp->lambda * pp->sigma_factor;
     if (!s->pairwise.thermo.enabled)
         fprintf(out,
                 "  expected tensions: Eq. 13 (thermostat off: the liquid freezes, and a frozen "
@@ -497,7 +534,7 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
     else
         fprintf(out,
                 "  expected tensions at theta = %.4g: Eq. 13 x %.3f (measured %dD factor at "
-                "temperature, docs/thermostat.md)%s\n",
+                "temperature, docs/thermostat.md; other pairs at their own temperature)%s\n",
                 pp->theta, pp->sigma_factor, s->dim,
                 pp->theta > pfsph_pairwise_sigma_theta_max(s->dim) ? "; theta beyond the measured table: "
                                                                      "its last value is used"
@@ -507,7 +544,7 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
         double ra = s->phases[a].rest_density;
         if (pp->c[a][a] > 0)
             fprintf(out, "  predicted: sigma(%s, air) = %.5g N/m (Eq. 16 with c_air = 0)\n", s->phases[a].name,
-                    lam * pp->c[a][a] * ra * ra);
+                    pp->sigma_factor_ab[a][a] * pp->lambda * pp->c[a][a] * ra * ra);
         for (int b = a + 1; b < np; b++) {
             double rb = s->phases[b].rest_density;
             if (s->phases[b].kind == PFSPH_PHASE_SOLID) {
@@ -521,10 +558,12 @@ void pfsph_pairwise_report(const pfsph_scene *s, FILE *out)
                 fprintf(out, "  predicted: contact angle of %s on %s = %.1f deg%s (%s)\n", s->phases[a].name,
                         s->phases[b].name, ang, note, table ? "measured at temperature, docs/pairwise.md" : "Eq. 21");
             } else {
-                double sg = lam * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb - 2.0 * pp->c[a][b] * ra * rb);
+                const double lab = pp->sigma_factor_ab[a][b] * pp->lambda;
+                double sg = lab * (pp->c[a][a] * ra * ra + pp->c[b][b] * rb * rb - 2.0 * pp->c[a][b] * ra * rb);
                 if (pp->c[a][a] > 0 || pp->c[b][b] > 0 || pp->c[a][b] > 0)
-                    fprintf(out, "  predicted: sigma(%s, %s) = %.5g N/m (Eq. 13)%s\n", s->phases[a].name,
-                            s->phases[b].name, sg, sg < 0 ? " -- negative: the fluids mix" : "");
+                    fprintf(out, "  predicted: sigma(%s, %s) = %.5g N/m (Eq. 13 x %.3f)%s\n", s->phases[a].name,
+                            s->phases[b].name, sg, pp->sigma_factor_ab[a][b],
+                            sg < 0 ? " -- negative: the fluids mix" : "");
             }
         }
     }

@@ -119,9 +119,16 @@ static void test_resolve(void **state)
         assert_true(fs > 0.5 && fs < 1.5 && fs != 1.0);
         /* Eq. 13 with c_air = 0: sigma = f lambda c rho^2 */
         assert_true(fabs(fs * lam * pp->c[0][0] * 1e6 - 0.0728) < 1e-12);
-        /* Eq. 13 for the pair: recompute sigma from the coefficients */
-        double sg = fs * lam * (pp->c[0][0] * 1e6 + pp->c[1][1] * 640000.0 - 2 * pp->c[0][1] * 800000.0);
-        assert_true(fabs(sg - 0.05) < 1e-12);
+        /* the reference liquid's own pair gets the scene's factor bit for bit */
+        assert_true(pp->sigma_factor_ab[0][0] == fs);
+        /* Eq. 13 for the pair, times the factor at the pair's own temperature (the oil's,
+         * kT 800 / 1000, against the pair's Eq. 13 tension): recompute sigma from the
+         * coefficients */
+        const double s13 = lam * (pp->c[0][0] * 1e6 + pp->c[1][1] * 640000.0 - 2 * pp->c[0][1] * 800000.0);
+        const double f01 = pp->sigma_factor_ab[0][1];
+        assert_true(pp->sigma_factor_ab[1][0] == f01);
+        assert_true(fabs(f01 - pfsph_pairwise_sigma_factor(dim, pp->theta * 0.8 * pp->thermo.sigma_ref / s13)) < 1e-9);
+        assert_true(fabs(f01 * s13 - 0.05) < 1e-9);
         assert_true(pp->c[1][0] == pp->c[0][1] && pp->c[0][1] > 0);
         /* the adhesion ratio r = c_wa rho_wall / (c_aa rho_water): the measured table at
          * temperature of the dimension (Eq. 21, cos 60 = 2 r - 1, where there is none) */
@@ -144,6 +151,68 @@ static void test_resolve(void **state)
         assert_non_null(strstr(buf, "target: sigma(water, water) = 0.0728"));
         assert_non_null(strstr(buf, "predicted: contact angle of water on wall = 60.0 deg"));
         assert_non_null(strstr(buf, "predicted: sigma(water, oil) = 0.05 N/m"));
+        free(s);
+    }
+}
+
+/* A tension factor per phase pair (docs/viscosity.md, "A tension factor per phase pair"): each
+ * pair's target is converted with f at the pair's own reduced temperature, theta_ab = kT_ab /
+ * (sigma13_ab d^(dim-1)), kT_ab the colder phase's temperature (kT rho / rho_ref, thermostat.c)
+ * and sigma13_ab the pair's Eq. 13 tension. Hysing's case 1 in 2D at theta 0.04: water (1000,
+ * 24.5 N/m against air), gas (100, 0.245), water-gas 24.5. The water-gas pair runs at a tenth of
+ * the water's kT against nearly the water's tension: theta_wg ~ 0.0052, f ~ 1.00, where the
+ * water against air has f(0.04) = 0.764; the gas against air (0.245 N/m at a tenth of kT) is
+ * far hotter, beyond the table (its last value). With the thermostat off every factor is 1. */
+static void test_pair_factors(void **state)
+{
+    (void)state;
+    for (int mode = 0; mode < 3; mode++) { /* theta 0.04, 0.01, thermostat off */
+        pfsph_scene *s = make_scene(2);
+        pfsph_pairwise_params *pp = &s->pairwise;
+        s->phases[3].rest_density = 100;
+        set_sigma(s, 0, 0, 24.5);
+        set_sigma(s, 3, 3, 0.245);
+        set_sigma(s, 0, 3, 24.5);
+        if (mode == 0) pp->thermo.reduced = 0.04;
+        if (mode == 1) pp->thermo.reduced = 0.01;
+        if (mode == 2) pp->thermo.enabled = false;
+        pfsph_error err = {0};
+        const double d = 0.03125;
+        assert_int_equal(pfsph_pairwise_resolve(s, (pfsph_real)d, (pfsph_real)(2 * d), &err), PFSPH_OK);
+        const double lam = pp->lambda, rw = 1000, rg = 100;
+        const double sw = lam * pp->c[0][0] * rw * rw, sgg = lam * pp->c[3][3] * rg * rg;
+        const double swg = lam * (pp->c[0][0] * rw * rw + pp->c[3][3] * rg * rg - 2 * pp->c[0][3] * rw * rg);
+        const double fw = pp->sigma_factor_ab[0][0], fg = pp->sigma_factor_ab[3][3], fwg = pp->sigma_factor_ab[0][3];
+        print_message("theta %g: f water %.4f gas %.4f water-gas %.4f; Eq. 13 tensions %.4g %.4g %.4g\n", pp->theta, fw,
+                      fg, fwg, sw, sgg, swg);
+        /* each target is met at its own factor */
+        assert_true(fabs(fw * sw - 24.5) < 1e-9 * 24.5);
+        assert_true(fabs(fg * sgg - 0.245) < 1e-9 * 24.5);
+        assert_true(fabs(fwg * swg - 24.5) < 1e-9 * 24.5);
+        assert_true(pp->thermo.rho_ref == rw && pp->thermo.sigma_ref == sw);
+        if (mode == 2) {
+            assert_true(fw == 1.0 && fg == 1.0 && fwg == 1.0);
+            free(s);
+            continue;
+        }
+        /* the water is the reference: its factor is the scene's, at the scene's theta */
+        assert_true(pp->theta == pp->thermo.reduced);
+        assert_true(fw == pfsph_pairwise_sigma_factor(2, pp->theta) && fw == pp->sigma_factor);
+        /* the other pairs at their own temperatures: kT = theta sigma_ref d, the gas's a tenth */
+        const double kT = pp->thermo.kT_resolved;
+        assert_true(fabs(kT - pp->theta * sw * d) < 1e-12 * kT);
+        const double twg = 0.1 * kT / (swg * d), tg = 0.1 * kT / (sgg * d);
+        assert_true(fabs(fwg - pfsph_pairwise_sigma_factor(2, twg)) < 1e-9);
+        assert_true(fabs(fg - pfsph_pairwise_sigma_factor(2, tg)) < 1e-9);
+        /* theta_wg = theta / 10 x sigma_ref / sigma13_wg = theta / 10 x f_wg / f_w */
+        assert_true(fabs(twg - 0.1 * pp->theta * fwg / fw) < 1e-9 * twg);
+        if (mode == 0) {
+            /* the pair is cold (f within 1 % of Eq. 13's), the water hot (0.764); the gas's
+             * theta, 0.1 x 0.04 x 32 / 0.3 ~ 0.4, is beyond the table */
+            assert_true(fabs(fw - 0.764) < 1e-12 && fwg > 0.99 && fwg < 1.01);
+            assert_true(tg > pfsph_pairwise_sigma_theta_max(2) &&
+                        fg == pfsph_pairwise_sigma_factor(2, pfsph_pairwise_sigma_theta_max(2)));
+        }
         free(s);
     }
 }
@@ -192,8 +261,14 @@ static void test_resolve_errors(void **state)
     assert_int_equal(pfsph_pairwise_resolve(s, 0.01f, 0.02f, &err), PFSPH_EINPUT);
     print_message("%s\n", err.msg);
     assert_non_null(strstr(err.msg, "at most 0.09"));
-    /* exactly the c = 0 limit is fine */
-    s->pairwise.sigma[0][1] = s->pairwise.sigma[1][0] = 0.09;
+    /* exactly the c = 0 limit is fine: the pair's Eq. 13 tension with c_ab = 0 times the factor
+     * at the pair's temperature there (the oil's kT, 800 / 1000 of the water's) */
+    s->pairwise.sigma[0][1] = s->pairwise.sigma[1][0] = 0.05;
+    assert_int_equal(pfsph_pairwise_resolve(s, 0.01f, 0.02f, &err), PFSPH_OK);
+    const pfsph_pairwise_params *pp = &s->pairwise;
+    const double s0 = pp->lambda * (pp->c[0][0] * 1e6 + pp->c[1][1] * 640000.0);
+    s->pairwise.sigma[0][1] = s->pairwise.sigma[1][0] =
+        s0 * pfsph_pairwise_sigma_factor(2, pp->theta * 0.8 * pp->thermo.sigma_ref / s0);
     assert_int_equal(pfsph_pairwise_resolve(s, 0.01f, 0.02f, &err), PFSPH_OK);
     assert_true(s->pairwise.c[0][1] < 1e-6 * s->pairwise.c[0][0]);
     free(s);
@@ -426,6 +501,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_lambda),
         cmocka_unit_test(test_resolve),
         cmocka_unit_test(test_resolve_errors),
+        cmocka_unit_test(test_pair_factors),
         cmocka_unit_test(test_temperature_tables),
         cmocka_unit_test(test_viscosity_correction),
         cmocka_unit_test(test_viscosity_bulk_3d),

@@ -41,7 +41,7 @@
  * Writes validation/hysing_case{1,2}.csv (t, yc, vy, circularity) in the working directory for
  * tools/validation_plots.py. Under AddressSanitizer it skips (tu_release_only).
  * Study knobs: PF_N (particles per diameter, 16), PF_CASES ("1,2"), PF_PW (pairwise text),
- * PF_SOLVER (both cases' solver text), PF_T (end, 3 s), PF_SWG (factor on the water-gas tension, 1). */
+ * PF_SOLVER (both cases' solver text), PF_T (end, 3 s), PF_SWG (factor on the water-gas tension, 1), PF_SEED (the scene's seed). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -58,7 +58,7 @@ enum { WATER = 0, GAS = 1, NMAX = 128, SMOOTH = 5 };
 static const char *SCENE =
     "{\"dimension\": 2, \"particle_radius\": %.10g, \"gravity\": [0, -0.98],"
     " \"domain\": {\"min\": [%.10g, %.10g], \"max\": [%.10g, %.10g]},"
-    " \"solver\": {\"type\": \"%s\"}, \"time\": {\"end\": 3, \"fps\": 20},"
+    " \"solver\": {\"type\": \"%s\"}, %s \"time\": {\"end\": 3, \"fps\": 20},"
     " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": 0.01},"
     "   {\"name\": \"gas\", \"kind\": \"gas\", \"rest_density\": %g, \"viscosity\": %g},"
     "   {\"name\": \"wall\", \"kind\": \"solid\"}],"
@@ -93,10 +93,11 @@ static void run_case(int cs, int n, series *r)
 {
     const hysing_ref *h = &REF[cs - 1];
     const double d = 0.5 / n, w = 3 * d;
-    char json[8192];
+    char json[8192], seed[64] = "";
+    if (getenv("PF_SEED")) snprintf(seed, sizeof seed, "\"seed\": %d,", (int)tu_env_num("PF_SEED", 0));
     snprintf(json, sizeof json, SCENE, 0.5 * d, -w - d, -w - d, 1 + w + d, 2 + w + d,
-             tu_env("PF_SOLVER", cs == 1 ? "pcisph" : "wcsph\", \"pressure_scale\": \"common"), h->rho_g, h->nu_g, -w,
-             -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma,
+             tu_env("PF_SOLVER", cs == 1 ? "pcisph" : "wcsph\", \"pressure_scale\": \"common"), seed, h->rho_g, h->nu_g,
+             -w, -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma,
              h->sigma * tu_env_num("PF_SWG", 1));
     pfsph_sim *sim = tu_sim_from_json(json, "hysing case");
     pfsph_error err = {0};
