@@ -4,6 +4,7 @@
 #include "view/draw.h"
 
 #include <epoxy/gl.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +22,9 @@ struct pfsph_vmesh {
 };
 
 struct pfsph_vdraw {
-    GLuint sprite_prog, comp_prog, over_prog, mesh_prog;
+    GLuint sprite_prog, over_prog, mesh_prog;
+    GLuint comp_prog[2][2]; /* [samples per axis - 1][walls' layer used] */
+    bool used[2];           /* the layers drawn into since begin */
     GLuint quad_vbo, inst_vbo, sprite_vao, empty_vao, over_vbo, over_vao;
     layer L[2];
     GLuint final_fbo, final_col;
@@ -125,29 +128,36 @@ static const char *COMP_VS = "#version 330 core\n"
                              "  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
                              "}\n";
 
-static const char *COMP_FS = "#version 330 core\n"
-                             "uniform sampler2D c0, z0, c1, z1;\n"
+/* The composite, compiled for each case (SS samples per pixel along each axis; WALLS: the
+ * walls' layer has something in it). One general shader with a loop bound and the walls' fetches
+ * taken at run time cost llvmpipe about 8 ms of CPU a 640x360 frame, more than the fluid's
+ * sprites (docs/viewer.md, "What a frame costs"): constant bounds unroll, and a frame without
+ * walls reads one texture instead of four. */
+static const char *COMP_FS = "uniform sampler2D c0, z0, c1, z1;\n"
                              "uniform float afront, aback;\n"
-                             "uniform int height, ss;\n"
+                             "uniform int height;\n"
                              "out vec4 o;\n"
                              "void main() {\n"
                              "  vec3 acc = vec3(0.0);\n"
-                             /* each output pixel averages ss x ss samples, each composited as the renderer does */
-                             "  for (int sy = 0; sy < ss; sy++)\n"
-                             "    for (int sx = 0; sx < ss; sx++) {\n"
-                             "      ivec2 p = ivec2(gl_FragCoord.xy) * ss + ivec2(sx, sy);\n"
-                             "      vec4 f = texelFetch(c0, p, 0), b = texelFetch(c1, p, 0);\n"
+                             /* each output pixel averages SS x SS samples, each composited as the renderer does */
+                             "  for (int sy = 0; sy < SS; sy++)\n"
+                             "    for (int sx = 0; sx < SS; sx++) {\n"
+                             "      ivec2 p = ivec2(gl_FragCoord.xy) * SS + ivec2(sx, sy);\n"
+                             "      vec4 f = texelFetch(c0, p, 0);\n"
                              "      float t = height > 1 ? float(height - 1 - p.y) / float(height - 1) : 0.0;\n"
                              "      vec3 bg = mix(vec3(0.945, 0.950, 0.965), vec3(0.840, 0.850, 0.875), t);\n"
                              "      vec3 c = f.a > 0.5 ? f.rgb : bg;\n"
+                             "#if WALLS\n"
+                             "      vec4 b = texelFetch(c1, p, 0);\n"
                              "      if (b.a > 0.5) {\n"
                              "        float zf = texelFetch(z0, p, 0).r, zb = texelFetch(z1, p, 0).r;\n"
                              "        float a = f.a < 0.5 ? aback : (zb < zf ? afront : 0.0);\n"
                              "        c = mix(c, b.rgb, a);\n"
                              "      }\n"
+                             "#endif\n"
                              "      acc += c;\n"
                              "    }\n"
-                             "  o = vec4(acc / float(ss * ss), 1.0);\n"
+                             "  o = vec4(acc / float(SS * SS), 1.0);\n"
                              "}\n";
 
 static const char *OVER_VS = "#version 330 core\n"
@@ -217,8 +227,13 @@ pfsph_vdraw *pfsph_vdraw_create(char *msg, size_t cap)
         return NULL;
     }
     d->sprite_prog = program(SPRITE_VS, SPRITE_FS, msg, cap);
-    d->comp_prog = d->sprite_prog ? program(COMP_VS, COMP_FS, msg, cap) : 0;
-    d->over_prog = d->comp_prog ? program(OVER_VS, OVER_FS, msg, cap) : 0;
+    bool ok = d->sprite_prog != 0;
+    for (int k = 0; k < 4 && ok; k++) {
+        char src[2048];
+        snprintf(src, sizeof src, "#version 330 core\n#define SS %d\n#define WALLS %d\n%s", k / 2 + 1, k % 2, COMP_FS);
+        ok = (d->comp_prog[k / 2][k % 2] = program(COMP_VS, src, msg, cap)) != 0;
+    }
+    d->over_prog = ok ? program(OVER_VS, OVER_FS, msg, cap) : 0;
     d->mesh_prog = d->over_prog ? program(MESH_VS, MESH_FS, msg, cap) : 0;
     if (!d->mesh_prog) {
         pfsph_vdraw_destroy(d);
@@ -276,7 +291,8 @@ void pfsph_vdraw_destroy(pfsph_vdraw *d)
     GLuint vaos[3] = {d->sprite_vao, d->empty_vao, d->over_vao};
     glDeleteVertexArrays(3, vaos);
     if (d->sprite_prog) glDeleteProgram(d->sprite_prog);
-    if (d->comp_prog) glDeleteProgram(d->comp_prog);
+    for (int k = 0; k < 4; k++)
+        if (d->comp_prog[k / 2][k % 2]) glDeleteProgram(d->comp_prog[k / 2][k % 2]);
     if (d->over_prog) glDeleteProgram(d->over_prog);
     if (d->mesh_prog) glDeleteProgram(d->mesh_prog);
     free(d->ov);
@@ -337,6 +353,7 @@ void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const
     d->f = f;
     d->walls3d = walls3d;
     d->nov = 0;
+    d->used[0] = d->used[1] = false;
     glViewport(0, 0, d->ss * w, d->ss * h);
     glClearColor(0, 0, 0, 0);
     glClearDepth(1.0);
@@ -350,6 +367,7 @@ void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const
 void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size_t n)
 {
     if (!n) return;
+    d->used[layer ? 1 : 0] = true;
     glBindFramebuffer(GL_FRAMEBUFFER, d->L[layer ? 1 : 0].fbo);
     glViewport(0, 0, d->ss * d->w, d->ss * d->h);
     glEnable(GL_DEPTH_TEST);
@@ -436,19 +454,19 @@ void pfsph_vdraw_composite(pfsph_vdraw *d)
     glViewport(0, 0, d->w, d->h);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
-    glUseProgram(d->comp_prog);
+    const GLuint prog = d->comp_prog[d->ss == 2][d->used[1]];
+    glUseProgram(prog);
     GLuint tex[4] = {d->L[0].col, d->L[0].depth, d->L[1].col, d->L[1].depth};
     const char *names[4] = {"c0", "z0", "c1", "z1"};
     for (int k = 0; k < 4; k++) {
         glActiveTexture(GL_TEXTURE0 + k);
         glBindTexture(GL_TEXTURE_2D, tex[k]);
-        glUniform1i(glGetUniformLocation(d->comp_prog, names[k]), k);
+        glUniform1i(glGetUniformLocation(prog, names[k]), k); /* -1 (a no-op) where unused */
     }
     /* walls in front of the fluid are see-through in 3D; in 2D they sit behind it */
-    glUniform1f(glGetUniformLocation(d->comp_prog, "afront"), d->walls3d ? 0.28f : 1.0f);
-    glUniform1f(glGetUniformLocation(d->comp_prog, "aback"), d->walls3d ? 0.85f : 1.0f);
-    glUniform1i(glGetUniformLocation(d->comp_prog, "height"), d->ss * d->h);
-    glUniform1i(glGetUniformLocation(d->comp_prog, "ss"), d->ss);
+    glUniform1f(glGetUniformLocation(prog, "afront"), d->walls3d ? 0.28f : 1.0f);
+    glUniform1f(glGetUniformLocation(prog, "aback"), d->walls3d ? 0.85f : 1.0f);
+    glUniform1i(glGetUniformLocation(prog, "height"), d->ss * d->h);
     glBindVertexArray(d->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);
