@@ -25,6 +25,13 @@ struct pfsph_vdraw {
     GLuint sprite_prog, over_prog, mesh_prog;
     GLuint comp_prog[2][2]; /* [samples per axis - 1][walls' layer used] */
     bool used[2];           /* the layers drawn into since begin */
+    /* the walls' layer as last drawn: its sprites and the camera they were drawn with; a frame
+     * with the same ones re-uses the layer instead of drawing them again (walls rarely move, and
+     * on llvmpipe their sprites cost more than the fluid's: docs/viewer.md) */
+    pfsph_vsprite *wall_spr;
+    size_t wall_n, wall_cap;
+    float wall_key[35];
+    bool wall_valid;
     GLuint quad_vbo, inst_vbo, sprite_vao, empty_vao, over_vbo, over_vao;
     layer L[2];
     GLuint final_fbo, final_col;
@@ -280,6 +287,7 @@ static void free_targets(pfsph_vdraw *d)
     if (d->final_col) glDeleteTextures(1, &d->final_col);
     d->final_fbo = d->final_col = 0;
     d->w = d->h = 0;
+    d->wall_valid = false;
 }
 
 void pfsph_vdraw_destroy(pfsph_vdraw *d)
@@ -296,6 +304,7 @@ void pfsph_vdraw_destroy(pfsph_vdraw *d)
     if (d->over_prog) glDeleteProgram(d->over_prog);
     if (d->mesh_prog) glDeleteProgram(d->mesh_prog);
     free(d->ov);
+    free(d->wall_spr);
     free(d);
 }
 
@@ -358,17 +367,45 @@ void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const
     glClearColor(0, 0, 0, 0);
     glClearDepth(1.0);
     glDepthMask(GL_TRUE);
-    for (int l = 0; l < 2; l++) {
-        glBindFramebuffer(GL_FRAMEBUFFER, d->L[l].fbo);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    /* the walls' layer is cleared when its sprites are drawn (pfsph_vdraw_sprites) */
+    glBindFramebuffer(GL_FRAMEBUFFER, d->L[0].fbo);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+}
+
+/* Whether the walls' layer already holds these n sprites drawn with this frame's camera; if
+ * not, remember them as what it is about to hold (false also when out of memory: drawn anyway). */
+static bool walls_cached(pfsph_vdraw *d, const pfsph_vsprite *s, size_t n)
+{
+    float key[35];
+    memcpy(key, d->view, sizeof d->view);
+    memcpy(key + 16, d->proj, sizeof d->proj);
+    key[32] = (float)d->ortho + 2.0f * (float)d->walls3d;
+    key[33] = (float)d->f;
+    key[34] = (float)d->ss;
+    if (d->wall_valid && n == d->wall_n && !memcmp(key, d->wall_key, sizeof key) &&
+        !memcmp(s, d->wall_spr, n * sizeof *s))
+        return true;
+    d->wall_valid = false;
+    if (n > d->wall_cap) {
+        pfsph_vsprite *q = realloc(d->wall_spr, n * sizeof *q);
+        if (!q) return false;
+        d->wall_spr = q;
+        d->wall_cap = n;
     }
+    memcpy(d->wall_spr, s, n * sizeof *s);
+    memcpy(d->wall_key, key, sizeof key);
+    d->wall_n = n;
+    d->wall_valid = true;
+    return false;
 }
 
 void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size_t n)
 {
     if (!n) return;
     d->used[layer ? 1 : 0] = true;
+    if (layer && walls_cached(d, s, n)) return;
     glBindFramebuffer(GL_FRAMEBUFFER, d->L[layer ? 1 : 0].fbo);
+    if (layer) glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glViewport(0, 0, d->ss * d->w, d->ss * d->h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
