@@ -67,12 +67,17 @@ static const char *SPRITE_VS =
     "  gl_Position = proj * vec4(c.xy + corner * r * grow, c.z, 1.0);\n"
     "}\n";
 
+/* The sprites' fragment shader runs for every covered sample of every sphere (it writes depth,
+ * so nothing is rejected early): on llvmpipe its length is the drawing's cost. The highlight's
+ * power 28 is taken by squaring (x^16 x^8 x^4) rather than pow (exp2 and log2), and the depth
+ * from the two rows of proj that give clip z and w (pfsph_vcam_matrices: x and y do not enter
+ * them), the same values to rounding. */
 static const char *SPRITE_FS =
     "#version 330 core\n"
     "in vec2 uv;\n"
     "flat in vec3 vcol, vc;\n"
     "flat in float vr, relief;\n"
-    "uniform mat4 proj;\n"
+    "uniform vec4 pzw;\n" /* clip z = pzw.x z + pzw.y, clip w = pzw.z z + pzw.w */
     "uniform int flatshade;\n"
     "out vec4 o;\n"
     "void main() {\n"
@@ -82,13 +87,14 @@ static const char *SPRITE_FS =
     "  vec3 n = vec3(uv, nz);\n"
     /* Lambert + ambient + a small highlight from the upper left, as the renderer's shade() */
     "  const vec3 L = vec3(-0.45, 0.62, 0.64), H = vec3(-0.2116, 0.2915, 0.9328);\n"
-    "  float diff = max(dot(n, L), 0.0), spec = pow(max(dot(n, H), 0.0), 28.0);\n"
+    "  float diff = max(dot(n, L), 0.0), h = max(dot(n, H), 0.0);\n"
+    "  float h2 = h * h, h4 = h2 * h2, h8 = h4 * h4, spec = h8 * h8 * h8 * h4;\n"
     "  float sh = 0.32 + 0.68 * diff;\n"
     "  if (flatshade == 1) { sh = 0.75 + 0.25 * diff; spec = 0.0; }\n"
     "  sh = relief * sh + (1.0 - relief) * 0.85;\n"
     "  o = vec4(clamp(vcol * sh + 0.22 * spec * relief, 0.0, 1.0), 1.0);\n"
-    "  vec4 cl = proj * vec4(vc.xy + uv * vr, vc.z + nz * vr, 1.0);\n"
-    "  gl_FragDepth = clamp(cl.z / cl.w * 0.5 + 0.5, 0.0, 1.0);\n"
+    "  float z = vc.z + nz * vr;\n"
+    "  gl_FragDepth = clamp((pzw.x * z + pzw.y) / (pzw.z * z + pzw.w) * 0.5 + 0.5, 0.0, 1.0);\n"
     "}\n";
 
 /* Meshes: the liquid shaded as render_raster.c's pfsph__shade_water, bodies as its
@@ -414,6 +420,7 @@ void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size
     glUniformMatrix4fv(glGetUniformLocation(d->sprite_prog, "view"), 1, GL_FALSE, d->view);
     glUniformMatrix4fv(glGetUniformLocation(d->sprite_prog, "proj"), 1, GL_FALSE, d->proj);
     glUniform1i(glGetUniformLocation(d->sprite_prog, "ortho"), d->ortho);
+    glUniform4f(glGetUniformLocation(d->sprite_prog, "pzw"), d->proj[10], d->proj[14], d->proj[11], d->proj[15]);
     glUniform1f(glGetUniformLocation(d->sprite_prog, "fpx"), (float)d->f);
     glUniform1f(glGetUniformLocation(d->sprite_prog, "ss"), (float)d->ss);
     glUniform1i(glGetUniformLocation(d->sprite_prog, "flatshade"), layer && d->walls3d);
