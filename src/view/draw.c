@@ -4,6 +4,7 @@
 #include "view/draw.h"
 
 #include <epoxy/gl.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +22,16 @@ struct pfsph_vmesh {
 };
 
 struct pfsph_vdraw {
-    GLuint sprite_prog, comp_prog, over_prog, mesh_prog;
+    GLuint sprite_prog, over_prog, mesh_prog;
+    GLuint comp_prog[2][2]; /* [samples per axis - 1][walls' layer used] */
+    bool used[2];           /* the layers drawn into since begin */
+    /* the walls' layer as last drawn: its sprites and the camera they were drawn with; a frame
+     * with the same ones re-uses the layer instead of drawing them again (walls rarely move, and
+     * on llvmpipe their sprites cost more than the fluid's: docs/viewer.md) */
+    pfsph_vsprite *wall_spr;
+    size_t wall_n, wall_cap;
+    float wall_key[35];
+    bool wall_valid;
     GLuint quad_vbo, inst_vbo, sprite_vao, empty_vao, over_vbo, over_vao;
     layer L[2];
     GLuint final_fbo, final_col;
@@ -57,12 +67,17 @@ static const char *SPRITE_VS =
     "  gl_Position = proj * vec4(c.xy + corner * r * grow, c.z, 1.0);\n"
     "}\n";
 
+/* The sprites' fragment shader runs for every covered sample of every sphere (it writes depth,
+ * so nothing is rejected early): on llvmpipe its length is the drawing's cost. The highlight's
+ * power 28 is taken by squaring (x^16 x^8 x^4) rather than pow (exp2 and log2), and the depth
+ * from the two rows of proj that give clip z and w (pfsph_vcam_matrices: x and y do not enter
+ * them), the same values to rounding. */
 static const char *SPRITE_FS =
     "#version 330 core\n"
     "in vec2 uv;\n"
     "flat in vec3 vcol, vc;\n"
     "flat in float vr, relief;\n"
-    "uniform mat4 proj;\n"
+    "uniform vec4 pzw;\n" /* clip z = pzw.x z + pzw.y, clip w = pzw.z z + pzw.w */
     "uniform int flatshade;\n"
     "out vec4 o;\n"
     "void main() {\n"
@@ -72,13 +87,14 @@ static const char *SPRITE_FS =
     "  vec3 n = vec3(uv, nz);\n"
     /* Lambert + ambient + a small highlight from the upper left, as the renderer's shade() */
     "  const vec3 L = vec3(-0.45, 0.62, 0.64), H = vec3(-0.2116, 0.2915, 0.9328);\n"
-    "  float diff = max(dot(n, L), 0.0), spec = pow(max(dot(n, H), 0.0), 28.0);\n"
+    "  float diff = max(dot(n, L), 0.0), h = max(dot(n, H), 0.0);\n"
+    "  float h2 = h * h, h4 = h2 * h2, h8 = h4 * h4, spec = h8 * h8 * h8 * h4;\n"
     "  float sh = 0.32 + 0.68 * diff;\n"
     "  if (flatshade == 1) { sh = 0.75 + 0.25 * diff; spec = 0.0; }\n"
     "  sh = relief * sh + (1.0 - relief) * 0.85;\n"
     "  o = vec4(clamp(vcol * sh + 0.22 * spec * relief, 0.0, 1.0), 1.0);\n"
-    "  vec4 cl = proj * vec4(vc.xy + uv * vr, vc.z + nz * vr, 1.0);\n"
-    "  gl_FragDepth = clamp(cl.z / cl.w * 0.5 + 0.5, 0.0, 1.0);\n"
+    "  float z = vc.z + nz * vr;\n"
+    "  gl_FragDepth = clamp((pzw.x * z + pzw.y) / (pzw.z * z + pzw.w) * 0.5 + 0.5, 0.0, 1.0);\n"
     "}\n";
 
 /* Meshes: the liquid shaded as render_raster.c's pfsph__shade_water, bodies as its
@@ -125,29 +141,36 @@ static const char *COMP_VS = "#version 330 core\n"
                              "  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
                              "}\n";
 
-static const char *COMP_FS = "#version 330 core\n"
-                             "uniform sampler2D c0, z0, c1, z1;\n"
+/* The composite, compiled for each case (SS samples per pixel along each axis; WALLS: the
+ * walls' layer has something in it). One general shader with a loop bound and the walls' fetches
+ * taken at run time cost llvmpipe about 8 ms of CPU a 640x360 frame, more than the fluid's
+ * sprites (docs/viewer.md, "What a frame costs"): constant bounds unroll, and a frame without
+ * walls reads one texture instead of four. */
+static const char *COMP_FS = "uniform sampler2D c0, z0, c1, z1;\n"
                              "uniform float afront, aback;\n"
-                             "uniform int height, ss;\n"
+                             "uniform int height;\n"
                              "out vec4 o;\n"
                              "void main() {\n"
                              "  vec3 acc = vec3(0.0);\n"
-                             /* each output pixel averages ss x ss samples, each composited as the renderer does */
-                             "  for (int sy = 0; sy < ss; sy++)\n"
-                             "    for (int sx = 0; sx < ss; sx++) {\n"
-                             "      ivec2 p = ivec2(gl_FragCoord.xy) * ss + ivec2(sx, sy);\n"
-                             "      vec4 f = texelFetch(c0, p, 0), b = texelFetch(c1, p, 0);\n"
+                             /* each output pixel averages SS x SS samples, each composited as the renderer does */
+                             "  for (int sy = 0; sy < SS; sy++)\n"
+                             "    for (int sx = 0; sx < SS; sx++) {\n"
+                             "      ivec2 p = ivec2(gl_FragCoord.xy) * SS + ivec2(sx, sy);\n"
+                             "      vec4 f = texelFetch(c0, p, 0);\n"
                              "      float t = height > 1 ? float(height - 1 - p.y) / float(height - 1) : 0.0;\n"
                              "      vec3 bg = mix(vec3(0.945, 0.950, 0.965), vec3(0.840, 0.850, 0.875), t);\n"
                              "      vec3 c = f.a > 0.5 ? f.rgb : bg;\n"
+                             "#if WALLS\n"
+                             "      vec4 b = texelFetch(c1, p, 0);\n"
                              "      if (b.a > 0.5) {\n"
                              "        float zf = texelFetch(z0, p, 0).r, zb = texelFetch(z1, p, 0).r;\n"
                              "        float a = f.a < 0.5 ? aback : (zb < zf ? afront : 0.0);\n"
                              "        c = mix(c, b.rgb, a);\n"
                              "      }\n"
+                             "#endif\n"
                              "      acc += c;\n"
                              "    }\n"
-                             "  o = vec4(acc / float(ss * ss), 1.0);\n"
+                             "  o = vec4(acc / float(SS * SS), 1.0);\n"
                              "}\n";
 
 static const char *OVER_VS = "#version 330 core\n"
@@ -217,8 +240,13 @@ pfsph_vdraw *pfsph_vdraw_create(char *msg, size_t cap)
         return NULL;
     }
     d->sprite_prog = program(SPRITE_VS, SPRITE_FS, msg, cap);
-    d->comp_prog = d->sprite_prog ? program(COMP_VS, COMP_FS, msg, cap) : 0;
-    d->over_prog = d->comp_prog ? program(OVER_VS, OVER_FS, msg, cap) : 0;
+    bool ok = d->sprite_prog != 0;
+    for (int k = 0; k < 4 && ok; k++) {
+        char src[2048];
+        snprintf(src, sizeof src, "#version 330 core\n#define SS %d\n#define WALLS %d\n%s", k / 2 + 1, k % 2, COMP_FS);
+        ok = (d->comp_prog[k / 2][k % 2] = program(COMP_VS, src, msg, cap)) != 0;
+    }
+    d->over_prog = ok ? program(OVER_VS, OVER_FS, msg, cap) : 0;
     d->mesh_prog = d->over_prog ? program(MESH_VS, MESH_FS, msg, cap) : 0;
     if (!d->mesh_prog) {
         pfsph_vdraw_destroy(d);
@@ -265,6 +293,7 @@ static void free_targets(pfsph_vdraw *d)
     if (d->final_col) glDeleteTextures(1, &d->final_col);
     d->final_fbo = d->final_col = 0;
     d->w = d->h = 0;
+    d->wall_valid = false;
 }
 
 void pfsph_vdraw_destroy(pfsph_vdraw *d)
@@ -276,10 +305,12 @@ void pfsph_vdraw_destroy(pfsph_vdraw *d)
     GLuint vaos[3] = {d->sprite_vao, d->empty_vao, d->over_vao};
     glDeleteVertexArrays(3, vaos);
     if (d->sprite_prog) glDeleteProgram(d->sprite_prog);
-    if (d->comp_prog) glDeleteProgram(d->comp_prog);
+    for (int k = 0; k < 4; k++)
+        if (d->comp_prog[k / 2][k % 2]) glDeleteProgram(d->comp_prog[k / 2][k % 2]);
     if (d->over_prog) glDeleteProgram(d->over_prog);
     if (d->mesh_prog) glDeleteProgram(d->mesh_prog);
     free(d->ov);
+    free(d->wall_spr);
     free(d);
 }
 
@@ -337,20 +368,58 @@ void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const
     d->f = f;
     d->walls3d = walls3d;
     d->nov = 0;
+    d->used[0] = d->used[1] = false;
     glViewport(0, 0, d->ss * w, d->ss * h);
     glClearColor(0, 0, 0, 0);
     glClearDepth(1.0);
     glDepthMask(GL_TRUE);
+    /* the walls' layer is kept while it holds walls that may be re-used (pfsph_vdraw_sprites
+     * clears it before it draws them), else cleared as the fluid's */
     for (int l = 0; l < 2; l++) {
+        if (l == 1 && d->wall_valid) continue;
         glBindFramebuffer(GL_FRAMEBUFFER, d->L[l].fbo);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     }
+    /* the clears go to llvmpipe's rasteriser now, not in one scene with what follows: a scene
+     * that starts with a clear and then bins a mesh of 50-70k triangles took 3x the CPU
+     * (measured, 60 paused frames of the wetting scene's surface: 8 s without, 2.4-3 s with) */
+    glFlush();
+}
+
+/* Whether the walls' layer already holds these n sprites drawn with this frame's camera; if
+ * not, remember them as what it is about to hold (false also when out of memory: drawn anyway). */
+static bool walls_cached(pfsph_vdraw *d, const pfsph_vsprite *s, size_t n)
+{
+    float key[35];
+    memcpy(key, d->view, sizeof d->view);
+    memcpy(key + 16, d->proj, sizeof d->proj);
+    key[32] = (float)d->ortho + 2.0f * (float)d->walls3d;
+    key[33] = (float)d->f;
+    key[34] = (float)d->ss;
+    if (d->wall_valid && n == d->wall_n && !memcmp(key, d->wall_key, sizeof key) &&
+        !memcmp(s, d->wall_spr, n * sizeof *s))
+        return true;
+    d->wall_valid = false;
+    if (n > d->wall_cap) {
+        pfsph_vsprite *q = realloc(d->wall_spr, n * sizeof *q);
+        if (!q) return false;
+        d->wall_spr = q;
+        d->wall_cap = n;
+    }
+    memcpy(d->wall_spr, s, n * sizeof *s);
+    memcpy(d->wall_key, key, sizeof key);
+    d->wall_n = n;
+    d->wall_valid = true;
+    return false;
 }
 
 void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size_t n)
 {
     if (!n) return;
+    d->used[layer ? 1 : 0] = true;
+    if (layer && walls_cached(d, s, n)) return;
     glBindFramebuffer(GL_FRAMEBUFFER, d->L[layer ? 1 : 0].fbo);
+    if (layer) glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glViewport(0, 0, d->ss * d->w, d->ss * d->h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -359,6 +428,7 @@ void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size
     glUniformMatrix4fv(glGetUniformLocation(d->sprite_prog, "view"), 1, GL_FALSE, d->view);
     glUniformMatrix4fv(glGetUniformLocation(d->sprite_prog, "proj"), 1, GL_FALSE, d->proj);
     glUniform1i(glGetUniformLocation(d->sprite_prog, "ortho"), d->ortho);
+    glUniform4f(glGetUniformLocation(d->sprite_prog, "pzw"), d->proj[10], d->proj[14], d->proj[11], d->proj[15]);
     glUniform1f(glGetUniformLocation(d->sprite_prog, "fpx"), (float)d->f);
     glUniform1f(glGetUniformLocation(d->sprite_prog, "ss"), (float)d->ss);
     glUniform1i(glGetUniformLocation(d->sprite_prog, "flatshade"), layer && d->walls3d);
@@ -436,19 +506,21 @@ void pfsph_vdraw_composite(pfsph_vdraw *d)
     glViewport(0, 0, d->w, d->h);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
-    glUseProgram(d->comp_prog);
-    GLuint tex[4] = {d->L[0].col, d->L[0].depth, d->L[1].col, d->L[1].depth};
+    const GLuint prog = d->comp_prog[d->ss == 2][d->used[1]];
+    glUseProgram(prog);
+    /* only the textures the program reads (a frame without walls: the fluid's colour) */
+    GLuint tex[4] = {d->L[0].col, 0, 0, 0};
+    if (d->used[1]) tex[1] = d->L[0].depth, tex[2] = d->L[1].col, tex[3] = d->L[1].depth;
     const char *names[4] = {"c0", "z0", "c1", "z1"};
     for (int k = 0; k < 4; k++) {
         glActiveTexture(GL_TEXTURE0 + k);
         glBindTexture(GL_TEXTURE_2D, tex[k]);
-        glUniform1i(glGetUniformLocation(d->comp_prog, names[k]), k);
+        glUniform1i(glGetUniformLocation(prog, names[k]), k); /* -1 (a no-op) where unused */
     }
     /* walls in front of the fluid are see-through in 3D; in 2D they sit behind it */
-    glUniform1f(glGetUniformLocation(d->comp_prog, "afront"), d->walls3d ? 0.28f : 1.0f);
-    glUniform1f(glGetUniformLocation(d->comp_prog, "aback"), d->walls3d ? 0.85f : 1.0f);
-    glUniform1i(glGetUniformLocation(d->comp_prog, "height"), d->ss * d->h);
-    glUniform1i(glGetUniformLocation(d->comp_prog, "ss"), d->ss);
+    glUniform1f(glGetUniformLocation(prog, "afront"), d->walls3d ? 0.28f : 1.0f);
+    glUniform1f(glGetUniformLocation(prog, "aback"), d->walls3d ? 0.85f : 1.0f);
+    glUniform1i(glGetUniformLocation(prog, "height"), d->ss * d->h);
     glBindVertexArray(d->empty_vao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);

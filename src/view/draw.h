@@ -31,7 +31,9 @@ int pfsph_vdraw_software(void);
  * translucent, flat-shaded walls (3D) rather than walls behind the fluid (2D). */
 void pfsph_vdraw_begin(pfsph_vdraw *d, int w, int h, const float view[16], const float proj[16], int ortho, double f,
                        int walls3d);
-/* Draw n sprites into layer 0 (fluid, bodies, diffuse) or 1 (walls). */
+/* Draw n sprites into layer 0 (fluid, bodies, diffuse) or 1 (walls: one call a frame, or none
+ * for no walls; the same sprites as the last frame's, with the same camera, re-use the layer
+ * as it was drawn: static walls cost nothing while the camera stands still). */
 void pfsph_vdraw_sprites(pfsph_vdraw *d, int layer, const pfsph_vsprite *s, size_t n);
 /* A triangle mesh held by the GPU (one vertex buffer, and an index buffer when indexed). */
 typedef struct pfsph_vmesh pfsph_vmesh;

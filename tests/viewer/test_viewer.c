@@ -3,7 +3,8 @@
  * the PNG renderer shows (2D and 3D, same camera, walls cut away or not; a run with a rigid
  * body and liquid meshes drawn as meshes, and the mesh toggle); live 3D draws the liquid as a
  * surface, M (pressed with --press) and --particles go back to particles, and a surface too
- * slow for its budget falls back to particles; bad input. Skipped in builds without the viewer
+ * slow for its budget falls back to particles; the walls' layer re-used while nothing moves
+ * is the layer drawn afresh, and drawn again when the walls shown change; bad input. Skipped in builds without the viewer
  * or without a display. */
 #include <math.h>
 #include <stdio.h>
@@ -464,6 +465,49 @@ static void test_live_surface(void **state)
     free(b.rgb);
 }
 
+/* Pixels (of w x h) whose colour differs between two screenshots of the same size. */
+static size_t pixels_differing(const img *a, const img *b)
+{
+    assert_int_equal(a->w, b->w);
+    assert_int_equal(a->h, b->h);
+    size_t n = 0;
+    for (size_t o = 0; o < (size_t)a->w * a->h; o++) n += memcmp(a->rgb + 3 * o, b->rgb + 3 * o, 3) != 0;
+    return n;
+}
+
+/* The walls' layer is drawn once and re-used while its sprites and the camera stay the same
+ * (draw.c): a paused frame drawn after two re-uses is the first frame, pixel for pixel; and a
+ * change of the walls drawn (X: the cut-away on or off, pressed after the first frame) draws
+ * the layer again, so the second frame is the picture a viewer started in that state draws. */
+static void test_wall_layer(void **state)
+{
+    (void)state;
+    if (!viewer_available()) tu_skip("no viewer in this build, or no display");
+    char scene[600], out[4096], shot[5][700];
+    write_scene(tu_tmpdir(), "walls3d.json", SCENE3D, scene, sizeof scene);
+    const char *args[5] = {"--all-walls --frames 1", "--all-walls --frames 3", "--frames 2 --press X", "--frames 1",
+                           "--all-walls --frames 2 --press X"};
+    char name[32];
+    for (int k = 0; k < 5; k++) {
+        char a[200];
+        snprintf(a, sizeof a, "--paused --particles %s", args[k]);
+        snprintf(name, sizeof name, "walls_%d.png", k);
+        assert_int_equal(live_shot(scene, a, name, shot[k], sizeof shot[k], out, sizeof out), 0);
+    }
+    img m[5];
+    for (int k = 0; k < 5; k++) m[k] = tu_read_png(shot[k]);
+    size_t cut = pixels_differing(&m[0], &m[3]), reused = pixels_differing(&m[0], &m[1]),
+           to_all = pixels_differing(&m[0], &m[2]), to_cut = pixels_differing(&m[3], &m[4]);
+    print_message("walls' layer: the cut-away changes %zu pixels; re-used twice: %zu differ; X to all walls: %zu, "
+                  "X to the cut-away: %zu (all required 0)\n",
+                  cut, reused, to_all, to_cut);
+    assert_true(cut > 1000); /* the comparisons below could not see a stale layer otherwise */
+    assert_int_equal(reused, 0);
+    assert_int_equal(to_all, 0);
+    assert_int_equal(to_cut, 0);
+    for (int k = 0; k < 5; k++) free(m[k].rgb);
+}
+
 /* Bad input: exit status 2 and a message naming the problem, before any window opens. */
 static void test_bad_input(void **state)
 {
@@ -501,8 +545,9 @@ int main(int argc, char **argv)
 {
     tu_init(argc, argv);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_bad_input), cmocka_unit_test(test_live_2d),       cmocka_unit_test(test_replay_2d),
-        cmocka_unit_test(test_replay_3d), cmocka_unit_test(test_replay_meshes), cmocka_unit_test(test_live_surface),
+        cmocka_unit_test(test_bad_input),  cmocka_unit_test(test_live_2d),       cmocka_unit_test(test_replay_2d),
+        cmocka_unit_test(test_replay_3d),  cmocka_unit_test(test_replay_meshes), cmocka_unit_test(test_live_surface),
+        cmocka_unit_test(test_wall_layer),
     };
     /* Drawing is what this program tests: without a viewer or a display only the bad-input
      * checks can run, and the program reads skipped once they pass. */
