@@ -6,6 +6,7 @@
 
 #include <stddef.h>
 
+#include "pfsph/particles.h"
 #include "pfsph/types.h"
 
 struct pfsph_sim;
@@ -20,6 +21,14 @@ struct pfsph_dist {
     void (*halo)(pfsph_dist *d, pfsph_real *const *a, int k);
     /* pfsph__sum of the global array whose owned part is a[own_lo, own_hi): the same bits */
     double (*sum)(pfsph_dist *d, const pfsph_real *a);
+    /* the exclusive prefix over the ranks (in rank order) and the total of k <= 8 counters */
+    void (*scan)(pfsph_dist *d, const uint64_t *v, int k, uint64_t *before, uint64_t *total);
+    /* Move a particle set that is not the fluid (diffuse particles) between ranks: particle i
+     * goes to the rank that owns cell key[i] of the step's cut (UINT32_MAX: it stays); key NULL:
+     * every particle goes to the root. The set is [0, *nold), a part in the global order, then
+     * [*nold, n), new particles in id order; a rank receives the first parts in rank order, then
+     * the new parts merged by id, and *nold becomes the count of the first. */
+    void (*migrate)(pfsph_dist *d, pfsph_particles *ps, size_t *nold, const uint32_t *key);
     /* every rank's status after a stage: the first failure (its message) on all ranks */
     int (*agree)(pfsph_dist *d, int rc, pfsph_error *err);
     /* a step begins (the root tells the other ranks to follow) */
