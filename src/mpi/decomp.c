@@ -756,7 +756,13 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
                           D->wall_bytes,
                           D->resident_max,
                           0,
+                          0,
                           0};
+    if (D->sim->st.df) {
+        size_t *no;
+        uint64_t *cr, *rf;
+        mine.diffuse = pfsph__diffuse_set(D->sim->st.df, &no, &cr, &rf)->n;
+    }
     struct rusage ru;
     if (getrusage(RUSAGE_SELF, &ru) == 0) mine.peak_rss_kb = (uint64_t)ru.ru_maxrss;
     FILE *sm = fopen("/proc/self/statm", "r");

@@ -26,6 +26,7 @@ typedef struct pfsph_mpi_fig {
     uint64_t resident_max;                                           /* fluid (own + halo) + walls, most */
     uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
     uint64_t rss_kb;      /* its resident memory at the frame */
+    uint64_t diffuse;     /* diffuse particles it held at the frame (before the gather) */
 } pfsph_mpi_fig;
 
 typedef struct pfsph_decomp {

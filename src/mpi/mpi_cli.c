@@ -94,6 +94,7 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(r, "wall_window_fetches", (double)f->wall_fetches);
         cJSON_AddNumberToObject(r, "wall_bytes_sent", (double)f->wall_bytes);
         cJSON_AddNumberToObject(r, "resident_particles_max", (double)f->resident_max);
+        cJSON_AddNumberToObject(r, "diffuse_held_at_frame", (double)f->diffuse);
         cJSON_AddNumberToObject(r, "rss_mib_at_last_frame", (double)f->rss_kb / 1024.0);
         cJSON_AddNumberToObject(r, "peak_rss_mib", (double)f->peak_rss_kb / 1024.0);
         cJSON_AddItemToArray(ranks, r);
