@@ -378,6 +378,14 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
             *rf = v[1];
             ds->next_id = (uint32_t)v[2];
         }
+        /* a resume: the ids the emitters go on from, and their state */
+        MPI_Bcast(&f->next_id, 1, MPI_UINT32_T, 0, D->comm);
+        for (int i = 0; i < pfsph_emitters_count(st->em); i++) {
+            pfsph_emitter_state es;
+            pfsph_emitters_get_state(st->em, i, &es);
+            MPI_Bcast(&es, sizeof es, MPI_BYTE, 0, D->comm);
+            if (pfsph_emitters_set_state(st->em, i, &es, st->time, err)) return PFSPH_EINPUT; /* the root's own */
+        }
     }
     size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
     const size_t m = hi - lo, nc = D->ncells;
@@ -554,6 +562,15 @@ static void scan(pfsph_dist *d, const uint64_t *v, int k, uint64_t *before, uint
         }
         before[j] = b;
         total[j] = t;
+    }
+}
+
+static void any(pfsph_dist *d, uint8_t *flags, size_t n)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    for (size_t o = 0; o < n; o += (size_t)1 << 30) {
+        const size_t k = n - o < (size_t)1 << 30 ? n - o : (size_t)1 << 30;
+        MPI_Allreduce(MPI_IN_PLACE, flags + o, (int)k, MPI_UINT8_T, MPI_BOR, D->comm);
     }
 }
 
@@ -774,7 +791,9 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
-    const size_t lo = D->d.own_lo, m = D->d.own_hi - D->d.own_lo, N = D->d.nglobal;
+    /* the last rank's owned particles end with those the emitters added since the sort (they
+     * follow every other in the global order, and have no cell of the sort) */
+    const size_t lo = D->d.own_lo, m = D->d.own_hi - D->d.own_lo, N = D->d.nglobal, N0 = D->gofs[D->size];
     uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
     if (!key) MPI_Abort(D->comm, 1); /* the root waits in the gather */
     D->key = key;
@@ -790,7 +809,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         kdispl[q] = (int)D->gofs[q];
     }
     if (D->rank == 0 && !(allkey = malloc((N ? N : 1) * sizeof(uint32_t)))) MPI_Abort(D->comm, 1);
-    MPI_Gatherv(key, (int)m, MPI_UINT32_T, allkey, kcount, kdispl, MPI_UINT32_T, 0, D->comm);
+    MPI_Gatherv(key, kcount[D->rank], MPI_UINT32_T, allkey, kcount, kdispl, MPI_UINT32_T, 0, D->comm);
     /* the particles, rank by rank in runs of at most GATHER_RUN through one bounded buffer: no
      * copy of the whole fluid besides the root's arrays. The root's own particles are already in
      * their global places (its slice starts at global index 0). */
@@ -804,17 +823,19 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         if (sim->st.reserve(&sim->st, N, err)) MPI_Abort(D->comm, 1);
         if (keep) memcpy(c->nd, keep, own * sizeof(pfsph_real));
         free(keep);
-        for (int q = 1; q < D->size; q++)
-            for (uint64_t o = D->gofs[q]; o < D->gofs[q + 1]; o += GATHER_RUN) {
-                const size_t k = D->gofs[q + 1] - o < GATHER_RUN ? (size_t)(D->gofs[q + 1] - o) : GATHER_RUN;
+        for (int q = 1; q < D->size; q++) {
+            const uint64_t e = q == D->size - 1 ? N : D->gofs[q + 1];
+            for (uint64_t o = D->gofs[q]; o < e; o += GATHER_RUN) {
+                const size_t k = e - o < GATHER_RUN ? (size_t)(e - o) : GATHER_RUN;
                 MPI_Recv(D->rbuf, (int)(k * REC), MPI_BYTE, q, 30, D->comm, MPI_STATUS_IGNORE);
                 for (size_t i = 0; i < k; i++) unpack(D->rbuf + i * REC, f, c->nd, (size_t)o + i);
             }
+        }
         D->root_own_hi = own;
         f->n = N;
         uint32_t *start = c->grid->start;
         memset(start, 0, (D->ncells + 1) * sizeof(uint32_t));
-        for (size_t i = 0; i < N; i++) start[allkey[i] + 1]++;
+        for (size_t i = 0; i < N0; i++) start[allkey[i] + 1]++;
         for (size_t k = 0; k < D->ncells; k++) start[k + 1] += start[k];
         free(allkey);
         D->d.own_lo = 0;
@@ -865,6 +886,9 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.halo = halo;
     D->d.sum = sum;
     D->d.scan = scan;
+    D->d.any = any;
+    D->d.rank = D->rank;
+    D->d.nranks = D->size;
     D->d.migrate = migrate;
     D->d.agree = agree;
     D->d.step_begin = step_begin;

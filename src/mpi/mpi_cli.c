@@ -46,7 +46,6 @@ int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
     const char *solver = pfsph_scene_solver_name(s);
     if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph")) no = "this solver", key = "$.solver.type";
     else if (s->nbodies) no = "rigid or keyframed bodies", key = "$.bodies";
-    else if (s->nemitters) no = "emitters", key = "$.emitters";
     else if (s->film.nbubbles > 0) no = "bubbles in air (film particles)", key = "$.fluid[].bubble";
     else if (g_size > 64) no = "more than 64 ranks", key = "mpirun -np";
     if (!no) return PFSPH_OK;

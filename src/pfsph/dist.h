@@ -5,6 +5,7 @@
 #define PFSPH_DIST_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "pfsph/particles.h"
 #include "pfsph/types.h"
@@ -16,11 +17,15 @@ struct pfsph_dist {
     /* The local fluid is a contiguous slice of the serial (global, sorted) order: halo copies,
      * then the particles this rank owns, [own_lo, own_hi), then halo copies again. */
     size_t own_lo, own_hi;
-    size_t nglobal; /* fluid particles of all ranks */
+    size_t nglobal;   /* fluid particles of all ranks */
+    int rank, nranks; /* this process, and how many; the last rank takes the emitters' new
+                       * particles: they follow every other in the global order */
     /* refresh the halo copies of k per-fluid-particle arrays from their owners */
     void (*halo)(pfsph_dist *d, pfsph_real *const *a, int k);
     /* pfsph__sum of the global array whose owned part is a[own_lo, own_hi): the same bits */
     double (*sum)(pfsph_dist *d, const pfsph_real *a);
+    /* flags[i] |= every rank's flags[i] (a logical or over the ranks, in place) */
+    void (*any)(pfsph_dist *d, uint8_t *flags, size_t n);
     /* the exclusive prefix over the ranks (in rank order) and the total of k <= 8 counters */
     void (*scan)(pfsph_dist *d, const uint64_t *v, int k, uint64_t *before, uint64_t *total);
     /* Move a particle set that is not the fluid (diffuse particles) between ranks: particle i
