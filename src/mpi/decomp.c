@@ -97,6 +97,26 @@ static void share_clock(pfsph_decomp *D, pfsph_step *st)
     st->stats = s.stats;
 }
 
+/* A resume: the root restored the bodies from the checkpoint; the others do the same with its
+ * states and its boundary order (every rank keeps every wall with bodies). */
+static int share_bodies(pfsph_decomp *D, pfsph_step *st, int nbod, pfsph_error *err)
+{
+    pfsph_particles *b = st->ctx->boundary;
+    pfsph_body_state *bs = malloc((size_t)nbod * sizeof *bs);
+    uint64_t n = b->n;
+    MPI_Bcast(&n, 1, MPI_UINT64_T, 0, D->comm);
+    uint32_t *ids = malloc((n ? n : 1) * sizeof(uint32_t));
+    if (!bs || !ids) MPI_Abort(D->comm, 1);
+    for (int i = 0; i < nbod; i++) pfsph_bodies_get_state(st->bodies, i, &bs[i]);
+    if (D->rank == 0) memcpy(ids, b->id, n * sizeof(uint32_t));
+    MPI_Bcast(bs, (int)((size_t)nbod * sizeof *bs), MPI_BYTE, 0, D->comm);
+    MPI_Bcast(ids, (int)n, MPI_UINT32_T, 0, D->comm);
+    int rc = D->rank ? pfsph_sim_restore_bodies(D->sim, nbod, bs, ids, (size_t)n, err) : PFSPH_OK;
+    free(bs);
+    free(ids);
+    return rc;
+}
+
 /* Cells [lo, hi) rank q holds: its own and those within a walk's reach of them. */
 static void held_cells(const pfsph_decomp *D, int q, size_t *lo, size_t *hi)
 {
@@ -378,6 +398,10 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
             *rf = v[1];
             ds->next_id = (uint32_t)v[2];
         }
+        /* a resume: the bodies' state and the order of the boundary particles the root restored */
+        const int nbod = pfsph_bodies_count(st->bodies);
+        int brc;
+        if (nbod && st->step > 0 && (brc = share_bodies(D, st, nbod, err))) return brc;
         /* a resume: the ids the emitters go on from, and their state */
         MPI_Bcast(&f->next_id, 1, MPI_UINT32_T, 0, D->comm);
         for (int i = 0; i < pfsph_emitters_count(st->em); i++) {
@@ -417,6 +441,8 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     D->d.own_lo = (size_t)(D->gofs[D->rank] - D->lofs[D->rank]);
     D->d.own_hi = (size_t)(D->gofs[D->rank + 1] - D->lofs[D->rank]);
     D->d.nglobal = (size_t)total;
+    D->d.cell_lo = D->cut[D->rank];
+    D->d.cell_hi = D->cut[D->rank + 1];
     D->root_all = 0;
     /* figures */
     const size_t own = D->d.own_hi - D->d.own_lo;
@@ -562,6 +588,15 @@ static void scan(pfsph_dist *d, const uint64_t *v, int k, uint64_t *before, uint
         }
         before[j] = b;
         total[j] = t;
+    }
+}
+
+static void allsum(pfsph_dist *d, double *a, size_t n)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    for (size_t o = 0; o < n; o += (size_t)1 << 28) {
+        const size_t k = n - o < (size_t)1 << 28 ? n - o : (size_t)1 << 28;
+        MPI_Allreduce(MPI_IN_PLACE, a + o, (int)k, MPI_DOUBLE, MPI_SUM, D->comm);
     }
 }
 
@@ -887,6 +922,7 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.sum = sum;
     D->d.scan = scan;
     D->d.any = any;
+    D->d.allsum = allsum;
     D->d.rank = D->rank;
     D->d.nranks = D->size;
     D->d.migrate = migrate;

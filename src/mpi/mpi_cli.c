@@ -45,15 +45,14 @@ int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
     const char *no = NULL, *key = NULL;
     const char *solver = pfsph_scene_solver_name(s);
     if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph")) no = "this solver", key = "$.solver.type";
-    else if (s->nbodies) no = "rigid or keyframed bodies", key = "$.bodies";
     else if (s->film.nbubbles > 0) no = "bubbles in air (film particles)", key = "$.fluid[].bubble";
     else if (g_size > 64) no = "more than 64 ranks", key = "mpirun -np";
     if (!no) return PFSPH_OK;
     return pfsph_fail(err, PFSPH_EINPUT,
-                      "%s: %s: %s%s%s not supported under MPI yet (%d ranks; docs/cluster.md lists what is): run it "
+                      "%s: %s: %s%s%s%s not supported under MPI yet (%d ranks; docs/cluster.md lists what is): run it "
                       "with one process",
                       s->source, key, no, !strcmp(no, "this solver") ? " \"" : "",
-                      !strcmp(no, "this solver") ? solver : "", g_size);
+                      !strcmp(no, "this solver") ? solver : "", !strcmp(no, "this solver") ? "\"" : "", g_size);
 }
 
 static void report(pfsph_dist *d, void *json)

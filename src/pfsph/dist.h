@@ -17,13 +17,17 @@ struct pfsph_dist {
     /* The local fluid is a contiguous slice of the serial (global, sorted) order: halo copies,
      * then the particles this rank owns, [own_lo, own_hi), then halo copies again. */
     size_t own_lo, own_hi;
-    size_t nglobal;   /* fluid particles of all ranks */
-    int rank, nranks; /* this process, and how many; the last rank takes the emitters' new
+    size_t nglobal;          /* fluid particles of all ranks */
+    size_t cell_lo, cell_hi; /* the grid cells this rank owns (the step's cut) */
+    int rank, nranks;        /* this process, and how many; the last rank takes the emitters' new
                        * particles: they follow every other in the global order */
     /* refresh the halo copies of k per-fluid-particle arrays from their owners */
     void (*halo)(pfsph_dist *d, pfsph_real *const *a, int k);
     /* pfsph__sum of the global array whose owned part is a[own_lo, own_hi): the same bits */
     double (*sum)(pfsph_dist *d, const pfsph_real *a);
+    /* a[i] summed over the ranks, in place: exact, in any order, where one rank holds the value
+     * and the others -0.0 (x + -0.0 == x for every x) */
+    void (*allsum)(pfsph_dist *d, double *a, size_t n);
     /* flags[i] |= every rank's flags[i] (a logical or over the ranks, in place) */
     void (*any)(pfsph_dist *d, uint8_t *flags, size_t n);
     /* the exclusive prefix over the ranks (in rank order) and the total of k <= 8 counters */

@@ -38,7 +38,7 @@ mpi() { # NP args...
     "$MPIRUN" $ROOTOPT --oversubscribe -np "$np" "$BIN" "$@"
 }
 
-same() { # DIR_A DIR_B: frames and stats.csv byte for byte
+same() { # DIR_A DIR_B: frames, stats.csv (and bodies.csv) byte for byte
     if ! diff -r "$1/frames" "$2/frames" >/dev/null; then
         echo "FAIL: $1/frames and $2/frames differ:"
         diff -rq "$1/frames" "$2/frames" | head -5
@@ -47,6 +47,11 @@ same() { # DIR_A DIR_B: frames and stats.csv byte for byte
     if ! cmp -s "$1/stats.csv" "$2/stats.csv"; then
         echo "FAIL: $1/stats.csv and $2/stats.csv differ:"
         diff "$1/stats.csv" "$2/stats.csv" | head -6
+        return 1
+    fi
+    if [ -f "$1/bodies.csv" ] && ! cmp -s "$1/bodies.csv" "$2/bodies.csv"; then
+        echo "FAIL: $1/bodies.csv and $2/bodies.csv differ:"
+        diff "$1/bodies.csv" "$2/bodies.csv" | head -6
         return 1
     fi
     n=$(ls "$1/frames" | wc -l)
