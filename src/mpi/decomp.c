@@ -14,48 +14,11 @@
 
 #include "core/reduce.h"
 #include "core/stage.h"
+#include "mpi/wire.h"
 #include "sim_internal.h"
-
-/* One particle on the wire: the persistent fields, the density of the step (frames), id, phase,
- * wall, bubble. A homogeneous cluster is assumed (the same byte order and pfsph_real). */
-#define REC (((PFSPH_NFIELDS + 1) * sizeof(pfsph_real) + 7 + 7) & ~(size_t)7)
 
 /* particles per message of the frame gather (its buffers: 3 MB) */
 #define GATHER_RUN ((size_t)65536)
-
-static int grow(char **buf, size_t *cap, size_t n)
-{
-    if (n <= *cap) return PFSPH_OK;
-    size_t c = n + n / 4 + 4096;
-    char *p = realloc(*buf, c);
-    if (!p) return PFSPH_ENOMEM;
-    *buf = p;
-    *cap = c;
-    return PFSPH_OK;
-}
-
-static void pack(char *o, const pfsph_particles *f, const pfsph_real *nd, size_t i)
-{
-    for (int k = 0; k < PFSPH_NFIELDS; k++) memcpy(o + k * sizeof(pfsph_real), &f->f[k][i], sizeof(pfsph_real));
-    pfsph_real v = nd ? nd[i] : 0;
-    memcpy(o + PFSPH_NFIELDS * sizeof(pfsph_real), &v, sizeof v);
-    char *t = o + (PFSPH_NFIELDS + 1) * sizeof(pfsph_real);
-    memcpy(t, &f->id[i], 4);
-    t[4] = (char)f->phase[i];
-    t[5] = (char)f->wall[i];
-    t[6] = (char)f->bubble[i];
-}
-
-static void unpack(const char *o, pfsph_particles *f, pfsph_real *nd, size_t i)
-{
-    for (int k = 0; k < PFSPH_NFIELDS; k++) memcpy(&f->f[k][i], o + k * sizeof(pfsph_real), sizeof(pfsph_real));
-    if (nd) memcpy(&nd[i], o + PFSPH_NFIELDS * sizeof(pfsph_real), sizeof(pfsph_real));
-    const char *t = o + (PFSPH_NFIELDS + 1) * sizeof(pfsph_real);
-    memcpy(&f->id[i], t, 4);
-    f->phase[i] = (uint8_t)t[4];
-    f->wall[i] = (uint8_t)t[5];
-    f->bubble[i] = (uint8_t)t[6];
-}
 
 /* The cell key of the serial sort (pfsph_grid_sort_in), UINT32_MAX for a particle it removes. */
 static uint32_t cell_key(const pfsph_grid *g, const pfsph_particles *f, size_t i)
@@ -571,125 +534,6 @@ static double sum(pfsph_dist *d, const pfsph_real *a)
     return total;
 }
 
-/* ---- counters over the ranks, and the sets that are not the fluid (diffuse particles) ---- */
-
-static void scan(pfsph_dist *d, const uint64_t *v, int k, uint64_t *before, uint64_t *total)
-{
-    pfsph_decomp *D = (pfsph_decomp *)d;
-    uint64_t mine[8], all[64 * 8];
-    if (k > 8 || k < 1) MPI_Abort(D->comm, 1); /* a caller's bug */
-    for (int j = 0; j < k && j < 8; j++) mine[j] = v[j];
-    MPI_Allgather(mine, k, MPI_UINT64_T, all, k, MPI_UINT64_T, D->comm);
-    for (int j = 0; j < k; j++) {
-        uint64_t b = 0, t = 0;
-        for (int q = 0; q < D->size; q++) {
-            if (q < D->rank) b += all[q * k + j];
-            t += all[q * k + j];
-        }
-        before[j] = b;
-        total[j] = t;
-    }
-}
-
-static void allsum(pfsph_dist *d, double *a, size_t n)
-{
-    pfsph_decomp *D = (pfsph_decomp *)d;
-    for (size_t o = 0; o < n; o += (size_t)1 << 28) {
-        const size_t k = n - o < (size_t)1 << 28 ? n - o : (size_t)1 << 28;
-        MPI_Allreduce(MPI_IN_PLACE, a + o, (int)k, MPI_DOUBLE, MPI_SUM, D->comm);
-    }
-}
-
-static void any(pfsph_dist *d, uint8_t *flags, size_t n)
-{
-    pfsph_decomp *D = (pfsph_decomp *)d;
-    for (size_t o = 0; o < n; o += (size_t)1 << 30) {
-        const size_t k = n - o < (size_t)1 << 30 ? n - o : (size_t)1 << 30;
-        MPI_Allreduce(MPI_IN_PLACE, flags + o, (int)k, MPI_UINT8_T, MPI_BOR, D->comm);
-    }
-}
-
-/* The rank whose cells [cut[q], cut[q + 1]) hold cell `key`. */
-static int owner(const pfsph_decomp *D, uint32_t key)
-{
-    int a = 0, b = D->size - 1;
-    while (a < b) {
-        const int m = (a + b + 1) / 2;
-        if (D->cut[m] <= key) a = m;
-        else b = m - 1;
-    }
-    return a;
-}
-
-/* A set in the global order is [0, nold), a slice of its sorted part (rank order), then
- * [nold, n), new particles whose ids rise in the global order. Each rank sends each particle to
- * its destination, the first part before the new; a receiver takes the first parts in rank
- * order, then merges the new parts by id: the global order of what it holds. One Alltoallv. */
-static void migrate(pfsph_dist *d, pfsph_particles *ps, size_t *nold, const uint32_t *key)
-{
-    pfsph_decomp *D = (pfsph_decomp *)d;
-    const int P = D->size;
-    int cnt[2 * 64] = {0}, rcnt[2 * 64];
-    int *dest = malloc((ps->n ? ps->n : 1) * sizeof(int));
-    if (!dest) MPI_Abort(D->comm, 1);
-    for (size_t i = 0; i < ps->n; i++) {
-        dest[i] = !key ? 0 : key[i] == UINT32_MAX ? D->rank : owner(D, key[i]);
-        cnt[2 * dest[i] + (i >= *nold)]++;
-    }
-    MPI_Alltoall(cnt, 2, MPI_INT, rcnt, 2, MPI_INT, D->comm);
-    size_t bytes = 0, rbytes = 0, rold = 0, rn = 0;
-    for (int q = 0; q < P; q++) {
-        D->scount[q] = (cnt[2 * q] + cnt[2 * q + 1]) * (int)REC;
-        D->sdispl[q] = (int)bytes;
-        D->rcount[q] = (rcnt[2 * q] + rcnt[2 * q + 1]) * (int)REC;
-        D->rdispl[q] = (int)rbytes;
-        bytes += (size_t)D->scount[q];
-        rbytes += (size_t)D->rcount[q];
-        rold += (size_t)rcnt[2 * q];
-        rn += (size_t)(rcnt[2 * q] + rcnt[2 * q + 1]);
-    }
-    if (bytes > (size_t)INT32_MAX || rbytes > (size_t)INT32_MAX || grow(&D->sbuf, &D->scap, bytes) ||
-        grow(&D->rbuf, &D->rcap, rbytes))
-        MPI_Abort(D->comm, 1);
-    size_t at[64];
-    for (int q = 0; q < P; q++) at[q] = (size_t)D->sdispl[q];
-    for (int part = 0; part < 2; part++) /* the first part, then the new */
-        for (size_t i = part ? *nold : 0; i < (part ? ps->n : *nold); i++) {
-            pack(D->sbuf + at[dest[i]], ps, NULL, i);
-            at[dest[i]] += REC;
-        }
-    free(dest);
-    MPI_Alltoallv(D->sbuf, D->scount, D->sdispl, MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, D->comm);
-    if (rn > ps->cap && pfsph_particles_reserve(ps, rn) != PFSPH_OK) MPI_Abort(D->comm, 1);
-    size_t k = 0, head[64], end[64];
-    for (int q = 0; q < P; q++)
-        for (int j = 0; j < rcnt[2 * q]; j++) unpack(D->rbuf + D->rdispl[q] + (size_t)j * REC, ps, NULL, k++);
-    for (int q = 0; q < P; q++) {
-        head[q] = (size_t)D->rdispl[q] + (size_t)rcnt[2 * q] * REC;
-        end[q] = (size_t)D->rdispl[q] + (size_t)D->rcount[q];
-    }
-    const size_t idat = (PFSPH_NFIELDS + 1) * sizeof(pfsph_real);
-    while (k < rn) { /* merge the new parts by id (each rises) */
-        int best = -1;
-        uint32_t bid = 0;
-        for (int q = 0; q < P; q++) {
-            if (head[q] >= end[q]) continue;
-            uint32_t id;
-            memcpy(&id, D->rbuf + head[q] + idat, 4);
-            if (best < 0 || id < bid) best = q, bid = id;
-        }
-        unpack(D->rbuf + head[best], ps, NULL, k++);
-        head[best] += REC;
-    }
-    ps->n = rn;
-    *nold = rold;
-    for (int q = 0; q < P; q++)
-        if (q != D->rank && D->scount[q]) {
-            D->migr_bytes += (uint64_t)D->scount[q];
-            D->messages++;
-        }
-}
-
 /* ---- the stages between the physics' own ---- */
 
 static int halo_pos_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
@@ -888,7 +732,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         size_t *nold;
         uint64_t *cr, *rf;
         pfsph_particles *ds = pfsph__diffuse_set(sim->st.df, &nold, &cr, &rf);
-        migrate(&D->d, ds, nold, NULL);
+        D->d.migrate(&D->d, ds, nold, NULL);
     }
     /* every rank keeps its slice: the next exchange goes on from it (the root's own particles
      * are untouched at the front of its arrays), only the clock is shared again */
@@ -920,12 +764,9 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     if (!D->scount || !D->sdispl || !D->rcount || !D->rdispl) return PFSPH_ENOMEM;
     D->d.halo = halo;
     D->d.sum = sum;
-    D->d.scan = scan;
-    D->d.any = any;
-    D->d.allsum = allsum;
+    pfsph_decomp_set_hooks(D); /* src/mpi/sets.c */
     D->d.rank = D->rank;
     D->d.nranks = D->size;
-    D->d.migrate = migrate;
     D->d.agree = agree;
     D->d.step_begin = step_begin;
     D->d.frame = frame;
