@@ -466,7 +466,12 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
         cJSON_AddNumberToObject(n, "boundary", (double)c->boundary->n);
         cJSON_AddNumberToObject(n, "removed", (double)pfsph_sim_removed(sim));
         const pfsph_particles *d = pfsph_sim_diffuse(sim);
-        if (d) cJSON_AddNumberToObject(n, "diffuse", (double)d->n);
+        if (d) {
+            uint64_t created;
+            pfsph_sim_diffuse_totals(sim, &created, NULL);
+            cJSON_AddNumberToObject(n, "diffuse", (double)d->n);
+            cJSON_AddNumberToObject(n, "diffuse_created", (double)created); /* created - live: the deaths */
+        }
         cJSON_AddNumberToObject(j, "simulated_time", pfsph_sim_time(sim));
         cJSON_AddNumberToObject(j, "steps", (double)pfsph_sim_steps(sim));
         cJSON *st = cJSON_AddObjectToObject(j, "stage_seconds");

@@ -14,48 +14,11 @@
 
 #include "core/reduce.h"
 #include "core/stage.h"
+#include "mpi/wire.h"
 #include "sim_internal.h"
-
-/* One particle on the wire: the persistent fields, the density of the step (frames), id, phase,
- * wall, bubble. A homogeneous cluster is assumed (the same byte order and pfsph_real). */
-#define REC (((PFSPH_NFIELDS + 1) * sizeof(pfsph_real) + 7 + 7) & ~(size_t)7)
 
 /* particles per message of the frame gather (its buffers: 3 MB) */
 #define GATHER_RUN ((size_t)65536)
-
-static int grow(char **buf, size_t *cap, size_t n)
-{
-    if (n <= *cap) return PFSPH_OK;
-    size_t c = n + n / 4 + 4096;
-    char *p = realloc(*buf, c);
-    if (!p) return PFSPH_ENOMEM;
-    *buf = p;
-    *cap = c;
-    return PFSPH_OK;
-}
-
-static void pack(char *o, const pfsph_particles *f, const pfsph_real *nd, size_t i)
-{
-    for (int k = 0; k < PFSPH_NFIELDS; k++) memcpy(o + k * sizeof(pfsph_real), &f->f[k][i], sizeof(pfsph_real));
-    pfsph_real v = nd ? nd[i] : 0;
-    memcpy(o + PFSPH_NFIELDS * sizeof(pfsph_real), &v, sizeof v);
-    char *t = o + (PFSPH_NFIELDS + 1) * sizeof(pfsph_real);
-    memcpy(t, &f->id[i], 4);
-    t[4] = (char)f->phase[i];
-    t[5] = (char)f->wall[i];
-    t[6] = (char)f->bubble[i];
-}
-
-static void unpack(const char *o, pfsph_particles *f, pfsph_real *nd, size_t i)
-{
-    for (int k = 0; k < PFSPH_NFIELDS; k++) memcpy(&f->f[k][i], o + k * sizeof(pfsph_real), sizeof(pfsph_real));
-    if (nd) memcpy(&nd[i], o + PFSPH_NFIELDS * sizeof(pfsph_real), sizeof(pfsph_real));
-    const char *t = o + (PFSPH_NFIELDS + 1) * sizeof(pfsph_real);
-    memcpy(&f->id[i], t, 4);
-    f->phase[i] = (uint8_t)t[4];
-    f->wall[i] = (uint8_t)t[5];
-    f->bubble[i] = (uint8_t)t[6];
-}
 
 /* The cell key of the serial sort (pfsph_grid_sort_in), UINT32_MAX for a particle it removes. */
 static uint32_t cell_key(const pfsph_grid *g, const pfsph_particles *f, size_t i)
@@ -95,6 +58,26 @@ static void share_clock(pfsph_decomp *D, pfsph_step *st)
     st->ctx->step = s.cstep;
     st->removed = (size_t)s.removed;
     st->stats = s.stats;
+}
+
+/* A resume: the root restored the bodies from the checkpoint; the others do the same with its
+ * states and its boundary order (every rank keeps every wall with bodies). */
+static int share_bodies(pfsph_decomp *D, pfsph_step *st, int nbod, pfsph_error *err)
+{
+    pfsph_particles *b = st->ctx->boundary;
+    pfsph_body_state *bs = malloc((size_t)nbod * sizeof *bs);
+    uint64_t n = b->n;
+    MPI_Bcast(&n, 1, MPI_UINT64_T, 0, D->comm);
+    uint32_t *ids = malloc((n ? n : 1) * sizeof(uint32_t));
+    if (!bs || !ids) MPI_Abort(D->comm, 1);
+    for (int i = 0; i < nbod; i++) pfsph_bodies_get_state(st->bodies, i, &bs[i]);
+    if (D->rank == 0) memcpy(ids, b->id, n * sizeof(uint32_t));
+    MPI_Bcast(bs, (int)((size_t)nbod * sizeof *bs), MPI_BYTE, 0, D->comm);
+    MPI_Bcast(ids, (int)n, MPI_UINT32_T, 0, D->comm);
+    int rc = D->rank ? pfsph_sim_restore_bodies(D->sim, nbod, bs, ids, (size_t)n, err) : PFSPH_OK;
+    free(bs);
+    free(ids);
+    return rc;
 }
 
 /* Cells [lo, hi) rank q holds: its own and those within a walk's reach of them. */
@@ -366,7 +349,31 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
         D->gathered = 0;
         share_clock(D, st);
     }
-    if (D->root_all) share_clock(D, st);
+    if (D->root_all) {
+        share_clock(D, st);
+        if (st->df) { /* a resume: the diffuse totals the root restored (the ids go on from them) */
+            size_t *nold;
+            uint64_t *cr, *rf;
+            pfsph_particles *ds = pfsph__diffuse_set(st->df, &nold, &cr, &rf);
+            uint64_t v[3] = {*cr, *rf, ds->next_id};
+            MPI_Bcast(v, 3, MPI_UINT64_T, 0, D->comm);
+            *cr = v[0];
+            *rf = v[1];
+            ds->next_id = (uint32_t)v[2];
+        }
+        /* a resume: the bodies' state and the order of the boundary particles the root restored */
+        const int nbod = pfsph_bodies_count(st->bodies);
+        int brc;
+        if (nbod && st->step > 0 && (brc = share_bodies(D, st, nbod, err))) return brc;
+        /* a resume: the ids the emitters go on from, and their state */
+        MPI_Bcast(&f->next_id, 1, MPI_UINT32_T, 0, D->comm);
+        for (int i = 0; i < pfsph_emitters_count(st->em); i++) {
+            pfsph_emitter_state es;
+            pfsph_emitters_get_state(st->em, i, &es);
+            MPI_Bcast(&es, sizeof es, MPI_BYTE, 0, D->comm);
+            if (pfsph_emitters_set_state(st->em, i, &es, st->time, err)) return PFSPH_EINPUT; /* the root's own */
+        }
+    }
     size_t lo = D->root_all ? 0 : D->d.own_lo, hi = D->root_all ? (D->rank == 0 ? f->n : 0) : D->d.own_hi;
     const size_t m = hi - lo, nc = D->ncells;
     int rc;
@@ -397,6 +404,8 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     D->d.own_lo = (size_t)(D->gofs[D->rank] - D->lofs[D->rank]);
     D->d.own_hi = (size_t)(D->gofs[D->rank + 1] - D->lofs[D->rank]);
     D->d.nglobal = (size_t)total;
+    D->d.cell_lo = D->cut[D->rank];
+    D->d.cell_hi = D->cut[D->rank + 1];
     D->root_all = 0;
     /* figures */
     const size_t own = D->d.own_hi - D->d.own_lo;
@@ -648,7 +657,13 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
                           D->wall_bytes,
                           D->resident_max,
                           0,
+                          0,
                           0};
+    if (D->sim->st.df) {
+        size_t *no;
+        uint64_t *cr, *rf;
+        mine.diffuse = pfsph__diffuse_set(D->sim->st.df, &no, &cr, &rf)->n;
+    }
     struct rusage ru;
     if (getrusage(RUSAGE_SELF, &ru) == 0) mine.peak_rss_kb = (uint64_t)ru.ru_maxrss;
     FILE *sm = fopen("/proc/self/statm", "r");
@@ -660,7 +675,9 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
-    const size_t lo = D->d.own_lo, m = D->d.own_hi - D->d.own_lo, N = D->d.nglobal;
+    /* the last rank's owned particles end with those the emitters added since the sort (they
+     * follow every other in the global order, and have no cell of the sort) */
+    const size_t lo = D->d.own_lo, m = D->d.own_hi - D->d.own_lo, N = D->d.nglobal, N0 = D->gofs[D->size];
     uint32_t *key = realloc(D->key, (m ? m : 1) * sizeof(uint32_t));
     if (!key) MPI_Abort(D->comm, 1); /* the root waits in the gather */
     D->key = key;
@@ -676,7 +693,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         kdispl[q] = (int)D->gofs[q];
     }
     if (D->rank == 0 && !(allkey = malloc((N ? N : 1) * sizeof(uint32_t)))) MPI_Abort(D->comm, 1);
-    MPI_Gatherv(key, (int)m, MPI_UINT32_T, allkey, kcount, kdispl, MPI_UINT32_T, 0, D->comm);
+    MPI_Gatherv(key, kcount[D->rank], MPI_UINT32_T, allkey, kcount, kdispl, MPI_UINT32_T, 0, D->comm);
     /* the particles, rank by rank in runs of at most GATHER_RUN through one bounded buffer: no
      * copy of the whole fluid besides the root's arrays. The root's own particles are already in
      * their global places (its slice starts at global index 0). */
@@ -690,17 +707,19 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         if (sim->st.reserve(&sim->st, N, err)) MPI_Abort(D->comm, 1);
         if (keep) memcpy(c->nd, keep, own * sizeof(pfsph_real));
         free(keep);
-        for (int q = 1; q < D->size; q++)
-            for (uint64_t o = D->gofs[q]; o < D->gofs[q + 1]; o += GATHER_RUN) {
-                const size_t k = D->gofs[q + 1] - o < GATHER_RUN ? (size_t)(D->gofs[q + 1] - o) : GATHER_RUN;
+        for (int q = 1; q < D->size; q++) {
+            const uint64_t e = q == D->size - 1 ? N : D->gofs[q + 1];
+            for (uint64_t o = D->gofs[q]; o < e; o += GATHER_RUN) {
+                const size_t k = e - o < GATHER_RUN ? (size_t)(e - o) : GATHER_RUN;
                 MPI_Recv(D->rbuf, (int)(k * REC), MPI_BYTE, q, 30, D->comm, MPI_STATUS_IGNORE);
                 for (size_t i = 0; i < k; i++) unpack(D->rbuf + i * REC, f, c->nd, (size_t)o + i);
             }
+        }
         D->root_own_hi = own;
         f->n = N;
         uint32_t *start = c->grid->start;
         memset(start, 0, (D->ncells + 1) * sizeof(uint32_t));
-        for (size_t i = 0; i < N; i++) start[allkey[i] + 1]++;
+        for (size_t i = 0; i < N0; i++) start[allkey[i] + 1]++;
         for (size_t k = 0; k < D->ncells; k++) start[k + 1] += start[k];
         free(allkey);
         D->d.own_lo = 0;
@@ -711,6 +730,14 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
             for (size_t i = 0; i < k; i++) pack(D->sbuf + i * REC, f, c->nd, lo + o + i);
             MPI_Send(D->sbuf, (int)(k * REC), MPI_BYTE, 0, 30, D->comm);
         }
+    }
+    /* the diffuse particles, in the serial order, to the root, which keeps them: the next
+     * step's diffuse stage sends each to the owner of its cell again */
+    if (sim->st.df) {
+        size_t *nold;
+        uint64_t *cr, *rf;
+        pfsph_particles *ds = pfsph__diffuse_set(sim->st.df, &nold, &cr, &rf);
+        D->d.migrate(&D->d, ds, nold, NULL);
     }
     /* every rank keeps its slice: the next exchange goes on from it (the root's own particles
      * are untouched at the front of its arrays), only the clock is shared again */
@@ -743,6 +770,9 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.halo = halo;
     D->d.sum = sum;
     D->d.count = count;
+    pfsph_decomp_set_hooks(D); /* src/mpi/sets.c */
+    D->d.rank = D->rank;
+    D->d.nranks = D->size;
     D->d.agree = agree;
     D->d.step_begin = step_begin;
     D->d.frame = frame;

@@ -26,6 +26,7 @@ typedef struct pfsph_mpi_fig {
     uint64_t resident_max;                                           /* fluid (own + halo) + walls, most */
     uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
     uint64_t rss_kb;      /* its resident memory at the frame */
+    uint64_t diffuse;     /* diffuse particles it held at the frame (before the gather) */
 } pfsph_mpi_fig;
 
 typedef struct pfsph_decomp {
@@ -64,6 +65,8 @@ typedef struct pfsph_decomp {
 int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm);
 /* The frame gather: every rank's owned particles to the root, in the serial order. */
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err);
+/* The hooks of src/mpi/sets.c: scan, any, allsum, migrate. */
+void pfsph_decomp_set_hooks(pfsph_decomp *D);
 /* Broadcast a command from the root. */
 void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c);
 

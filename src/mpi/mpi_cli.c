@@ -46,16 +46,13 @@ int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
     const char *solver = pfsph_scene_solver_name(s);
     if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph") && strcmp(solver, "dfsph") && strcmp(solver, "iisph"))
         no = "this solver", key = "$.solver.type";
-    else if (s->diffuse.enabled) no = "diffuse particles", key = "$.diffuse";
-    else if (s->nbodies) no = "rigid or keyframed bodies", key = "$.bodies";
-    else if (s->nemitters) no = "emitters", key = "$.emitters";
     else if (g_size > 64) no = "more than 64 ranks", key = "mpirun -np";
     if (!no) return PFSPH_OK;
     return pfsph_fail(err, PFSPH_EINPUT,
-                      "%s: %s: %s%s%s not supported under MPI yet (%d ranks; docs/cluster.md lists what is): run it "
+                      "%s: %s: %s%s%s%s not supported under MPI yet (%d ranks; docs/cluster.md lists what is): run it "
                       "with one process",
                       s->source, key, no, !strcmp(no, "this solver") ? " \"" : "",
-                      !strcmp(no, "this solver") ? solver : "", g_size);
+                      !strcmp(no, "this solver") ? solver : "", !strcmp(no, "this solver") ? "\"" : "", g_size);
 }
 
 static void report(pfsph_dist *d, void *json)
@@ -95,6 +92,7 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(r, "wall_window_fetches", (double)f->wall_fetches);
         cJSON_AddNumberToObject(r, "wall_bytes_sent", (double)f->wall_bytes);
         cJSON_AddNumberToObject(r, "resident_particles_max", (double)f->resident_max);
+        cJSON_AddNumberToObject(r, "diffuse_held_at_frame", (double)f->diffuse);
         cJSON_AddNumberToObject(r, "rss_mib_at_last_frame", (double)f->rss_kb / 1024.0);
         cJSON_AddNumberToObject(r, "peak_rss_mib", (double)f->peak_rss_kb / 1024.0);
         cJSON_AddItemToArray(ranks, r);

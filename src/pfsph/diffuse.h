@@ -40,6 +40,10 @@ void pfsph_diffuse_totals(const pfsph_diffuse *d, uint64_t *created, uint64_t *r
  * ps is copied, ids and next_id included. Returns PFSPH_OK, PFSPH_ENOMEM, or PFSPH_EINPUT when
  * ps holds more than max_particles or an unknown type. */
 int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created, uint64_t refused);
+/* A distributed run's side (src/mpi/, docs/cluster.md): the live set, the count of its first
+ * part (the particles of the last sort; the rest are the step's new ones, in id order), and the
+ * run's totals (the same on every rank). */
+pfsph_particles *pfsph__diffuse_set(pfsph_diffuse *d, size_t **nold, uint64_t **created, uint64_t **refused);
 
 /* Insert a diffuse particle (tests, restarts). Returns its index or -1 (cap or ENOMEM). */
 long pfsph_diffuse_add(pfsph_diffuse *d, const pfsph_real x[3], const pfsph_real v[3], int type, pfsph_real lifetime);

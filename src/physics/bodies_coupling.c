@@ -7,7 +7,21 @@
 #include <math.h>
 #include <string.h>
 
+#include "pfsph/dist.h"
 #include "physics/bodies_internal.h"
+
+/* Whether this rank owns the fluid grid cell of boundary particle j (clamped into the grid). */
+static bool owns(const pfsph_grid *g, const pfsph_dist *D, const pfsph_particles *b, size_t j)
+{
+    const pfsph_real p[3] = {b->x[j], b->y[j], b->z[j]};
+    size_t c[3] = {0, 0, 0};
+    for (int a = 0; a < g->dim; a++) {
+        pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
+        c[a] = !(t > 0) ? 0 : (t >= (pfsph_real)g->nc[a] ? (size_t)g->nc[a] - 1 : (size_t)t);
+    }
+    const size_t key = (c[2] * (size_t)g->nc[1] + c[1]) * (size_t)g->nc[0] + c[0];
+    return key >= D->cell_lo && key < D->cell_hi;
+}
 
 void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsph_real *p)
 {
@@ -30,10 +44,15 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
     memset(B->fp, 0, 3 * (size_t)B->np * sizeof(double));
     const double amp = pfsph__thermo_amp(ctx);
     const uint64_t wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
+    pfsph_dist *D = ctx->dist;
 #pragma omp parallel for schedule(static)
     for (size_t j = 0; j < nb; j++) {
         if (b->id[j] < first) continue;
         const uint32_t l = b->id[j] - first;
+        if (D && !owns(ctx->grid, D, b, j)) { /* another rank's: its fluid is there (below) */
+            B->fp[3 * l] = B->fp[3 * l + 1] = B->fp[3 * l + 2] = -0.0;
+            continue;
+        }
         const pfsph_real xj = b->x[j], yj = b->y[j], zj = b->z[j], vol = b->aux[j];
         double fx = 0, fy = 0, fz = 0, tx = 0, ty = 0, tz = 0;
         pfsph_ranges r;
@@ -99,6 +118,9 @@ void pfsph_bodies_fluid_forces(pfsph_bodies *B, const pfsph_ctx *ctx, const pfsp
         B->fp[3 * l + 1] = fy;
         B->fp[3 * l + 2] = fz;
     }
+    /* distributed: each body particle's force from the rank that owns its cell, whose halo
+     * holds every fluid particle its walks reach; -0.0 from the others adds nothing */
+    if (D) D->allsum(D, B->fp, 3 * (size_t)B->np);
     /* sums in id order: the same bits for any thread count and particle order */
     for (int i = 0; i < B->nb; i++) {
         body *bd = &B->b[i];

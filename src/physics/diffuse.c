@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "pfsph/rng.h"
 #include "physics/stages.h"
 
@@ -24,6 +25,9 @@ struct pfsph_diffuse {
     bool liquid[PFSPH_MAX_PHASES]; /* fluid phases that emit and couple (gas phases do not) */
     bool all_liquid;               /* no gas phase: the per-neighbour phase test can go */
     pfsph_particles ps;
+    /* [0, nold): the particles of the last step's sort that stayed; [nold, n): the step's new
+     * ones, in id order. Only a distributed run reads it (the global order, docs/cluster.md). */
+    size_t nold;
     uint64_t created, refused;
     uint32_t *emit; /* per fluid particle: count, then exclusive prefix (scratch) */
     size_t emit_cap;
@@ -41,6 +45,8 @@ struct pfsph_diffuse {
     size_t perm_cap;
     void *tmp; /* permutation scratch, 4 bytes per diffuse particle */
     size_t tmp_cap;
+    uint32_t *mkey; /* per diffuse particle: its cell, for a distributed run's exchange */
+    size_t mkey_cap;
 };
 
 int pfsph_diffuse_create(pfsph_diffuse **out, const pfsph_ctx *ctx, pfsph_error *err)
@@ -79,6 +85,7 @@ void pfsph_diffuse_destroy(pfsph_diffuse *d)
     free(d->perm2);
     free(d->key2);
     free(d->tmp);
+    free(d->mkey);
     free(d);
 }
 
@@ -168,6 +175,7 @@ static inline double kinetic_energy(const pfsph_diffuse *d, const pfsph_ctx *ctx
 }
 
 static int prepare_old(pfsph_diffuse *d, const pfsph_ctx *ctx);
+static void distribute(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t from);
 
 void pfsph_diffuse_potentials(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t i, double *v_diff, double *energy,
                               double *rate)
@@ -431,61 +439,75 @@ static void compact(pfsph_diffuse *d)
 
 /* Algorithm 1 lines 12-17. Counts per emitter in parallel, an exclusive prefix in fluid order
  * (deterministic: the grid order is), then each emitter writes its own slots. New ids follow
- * the slots. Beyond max_particles the rest is refused (later emitters in fluid order first). */
+ * the slots. Beyond max_particles the rest is refused (later emitters in fluid order first).
+ * Distributed: each rank's emitters are its owned fluid particles, a slice of the fluid order,
+ * so the slots, ids and the cap follow from the counts' prefix over the ranks; every rank takes
+ * the same branches (global counts), and the new particles go to the owners of their cells
+ * before they are labelled (the labels read the fluid around them). */
 static void generate(pfsph_diffuse *d, const pfsph_ctx *ctx)
 {
     const pfsph_particles *f = ctx->fluid;
-    const long nf = (long)f->n;
-    size_t room = (size_t)d->p.max_particles > d->ps.n ? (size_t)d->p.max_particles - d->ps.n : 0;
+    pfsph_dist *D = ctx->dist;
+    size_t lo, hi;
+    pfsph__owned(ctx, &lo, &hi);
+    const uint64_t nmine = d->ps.n;
+    uint64_t nall = nmine, nbefore = 0; /* the live particles of all ranks */
+    if (D) D->scan(D, &nmine, 1, &nbefore, &nall);
+    size_t room = (uint64_t)d->p.max_particles > nall ? (size_t)((uint64_t)d->p.max_particles - nall) : 0;
     /* At the cap nothing can be created: skip the potentials (refusals are then not counted). */
-    if (nf == 0 || d->p.sampling_rate <= 0 || room == 0) return;
+    if (pfsph__fluid_count(ctx) == 0 || d->p.sampling_rate <= 0 || room == 0) return;
     bool ok;
     uint32_t *cnt = d->lent_emit;
     if (!cnt) {
-        d->emit = ensure(d->emit, &d->emit_cap, (size_t)nf, sizeof(uint32_t), &ok);
+        d->emit = ensure(d->emit, &d->emit_cap, f->n, sizeof(uint32_t), &ok);
         if (!ok) return;
         cnt = d->emit;
     }
 #pragma omp parallel for schedule(dynamic, 512)
-    for (long i = 0; i < nf; i++) cnt[i] = emit_count(d, ctx, (size_t)i);
+    for (long i = (long)lo; i < (long)hi; i++) cnt[i] = emit_count(d, ctx, (size_t)i);
     uint64_t total = 0;
-    for (long i = 0; i < nf; i++) {
+    for (size_t i = lo; i < hi; i++) {
         uint32_t c = cnt[i];
         cnt[i] = (uint32_t)(total < UINT32_MAX ? total : UINT32_MAX);
         total += c;
     }
-    if (total == 0) return;
-    size_t add = total < room ? (size_t)total : room;
-    d->refused += total - add;
-    if (add == 0) return;
+    uint64_t before = 0, all = total; /* this rank's emissions: [before, before + total) of all */
+    if (D) D->scan(D, &total, 1, &before, &all);
+    if (all == 0) return;
+    const size_t addg = all < room ? (size_t)all : room;
+    d->refused += all - addg;
+    const size_t add = before >= addg ? 0 : (addg - before < total ? (size_t)(addg - before) : (size_t)total);
     size_t base = d->ps.n;
     if (base + add > d->ps.cap) {
         size_t c = d->ps.cap ? d->ps.cap : 1024;
         while (c < base + add) c *= 2;
         if (pfsph_particles_reserve(&d->ps, c) != PFSPH_OK) {
+            if (D) abort(); /* the ids of the other ranks' would no longer follow */
             d->refused += add;
             return;
         }
     }
 #pragma omp parallel for schedule(dynamic, 512)
-    for (long i = 0; i < nf; i++) {
-        uint32_t b = cnt[i], e = i + 1 < nf ? cnt[i + 1] : (uint32_t)total;
+    for (long i = (long)lo; i < (long)hi; i++) {
+        uint32_t b = cnt[i], e = i + 1 < (long)hi ? cnt[i + 1] : (uint32_t)total;
         for (uint32_t k = 0; b + k < e && (size_t)(b + k) < add; k++) emit_one(d, ctx, (size_t)i, k, base + b + k);
     }
     pfsph_particles *ps = &d->ps;
+    for (size_t s = 0; s < add; s++) ps->id[base + s] = ps->next_id + (uint32_t)(before + s);
+    ps->next_id += (uint32_t)addg;
+    ps->n = base + add;
+    d->created += addg;
+    d->nold = base;
+    distribute(d, ctx, base);
     /* Label the new particles at their own position (current fluid positions; the next step
      * reclassifies with the exact start-of-step ones). */
+    base = d->nold;
 #pragma omp parallel for schedule(dynamic, 256)
-    for (long s = 0; s < (long)add; s++) {
-        size_t q = base + (size_t)s;
+    for (long q = (long)base; q < (long)ps->n; q++) {
         const pfsph_real xd[3] = {ps->x[q], ps->y[q], ps->z[q]};
         double sw, sv[3];
         ps->phase[q] = (uint8_t)classify(d, fluid_sample(d, ctx, xd, false, &sw, sv));
-        ps->id[q] = ps->next_id + (uint32_t)s;
     }
-    ps->next_id += (uint32_t)add;
-    ps->n = base + add;
-    d->created += add;
 }
 
 static int prepare_old(pfsph_diffuse *d, const pfsph_ctx *ctx)
@@ -521,6 +543,34 @@ static int prepare_old(pfsph_diffuse *d, const pfsph_ctx *ctx)
     return PFSPH_OK;
 }
 
+/* The fluid grid cell of diffuse particle i, clamped into the grid (the spatial sort's key, and
+ * under MPI the cell whose owner takes the particle). */
+static inline uint32_t cell_of(const pfsph_grid *g, const pfsph_particles *ps, size_t i)
+{
+    const pfsph_real p[3] = {ps->x[i], ps->y[i], ps->z[i]};
+    size_t c[3] = {0, 0, 0};
+    for (int a = 0; a < g->dim; a++) {
+        pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
+        c[a] = !(t > 0) ? 0 : (t >= (pfsph_real)g->nc[a] ? (size_t)g->nc[a] - 1 : (size_t)t);
+    }
+    return (uint32_t)((c[2] * (size_t)g->nc[1] + c[1]) * (size_t)g->nc[0] + c[0]);
+}
+
+/* A distributed run (docs/cluster.md): the particles [from, n) go to the rank that owns their
+ * cell of the step's cut, those before `from` stay; the set then keeps the serial order's slice
+ * (ps.n and nold change). Serial: nothing. */
+static void distribute(pfsph_diffuse *d, const pfsph_ctx *ctx, size_t from)
+{
+    pfsph_dist *D = ctx->dist;
+    if (!D) return;
+    pfsph_particles *ps = &d->ps;
+    bool ok;
+    d->mkey = ensure(d->mkey, &d->mkey_cap, ps->n ? ps->n : 1, sizeof(uint32_t), &ok);
+    if (!ok) abort(); /* the other ranks wait in the exchange: nothing sensible is left */
+    for (size_t i = 0; i < ps->n; i++) d->mkey[i] = i < from ? UINT32_MAX : cell_of(ctx->grid, ps, i);
+    D->migrate(D, ps, &d->nold, d->mkey);
+}
+
 /* Order the diffuse set by fluid grid cell (stable counting sort), so that neighbouring diffuse
  * particles read the same fluid cells: the coupling loop then walks memory nearly in order.
  * Deterministic; ids travel with their particles. */
@@ -541,13 +591,7 @@ static void sort_spatially(pfsph_diffuse *d, const pfsph_grid *g)
     d->perm_cap = pc;
 #pragma omp parallel for schedule(static)
     for (long i = 0; i < (long)n; i++) {
-        const pfsph_real p[3] = {ps->x[i], ps->y[i], ps->z[i]};
-        size_t c[3] = {0, 0, 0};
-        for (int a = 0; a < g->dim; a++) {
-            pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
-            c[a] = !(t > 0) ? 0 : (t >= (pfsph_real)g->nc[a] ? (size_t)g->nc[a] - 1 : (size_t)t);
-        }
-        d->key[i] = (uint32_t)((c[2] * (size_t)g->nc[1] + c[1]) * (size_t)g->nc[0] + c[0]);
+        d->key[i] = cell_of(g, ps, (size_t)i);
         d->perm[i] = (uint32_t)i;
     }
     /* A stable LSD radix sort, a byte of the cell key a pass: the order of a stable counting
@@ -588,12 +632,30 @@ void pfsph_diffuse_step(pfsph_diffuse *d, const pfsph_ctx *ctx)
 {
     if (!d || !ctx || !ctx->fluid || !ctx->grid || !(ctx->dt > 0)) return;
     bool ok;
+    if (ctx->dist) {
+        /* the integrator moved the owned particles only: the halo's positions and velocities
+         * at t + dt, which the walks below read */
+        pfsph_particles *f = ctx->fluid;
+        pfsph_real *const a[6] = {f->x, f->y, f->z, f->vx, f->vy, f->vz};
+        pfsph__halo(ctx, a, 6);
+    }
+    if (prepare_old(d, ctx) != PFSPH_OK) return;
+    distribute(d, ctx, 0); /* each particle to the owner of its cell */
     d->keep = ensure(d->keep, &d->keep_cap, d->ps.n, 1, &ok);
-    if (!ok || prepare_old(d, ctx) != PFSPH_OK) return;
+    if (!ok) return;
     sort_spatially(d, ctx->grid);
     advect(d, ctx);
     compact(d);
+    d->nold = d->ps.n;
     generate(d, ctx);
+}
+
+pfsph_particles *pfsph__diffuse_set(pfsph_diffuse *d, size_t **nold, uint64_t **created, uint64_t **refused)
+{
+    *nold = &d->nold;
+    *created = &d->created;
+    *refused = &d->refused;
+    return &d->ps;
 }
 
 int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t created, uint64_t refused)
@@ -609,6 +671,7 @@ int pfsph_diffuse_import(pfsph_diffuse *d, const pfsph_particles *ps, uint64_t c
         memcpy(d->ps.id, ps->id, ps->n * sizeof(uint32_t));
     }
     d->ps.n = ps->n;
+    d->nold = ps->n;
     d->ps.next_id = ps->next_id;
     d->created = created;
     d->refused = refused;

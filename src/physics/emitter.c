@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pfsph/dist.h"
 #include "physics/stages.h"
 
 /* Closer than this to a particle already there, a site is skipped for the layer: the issue's
@@ -29,6 +30,8 @@ struct pfsph_emitters {
     nozzle *z;
     uint32_t *near; /* indices of particles near a nozzle: grown geometrically, kept */
     size_t near_cap;
+    uint8_t *blocked; /* per site of the step's layers: a particle stands in the way */
+    size_t blocked_cap;
 };
 
 static double lat(double d, long k) { return ((double)k + 0.5) * d; }
@@ -145,6 +148,7 @@ void pfsph_emitters_destroy(pfsph_emitters *em)
     for (int i = 0; i < em->n && em->z; i++) free(em->z[i].site);
     free(em->z);
     free(em->near);
+    free(em->blocked);
     free(em);
 }
 
@@ -190,10 +194,10 @@ size_t pfsph_emitters_due(const pfsph_emitters *em, double t0, double dt)
 
 /* Indices of the particles in the box [lo - r, hi + r], into em->near (grown when needed). */
 static size_t gather(pfsph_emitters *em, const pfsph_particles *f, int dim, const double *lo, const double *hi,
-                     double r)
+                     double r, size_t j0, size_t j1)
 {
     size_t m = 0;
-    for (size_t j = 0; j < f->n; j++) {
+    for (size_t j = j0; j < j1; j++) {
         const double x[3] = {f->x[j], f->y[j], f->z[j]};
         int in = 1;
         for (int a = 0; a < dim && in; a++) in = x[a] >= lo[a] - r && x[a] <= hi[a] + r;
@@ -216,7 +220,8 @@ static size_t gather(pfsph_emitters *em, const pfsph_particles *f, int dim, cons
  * particle standing in front of the nozzle (a pool risen to it, gas in a tube that a bubble is
  * blown from) would block its sites for good; with it the inlet pushes the way clear, as the
  * pressure behind a real nozzle does. Returns the particles set. */
-static size_t push_inlet(const nozzle *z, pfsph_particles *f, int dim, double d, const pfsph_real *v)
+static size_t push_inlet(const nozzle *z, pfsph_particles *f, int dim, double d, const pfsph_real *v, size_t j0,
+                         size_t j1)
 {
     const int a = z->p.axis;
     const double sgn = z->p.direction[a] > 0 ? 1 : -1, vn = (double)v[a] * sgn;
@@ -227,7 +232,7 @@ static size_t push_inlet(const nozzle *z, pfsph_particles *f, int dim, double d,
     const double half1 = z->p.shape == PFSPH_NOZZLE_DISC ? z->p.radius : 0.5 * z->p.size[1];
     const double m = 0.5 * d;
     size_t set = 0;
-    for (size_t j = 0; j < f->n; j++) {
+    for (size_t j = j0; j < j1; j++) {
         const double x[3] = {f->x[j], f->y[j], f->z[j]};
         double along = (x[a] - z->p.center[a]) * sgn;
         if (!(along >= -0.5 * d && along < d)) continue;
@@ -246,20 +251,32 @@ static size_t push_inlet(const nozzle *z, pfsph_particles *f, int dim, double d,
     return set;
 }
 
+/* Distributed (docs/cluster.md): each rank pushes and looks for particles in the way among
+ * those it owns (the last rank: and those it took this step), the sites' flags are or-ed over
+ * the ranks, and the last rank alone appends the new particles: in the global order they follow
+ * every other, as serially they follow the whole array. Every rank counts the same. */
 size_t pfsph_emitters_step(pfsph_emitters *em, pfsph_particles *f, const pfsph_ctx *ctx, double t0, double dt,
                            double *vmax_in)
 {
     *vmax_in = 0;
     if (!em) return 0;
+    pfsph_dist *D = ctx->dist;
+    const bool takes = !D || D->rank == D->nranks - 1;
+    const size_t j0 = D ? D->own_lo : 0;
     const int dim = ctx->dim;
     const double d = (double)ctx->spacing, gap2 = EMIT_MIN_GAP * EMIT_MIN_GAP * d * d;
     size_t added = 0;
     for (int i = 0; i < em->n; i++) {
         nozzle *z = &em->z[i];
+        const size_t j1 = takes ? f->n : D->own_hi;
         const pfsph_real v[3] = {(pfsph_real)(z->info.speed * z->p.direction[0]),
                                  (pfsph_real)(z->info.speed * z->p.direction[1]),
                                  (pfsph_real)(z->info.speed * z->p.direction[2])};
-        if (open_for(z, t0, t0 + dt) > 0) z->st.pushed += push_inlet(z, f, dim, d, v);
+        if (open_for(z, t0, t0 + dt) > 0) {
+            uint64_t set = push_inlet(z, f, dim, d, v, j0, j1), before;
+            if (D) D->scan(D, &(uint64_t){set}, 1, &before, &set);
+            z->st.pushed += set;
+        }
         double debt = owed(z, t0, dt);
         if (debt < 1) {
             z->st.debt = debt;
@@ -273,33 +290,55 @@ size_t pfsph_emitters_step(pfsph_emitters *em, pfsph_particles *f, const pfsph_c
             lo[a] = z->lo[a] + fmin(0, far);
             hi[a] = z->hi[a] + fmax(0, far);
         }
-        size_t m = gather(em, f, dim, lo, hi, EMIT_MIN_GAP * d);
+        size_t m = gather(em, f, dim, lo, hi, EMIT_MIN_GAP * d, j0, j1);
         if (m == SIZE_MAX) m = 0; /* out of memory for the list: nothing blocks (rare) */
-        const pfsph_real rho0 = ctx->rest_density[z->p.phase];
+        const size_t ns = z->info.sites, nflag = (size_t)layers * ns;
+        if (nflag > em->blocked_cap) {
+            uint8_t *q = realloc(em->blocked, nflag);
+            if (!q) abort(); /* a few bytes a site: nothing sensible is left */
+            em->blocked = q;
+            em->blocked_cap = nflag;
+        }
+        /* the sites in the way first (the list holds no particle of this nozzle's step) */
+        double deb = debt;
         for (long l = 0; l < layers; l++) {
-            debt -= 1;
-            /* this layer crossed the exit plane `debt` layers of travel ago */
-            const double off = debt;
-            for (size_t s = 0; s < z->info.sites; s++) {
-                double x[3];
-                for (int a = 0; a < 3; a++) x[a] = z->site[3 * s + a] + off * z->step[a];
-                pfsph_real xr[3] = {(pfsph_real)x[0], (pfsph_real)x[1], (pfsph_real)x[2]};
-                int blocked = 0;
+            deb -= 1;
+            /* this layer crossed the exit plane `deb` layers of travel ago */
+            for (size_t s = 0; s < ns; s++) {
+                pfsph_real xr[3];
+                for (int a = 0; a < 3; a++) xr[a] = (pfsph_real)(z->site[3 * s + a] + deb * z->step[a]);
+                uint8_t blocked = 0;
                 for (size_t q = 0; q < m && !blocked; q++) {
                     const uint32_t j = em->near[q];
                     double dx = (double)f->x[j] - (double)xr[0], dy = (double)f->y[j] - (double)xr[1],
                            dz = (double)f->z[j] - (double)xr[2];
                     blocked = dx * dx + dy * dy + dz * dz < gap2;
                 }
-                if (blocked || f->n == f->cap) { /* the caller reserved room: full means a bug, refuse */
+                em->blocked[(size_t)l * ns + s] = blocked;
+            }
+        }
+        if (D) D->any(D, em->blocked, nflag);
+        const pfsph_real rho0 = ctx->rest_density[z->p.phase];
+        for (long l = 0; l < layers; l++) {
+            debt -= 1;
+            const double off = debt;
+            for (size_t s = 0; s < ns; s++) {
+                pfsph_real xr[3];
+                for (int a = 0; a < 3; a++) xr[a] = (pfsph_real)(z->site[3 * s + a] + off * z->step[a]);
+                /* the caller reserved room: full means a bug, refuse */
+                if (em->blocked[(size_t)l * ns + s] || (takes && f->n == f->cap)) {
                     z->st.refused++;
                     continue;
                 }
-                long k = pfsph_particles_push(f, xr, v, (uint8_t)z->p.phase);
-                f->rho[k] = rho0;
-                /* blown gas joins its bubble: the next film stage counts it in the bubble's
-                 * detection group, so the film spreads over the grown surface */
-                f->bubble[k] = (uint8_t)z->p.bubble;
+                if (takes) {
+                    long k = pfsph_particles_push(f, xr, v, (uint8_t)z->p.phase);
+                    f->rho[k] = rho0;
+                    /* blown gas joins its bubble: the next film stage counts it in the bubble's
+                     * detection group, so the film spreads over the grown surface */
+                    f->bubble[k] = (uint8_t)z->p.bubble;
+                } else {
+                    f->next_id++; /* the ids the last rank gives */
+                }
                 z->st.emitted++;
                 added++;
             }
@@ -352,8 +391,13 @@ static int emit_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error 
     int rc = st->reserve(st, f->n + due, err);
     if (rc) return rc;
     double vin = 0;
-    pfsph_emitters_step(st->em, f, st->ctx, st->time, st->ctx->dt, &vin);
+    const size_t added = pfsph_emitters_step(st->em, f, st->ctx, st->time, st->ctx->dt, &vin);
     if (vin > st->stats.vmax) st->stats.vmax = vin;
+    pfsph_dist *D = st->ctx->dist;
+    if (D) { /* the last rank owns the new particles (it holds no halo behind its own) */
+        D->nglobal += added;
+        if (D->rank == D->nranks - 1) D->own_hi = f->n;
+    }
     return PFSPH_OK;
 }
 

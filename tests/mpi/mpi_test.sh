@@ -12,6 +12,8 @@
 #                                          every step): some rank holds fewer walls than the scene,
 #                                          the root sent some windows, the fluid and walls a rank
 #                                          holds stay under 1.5 N / NP + halo + walls of the scene
+#   mpi_test.sh diffuse SCENE END NP...   as compare, and the run made diffuse particles, some
+#                                          died, and a rank other than the root held some
 #   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
 #                                          STATUS (default 2) from mpirun
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
@@ -36,7 +38,7 @@ mpi() { # NP args...
     "$MPIRUN" $ROOTOPT --oversubscribe -np "$np" "$BIN" "$@"
 }
 
-same() { # DIR_A DIR_B: frames and stats.csv byte for byte
+same() { # DIR_A DIR_B: frames, stats.csv (and bodies.csv) byte for byte
     if ! diff -r "$1/frames" "$2/frames" >/dev/null; then
         echo "FAIL: $1/frames and $2/frames differ:"
         diff -rq "$1/frames" "$2/frames" | head -5
@@ -45,6 +47,11 @@ same() { # DIR_A DIR_B: frames and stats.csv byte for byte
     if ! cmp -s "$1/stats.csv" "$2/stats.csv"; then
         echo "FAIL: $1/stats.csv and $2/stats.csv differ:"
         diff "$1/stats.csv" "$2/stats.csv" | head -6
+        return 1
+    fi
+    if [ -f "$1/bodies.csv" ] && ! cmp -s "$1/bodies.csv" "$2/bodies.csv"; then
+        echo "FAIL: $1/bodies.csv and $2/bodies.csv differ:"
+        diff "$1/bodies.csv" "$2/bodies.csv" | head -6
         return 1
     fi
     n=$(ls "$1/frames" | wc -l)
@@ -62,6 +69,25 @@ compare)
         [ "$np" = 1 ] || grep -q '"ranks":' "$TMP/np$np/summary.json" ||
             { echo "FAIL: no per-rank figures in summary.json"; exit 1; }
     done
+    ;;
+diffuse)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    live=$(grep -Eo '"diffuse":[[:space:]]*[0-9]+' "$TMP/serial/summary.json" | head -n 1 | grep -Eo '[0-9]+$')
+    made=$(grep -Eo '"diffuse_created":[[:space:]]*[0-9]+' "$TMP/serial/summary.json" | grep -Eo '[0-9]+$')
+    [ "${live:-0}" -gt 0 ] && [ "${made:-0}" -gt "$live" ] ||
+        { echo "FAIL: the scene must make diffuse particles and see some die ($made made, $live live)"; exit 1; }
+    for np in "$@"; do
+        mpi "$np" run "$scene" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        [ "$np" = 1 ] && continue
+        awk -F'[:,]' '/"rank":/ { r = $2 + 0 } /"diffuse_held_at_frame":/ { if (r > 0) h += $2 }
+            END { if (!h) { print "FAIL: only the root held diffuse particles"; exit 1 }
+                  printf "ok: ranks 1.. held %d diffuse particles at the last frame\n", h }' \
+            "$TMP/np$np/summary.json" || exit 1
+    done
+    echo "ok: $made diffuse particles made, $live live at the end"
     ;;
 cutcheck)
     scene=$SRC/$1 end=$2
