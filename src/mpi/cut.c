@@ -32,6 +32,12 @@ static void cut_from_prefix(pfsph_cut *C, const uint64_t *pre, size_t nc, int si
     C->gofs[size] = total;
 }
 
+/* A window of cells [s, e) counted exactly: F(k), the particles before cell k, for k in [s, e]. */
+typedef struct window {
+    uint64_t s, e, Fs;
+    uint32_t *cnt;
+} window;
+
 int pfsph_cut_init(pfsph_cut *C, int size, uint64_t buckets)
 {
     memset(C, 0, sizeof *C);
@@ -45,7 +51,11 @@ int pfsph_cut_init(pfsph_cut *C, int size, uint64_t buckets)
     C->cnt_cap = (size_t)C->buckets + 2;
     C->cnt = malloc(C->cnt_cap * sizeof(uint32_t));
     C->pre = malloc(((size_t)C->buckets + 1) * sizeof(uint64_t));
-    if (!C->cut || !C->gofs || !C->lofs || !C->lend || !C->cnt || !C->pre) return PFSPH_ENOMEM;
+    C->win = calloc(3 * P, sizeof(window));
+    C->a_q = calloc(P, sizeof(uint64_t));
+    C->b_q = calloc(P, sizeof(uint64_t));
+    if (!C->cut || !C->gofs || !C->lofs || !C->lend || !C->cnt || !C->pre || !C->win || !C->a_q || !C->b_q)
+        return PFSPH_ENOMEM;
     return PFSPH_OK;
 }
 
@@ -57,6 +67,9 @@ void pfsph_cut_free(pfsph_cut *C)
     free(C->lend);
     free(C->cnt);
     free(C->pre);
+    free(C->win);
+    free(C->a_q);
+    free(C->b_q);
     free(C->sorted);
     free(C->tmp);
     memset(C, 0, sizeof *C);
@@ -87,12 +100,6 @@ static size_t lower_bound(const uint32_t *a, size_t m, uint64_t v)
     }
     return lo;
 }
-
-/* A window of cells [s, e) counted exactly: F(k), the particles before cell k, for k in [s, e]. */
-typedef struct window {
-    uint64_t s, e, Fs;
-    uint32_t *cnt;
-} window;
 
 static uint64_t F_at(const window *W, uint64_t k)
 {
@@ -159,8 +166,8 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
     }
     /* round 2: per cut q, the bucket (a, b] it falls in and the windows of its halo bounds */
     const uint32_t *s = m ? radix(memcpy(C->sorted, key, m * sizeof(uint32_t)), C->tmp, m) : NULL;
-    window W[3 * 64];
-    uint64_t a_q[64], b_q[64];
+    window *W = C->win;
+    uint64_t *a_q = C->a_q, *b_q = C->b_q;
     size_t j = 1;
     for (int q = 1; q < size; q++) {
         while (j < nb && pre[j] * P < (uint64_t)q * total) j++;

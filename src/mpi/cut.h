@@ -19,6 +19,8 @@ typedef struct pfsph_cut {
     uint32_t *sorted, *tmp;  /* scratch: this rank's keys, radix-sorted */
     uint32_t *cnt;           /* scratch: the histograms */
     uint64_t *pre;           /* scratch: the coarse prefix, buckets + 1 */
+    void *win;               /* scratch: the 3 (size - 1) windows of round 2 (cut.c) */
+    uint64_t *a_q, *b_q;     /* scratch: each cut's bucket, size */
     size_t sorted_cap, cnt_cap;
     uint64_t buckets;       /* the coarse histogram's size (a power of 2) */
     uint64_t hist_counters; /* counters of the last cut's reductions (figures) */

@@ -435,7 +435,7 @@ static void halo(pfsph_dist *d, pfsph_real *const *a, int k)
     const int r = D->rank;
     const size_t rs = sizeof(pfsph_real);
     size_t bytes = 0, rbytes = 0;
-    uint64_t s_lo[64], r_lo[64];
+    size_t *s_lo = D->qa, *r_lo = D->qb;
     for (int q = 0; q < D->size; q++) {
         uint64_t s = D->gofs[r] > D->lofs[q] ? D->gofs[r] : D->lofs[q];
         uint64_t e = D->gofs[r + 1] < D->lend[q] ? D->gofs[r + 1] : D->lend[q];
@@ -514,7 +514,7 @@ static double sum(pfsph_dist *d, const pfsph_real *a)
     MPI_Gatherv(mine, D->rcount[r], MPI_DOUBLE, all, D->rcount, D->rdispl, MPI_DOUBLE, 0, D->comm);
     double total = 0;
     if (r == 0) {
-        size_t pos[64];
+        size_t *pos = D->qa;
         for (int q = 0; q < D->size; q++) pos[q] = (size_t)D->rdispl[q];
         for (uint64_t b = 0; b * B < N; b++) {
             const uint64_t blo = b * B, bhi = blo + B < N ? blo + B : N;
@@ -753,7 +753,6 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->comm = comm;
     MPI_Comm_rank(comm, &D->rank);
     MPI_Comm_size(comm, &D->size);
-    if (D->size > 64) return PFSPH_EINPUT;
     const size_t P = (size_t)D->size;
     const char *b = getenv("PFSPH_MPI_CUT_BUCKETS"), *chk = getenv("PFSPH_MPI_CHECK_CUT");
     D->check_cut = chk && atoi(chk) > 0;
@@ -766,7 +765,17 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->sdispl = calloc(P, sizeof(int));
     D->rcount = calloc(P, sizeof(int));
     D->rdispl = calloc(P, sizeof(int));
-    if (!D->scount || !D->sdispl || !D->rcount || !D->rdispl) return PFSPH_ENOMEM;
+    D->wlo = calloc(P, sizeof(size_t));
+    D->whi = calloc(P, sizeof(size_t));
+    D->fig = calloc(P, sizeof(pfsph_mpi_fig));
+    D->qa = calloc(P, sizeof(size_t));
+    D->qb = calloc(P, sizeof(size_t));
+    D->qc = calloc(P, sizeof(size_t));
+    D->cnt2 = calloc(2 * P, sizeof(int));
+    D->rcnt2 = calloc(2 * P, sizeof(int));
+    if (!D->scount || !D->sdispl || !D->rcount || !D->rdispl || !D->wlo || !D->whi || !D->fig || !D->qa || !D->qb ||
+        !D->qc || !D->cnt2 || !D->rcnt2)
+        return PFSPH_ENOMEM;
     D->d.halo = halo;
     D->d.sum = sum;
     D->d.count = count;

@@ -54,11 +54,15 @@ typedef struct pfsph_decomp {
     /* the static walls this rank keeps: cells [wlo[q], whi[q]) for rank q (the root: all) */
     int trim_walls;
     size_t wall_slack; /* percent of the need added each side when a window moves */
-    size_t wlo[64], whi[64];
+    size_t *wlo, *whi; /* size each */
     uint64_t walls_total, walls_max, wall_trims, wall_fetches, wall_bytes, resident_max;
     uint64_t steps, halo_calls, bytes_sent, messages, migr_bytes, halo_particles;
     size_t own_min, own_max; /* owned particles of this rank over the run */
-    pfsph_mpi_fig fig[64];   /* the root: every rank's, as of the last frame */
+    pfsph_mpi_fig *fig;      /* size; the root: every rank's, as of the last frame */
+    /* per-rank scratch (size each, 2 size for cnt2 and rcnt2): the halo's offsets, the global
+     * sum's read positions, the moves of a particle set */
+    size_t *qa, *qb, *qc;
+    int *cnt2, *rcnt2;
 } pfsph_decomp;
 
 /* The decomposition of the world communicator (not yet attached to a simulation). */

@@ -46,7 +46,6 @@ int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
     const char *solver = pfsph_scene_solver_name(s);
     if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph") && strcmp(solver, "dfsph") && strcmp(solver, "iisph"))
         no = "this solver", key = "$.solver.type";
-    else if (g_size > 64) no = "more than 64 ranks", key = "mpirun -np";
     if (!no) return PFSPH_OK;
     return pfsph_fail(err, PFSPH_EINPUT,
                       "%s: %s: %s%s%s%s not supported under MPI yet (%d ranks; docs/cluster.md lists what is): run it "

@@ -63,7 +63,8 @@ static void migrate(pfsph_dist *d, pfsph_particles *ps, size_t *nold, const uint
 {
     pfsph_decomp *D = (pfsph_decomp *)d;
     const int P = D->size;
-    int cnt[2 * 64] = {0}, rcnt[2 * 64];
+    int *cnt = D->cnt2, *rcnt = D->rcnt2;
+    memset(cnt, 0, 2 * (size_t)P * sizeof(int));
     int *dest = malloc((ps->n ? ps->n : 1) * sizeof(int));
     if (!dest) MPI_Abort(D->comm, 1);
     for (size_t i = 0; i < ps->n; i++) {
@@ -85,7 +86,7 @@ static void migrate(pfsph_dist *d, pfsph_particles *ps, size_t *nold, const uint
     if (bytes > (size_t)INT32_MAX || rbytes > (size_t)INT32_MAX || grow(&D->sbuf, &D->scap, bytes) ||
         grow(&D->rbuf, &D->rcap, rbytes))
         MPI_Abort(D->comm, 1);
-    size_t at[64];
+    size_t *at = D->qa;
     for (int q = 0; q < P; q++) at[q] = (size_t)D->sdispl[q];
     for (int part = 0; part < 2; part++) /* the first part, then the new */
         for (size_t i = part ? *nold : 0; i < (part ? ps->n : *nold); i++) {
@@ -95,7 +96,7 @@ static void migrate(pfsph_dist *d, pfsph_particles *ps, size_t *nold, const uint
     free(dest);
     MPI_Alltoallv(D->sbuf, D->scount, D->sdispl, MPI_BYTE, D->rbuf, D->rcount, D->rdispl, MPI_BYTE, D->comm);
     if (rn > ps->cap && pfsph_particles_reserve(ps, rn) != PFSPH_OK) MPI_Abort(D->comm, 1);
-    size_t k = 0, head[64], end[64];
+    size_t k = 0, *head = D->qb, *end = D->qc;
     for (int q = 0; q < P; q++)
         for (int j = 0; j < rcnt[2 * q]; j++) unpack(D->rbuf + D->rdispl[q] + (size_t)j * REC, ps, NULL, k++);
     for (int q = 0; q < P; q++) {
