@@ -233,7 +233,6 @@ int pfsph_vwindow_run(pfsph_vapp *A)
                        (const char *)glGetString(GL_RENDERER));
                 print_surface(A);
                 print_changes(A);
-                print_changes(A);
                 break;
             }
             glfwPollEvents();
