@@ -534,11 +534,6 @@ static double sum(pfsph_dist *d, const pfsph_real *a)
     return total;
 }
 
-static void count(pfsph_dist *d, long *v, int k)
-{
-    MPI_Allreduce(MPI_IN_PLACE, v, k, MPI_LONG, MPI_SUM, ((pfsph_decomp *)d)->comm);
-}
-
 /* ---- the stages between the physics' own ---- */
 
 static int halo_pos_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
@@ -773,12 +768,12 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->qc = calloc(P, sizeof(size_t));
     D->cnt2 = calloc(2 * P, sizeof(int));
     D->rcnt2 = calloc(2 * P, sizeof(int));
+    D->scan_all = calloc(8 * P, sizeof(uint64_t));
     if (!D->scount || !D->sdispl || !D->rcount || !D->rdispl || !D->wlo || !D->whi || !D->fig || !D->qa || !D->qb ||
-        !D->qc || !D->cnt2 || !D->rcnt2)
+        !D->qc || !D->cnt2 || !D->rcnt2 || !D->scan_all)
         return PFSPH_ENOMEM;
     D->d.halo = halo;
     D->d.sum = sum;
-    D->d.count = count;
     pfsph_decomp_set_hooks(D); /* src/mpi/sets.c */
     D->d.rank = D->rank;
     D->d.nranks = D->size;

@@ -63,6 +63,7 @@ typedef struct pfsph_decomp {
      * sum's read positions, the moves of a particle set */
     size_t *qa, *qb, *qc;
     int *cnt2, *rcnt2;
+    uint64_t *scan_all; /* 8 size: every rank's counters of a scan (sets.c) */
 } pfsph_decomp;
 
 /* The decomposition of the world communicator (not yet attached to a simulation). */

@@ -10,7 +10,7 @@
 static void scan(pfsph_dist *d, const uint64_t *v, int k, uint64_t *before, uint64_t *total)
 {
     pfsph_decomp *D = (pfsph_decomp *)d;
-    uint64_t mine[8], all[64 * 8];
+    uint64_t mine[8], *all = D->scan_all;      /* 8 per rank */
     if (k > 8 || k < 1) MPI_Abort(D->comm, 1); /* a caller's bug */
     for (int j = 0; j < k && j < 8; j++) mine[j] = v[j];
     MPI_Allgather(mine, k, MPI_UINT64_T, all, k, MPI_UINT64_T, D->comm);
@@ -23,6 +23,11 @@ static void scan(pfsph_dist *d, const uint64_t *v, int k, uint64_t *before, uint
         before[j] = b;
         total[j] = t;
     }
+}
+
+static void count(pfsph_dist *d, long *v, int k)
+{
+    MPI_Allreduce(MPI_IN_PLACE, v, k, MPI_LONG, MPI_SUM, ((pfsph_decomp *)d)->comm);
 }
 
 static void allsum(pfsph_dist *d, double *a, size_t n)
@@ -128,6 +133,7 @@ static void migrate(pfsph_dist *d, pfsph_particles *ps, size_t *nold, const uint
 void pfsph_decomp_set_hooks(pfsph_decomp *D)
 {
     D->d.scan = scan;
+    D->d.count = count;
     D->d.any = any;
     D->d.allsum = allsum;
     D->d.migrate = migrate;

@@ -89,6 +89,20 @@ static inline void pfsph_grid_ranges(const pfsph_grid *g, pfsph_real x, pfsph_re
     pfsph_grid_ranges_reach(g, x, y, z, g->reach, r);
 }
 
+/* The linear index of the cell holding (x, y, z), the point clamped into the grid (the spatial
+ * sort's key of a set that is not sorted by the grid itself, and under MPI the cell whose owner
+ * takes the point). */
+static inline uint32_t pfsph_grid_cell_clamped(const pfsph_grid *g, pfsph_real x, pfsph_real y, pfsph_real z)
+{
+    const pfsph_real p[3] = {x, y, z};
+    size_t c[3] = {0, 0, 0};
+    for (int a = 0; a < g->dim; a++) {
+        pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
+        c[a] = !(t > 0) ? 0 : (t >= (pfsph_real)g->nc[a] ? (size_t)g->nc[a] - 1 : (size_t)t);
+    }
+    return (uint32_t)((c[2] * (size_t)g->nc[1] + c[1]) * (size_t)g->nc[0] + c[0]);
+}
+
 static inline int pfsph__grid_flag(const pfsph_grid *g, const uint8_t *flags, pfsph_real x, pfsph_real y, pfsph_real z)
 {
     if (!flags) return 1;

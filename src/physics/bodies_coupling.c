@@ -13,13 +13,7 @@
 /* Whether this rank owns the fluid grid cell of boundary particle j (clamped into the grid). */
 static bool owns(const pfsph_grid *g, const pfsph_dist *D, const pfsph_particles *b, size_t j)
 {
-    const pfsph_real p[3] = {b->x[j], b->y[j], b->z[j]};
-    size_t c[3] = {0, 0, 0};
-    for (int a = 0; a < g->dim; a++) {
-        pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
-        c[a] = !(t > 0) ? 0 : (t >= (pfsph_real)g->nc[a] ? (size_t)g->nc[a] - 1 : (size_t)t);
-    }
-    const size_t key = (c[2] * (size_t)g->nc[1] + c[1]) * (size_t)g->nc[0] + c[0];
+    const size_t key = pfsph_grid_cell_clamped(g, b->x[j], b->y[j], b->z[j]);
     return key >= D->cell_lo && key < D->cell_hi;
 }
 

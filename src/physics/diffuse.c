@@ -547,13 +547,7 @@ static int prepare_old(pfsph_diffuse *d, const pfsph_ctx *ctx)
  * under MPI the cell whose owner takes the particle). */
 static inline uint32_t cell_of(const pfsph_grid *g, const pfsph_particles *ps, size_t i)
 {
-    const pfsph_real p[3] = {ps->x[i], ps->y[i], ps->z[i]};
-    size_t c[3] = {0, 0, 0};
-    for (int a = 0; a < g->dim; a++) {
-        pfsph_real t = (p[a] - g->lo[a]) * g->inv_cell;
-        c[a] = !(t > 0) ? 0 : (t >= (pfsph_real)g->nc[a] ? (size_t)g->nc[a] - 1 : (size_t)t);
-    }
-    return (uint32_t)((c[2] * (size_t)g->nc[1] + c[1]) * (size_t)g->nc[0] + c[0]);
+    return pfsph_grid_cell_clamped(g, ps->x[i], ps->y[i], ps->z[i]);
 }
 
 /* A distributed run (docs/cluster.md): the particles [from, n) go to the rank that owns their
