@@ -261,6 +261,15 @@ static int convert_targets(pfsph_scene *s, double lam, const double (*fab)[PFSPH
     return PFSPH_OK;
 }
 
+/* convert_targets' "pairwise: ..." message, which names the phases, with the file and the block's
+ * path instead of its prefix */
+static int in_block(const pfsph_scene *s, int rc, pfsph_error *err)
+{
+    char msg[sizeof err->msg];
+    snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
+    return pfsph_fail(err, rc, "%s: $.pairwise: %s", s->source, msg);
+}
+
 int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfsph_error *err)
 {
     pfsph_pairwise_params *pp = &s->pairwise;
@@ -295,11 +304,7 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
         bool over;
         int rc = convert_targets(s, lam, (const double(*)[PFSPH_MAX_PHASES])fab, theta, rho, err, &over);
         if (!rc && over && it == 31) rc = PFSPH_EINPUT;
-        if (rc) { /* "pairwise: ..." names the phases: add the file and the block's path */
-            char msg[sizeof err->msg];
-            snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
-            return pfsph_fail(err, rc, "%s: $.pairwise: %s", s->source, msg);
-        }
+        if (rc) return in_block(s, rc, err);
         tp->sigma_ref = 0;
         tp->rho_ref = 0;
         for (int a = 0; a < np; a++)
@@ -329,11 +334,7 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
                 fab[a][b] = fab[b][a] = tab > 0 ? pfsph_pairwise_sigma_factor(s->dim, tab) : f;
                 if (!(fabs(fab[a][b] - fo) <= 1e-12 * fab[a][b])) done = false;
             }
-        if (done && over) { /* a target beyond the c_ab = 0 limit at the fixed point */
-            char msg[sizeof err->msg];
-            snprintf(msg, sizeof msg, "%s", err->msg + (strncmp(err->msg, "pairwise: ", 10) ? 0 : 10));
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: $.pairwise: %s", s->source, msg);
-        }
+        if (done && over) return in_block(s, PFSPH_EINPUT, err); /* beyond c_ab = 0 at the fixed point */
         if (done) break;
     }
     for (int a = 0; a < np; a++)
