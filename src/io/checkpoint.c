@@ -13,12 +13,15 @@
 
 #include "io/checkpoint_format.h"
 #include "io/io_internal.h"
+#include "pfsph/dist.h"
 #include "pfsph/io.h"
 
 static long name_frame(const char *name);
 
 static int save(const char *path, const pfsph_sim *sim, int frame, int durable, size_t *bytes, pfsph_error *err)
 {
+    pfsph_dist *d = pfsph_sim_ctx(sim)->dist; /* under MPI every rank writes its part */
+    if (d && d->save) return d->save(d, path, frame, durable, bytes, err);
     pfsph__afile a;
     int rc = pfsph__afile_open(&a, path, err);
     if (rc) return rc;
@@ -49,11 +52,13 @@ int pfsph_checkpoint_keep(const char *stash, const char *dest, pfsph_error *err)
 
 int pfsph_checkpoint_load(const char *path, pfsph_sim *sim, pfsph_checkpoint_info *info, pfsph_error *err)
 {
+    const char *base = strrchr(path, '/');
+    pfsph_dist *d = pfsph_sim_ctx(sim)->dist; /* under MPI every rank reads a range */
+    if (d && d->load) return d->load(d, path, name_frame(base ? base + 1 : path), info, err);
     unsigned char *data;
     size_t len;
     int rc = pfsph__read_file(path, &data, &len, err);
     if (rc) return rc;
-    const char *base = strrchr(path, '/');
     rc = pfsph__checkpoint_read(sim, data, len, path, name_frame(base ? base + 1 : path), info, err);
     free(data);
     return rc;

@@ -67,6 +67,23 @@ static double r_f64(rbuf *r)
     return v;
 }
 
+int pfsph__checkpoint_check_set(const pfsph_particles *ps, size_t i0, const char *name, const char *what,
+                                pfsph_error *err)
+{
+    for (size_t i = 0; i < ps->n; i++)
+        if (ps->id[i] >= ps->next_id)
+            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle id %u not below next id %u", name,
+                              what, ps->id[i], ps->next_id);
+    for (int k = 0; k < PFSPH_NFIELDS; k++)
+        for (size_t i = 0; i < ps->n; i++)
+            if (!isfinite((double)ps->f[k][i]))
+                return pfsph_fail(err, PFSPH_EINPUT,
+                                  "%s: corrupt checkpoint: %s particle %zu has a non-finite "
+                                  "field (%g)",
+                                  name, what, i0 + i, (double)ps->f[k][i]);
+    return PFSPH_OK;
+}
+
 /* Read a particle set; ps is initialised here (free with pfsph_particles_free). */
 static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *what, pfsph_error *err)
 {
@@ -80,38 +97,35 @@ static int r_set(rbuf *r, pfsph_particles *ps, const char *name, const char *wha
     if (pfsph_particles_init(ps, (size_t)n ? (size_t)n : 1) != PFSPH_OK)
         return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory for %llu %s particles", name, (unsigned long long)n,
                           what);
-    for (int k = 0; k < PFSPH_NFIELDS; k++) {
-        if (pfsph__host_le()) {
-            memcpy(ps->f[k], r->p + r->pos, (size_t)n * sizeof(pfsph_real));
-            r->pos += (size_t)n * sizeof(pfsph_real);
+    for (int k = 0; k < PFSPH__CKPT_ARRAYS; k++) {
+        const void *p;
+        const size_t es = pfsph__checkpoint_array(ps, k, 0, &p);
+        if (pfsph__host_le() || es == 1) {
+            memcpy((void *)p, r->p + r->pos, (size_t)n * es);
+            r->pos += (size_t)n * es;
         } else {
-            for (size_t i = 0; i < n; i++) r_raw(r, &ps->f[k][i], sizeof(pfsph_real));
+            for (size_t i = 0; i < n; i++) r_raw(r, (char *)p + i * es, es);
         }
     }
-    memcpy(ps->phase, r->p + r->pos, (size_t)n);
-    r->pos += (size_t)n;
-    memcpy(ps->bubble, r->p + r->pos, (size_t)n);
-    r->pos += (size_t)n;
-    for (size_t i = 0; i < n; i++) ps->id[i] = r_u32(r);
     ps->n = (size_t)n;
     ps->next_id = next_id;
-    for (size_t i = 0; i < ps->n; i++)
-        if (ps->id[i] >= next_id) {
-            const uint32_t id = ps->id[i]; /* read before the arrays go */
-            pfsph_particles_free(ps);
-            return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: %s particle id %u not below next id %u", name,
-                              what, id, next_id);
-        }
-    for (int k = 0; k < PFSPH_NFIELDS; k++)
-        for (size_t i = 0; i < ps->n; i++)
-            if (!isfinite((double)ps->f[k][i])) {
-                const double v = (double)ps->f[k][i];
-                pfsph_particles_free(ps);
-                return pfsph_fail(err, PFSPH_EINPUT,
-                                  "%s: corrupt checkpoint: %s particle %zu has a non-finite "
-                                  "field (%g)",
-                                  name, what, i, v);
-            }
+    int rc = pfsph__checkpoint_check_set(ps, 0, name, what, err);
+    if (rc) pfsph_particles_free(ps);
+    return rc;
+}
+
+/* The fluid's count and next id, its arrays elided (a reader of ranges: el->fluid holds this
+ * process's range, read and checked by the caller). */
+static int r_elided(rbuf *r, const pfsph__ckpt_elided *el, pfsph_particles *ps, const char *name, pfsph_error *err)
+{
+    uint64_t n = r_u64(r);
+    uint32_t next_id = r_u32(r);
+    if (r->bad || n != (el->file_len - r->len) / PFSPH__CKPT_PER_PARTICLE ||
+        n * PFSPH__CKPT_PER_PARTICLE != el->file_len - r->len)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: corrupt checkpoint: fluid particle count %llu does not fit the file",
+                          name, (unsigned long long)n);
+    *ps = *el->fluid;
+    ps->next_id = next_id;
     return PFSPH_OK;
 }
 
@@ -176,8 +190,8 @@ static int check_emitters(const pfsph_emitters *E, int n, const pfsph_emitter_st
     return PFSPH_OK;
 }
 
-int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const char *name, long expect_frame,
-                           pfsph_checkpoint_info *info, pfsph_error *err)
+int pfsph__checkpoint_read_elided(pfsph_sim *sim, const void *data, size_t len, const char *name, long expect_frame,
+                                  const pfsph__ckpt_elided *el, pfsph_checkpoint_info *info, pfsph_error *err)
 {
     int rc;
     const unsigned char *b = data;
@@ -208,12 +222,13 @@ int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const c
     if (real_size != sizeof(pfsph_real))
         return pfsph_fail(err, PFSPH_EINPUT, "%s: checkpoint written in %s precision, this pfsph is built for %s", name,
                           real_size == 8 ? "double" : "float", PFSPH_REAL_NAME);
-    if (payload != len - PFSPH__CKPT_HEADER)
-        return pfsph_fail(err, PFSPH_EINPUT, "%s: %s checkpoint: %zu bytes, the header says %llu", name,
-                          len - PFSPH__CKPT_HEADER < payload ? "truncated" : "corrupt", len,
+    const uint64_t flen = el ? el->file_len : len; /* the file's length */
+    if (payload != flen - PFSPH__CKPT_HEADER)
+        return pfsph_fail(err, PFSPH_EINPUT, "%s: %s checkpoint: %llu bytes, the header says %llu", name,
+                          flen - PFSPH__CKPT_HEADER < payload ? "truncated" : "corrupt", (unsigned long long)flen,
                           (unsigned long long)(payload + PFSPH__CKPT_HEADER));
-    uint32_t crc = (uint32_t)crc32(0L, Z_NULL, 0);
-    for (size_t off = PFSPH__CKPT_HEADER; off < len;) {
+    uint32_t crc = el ? el->crc : (uint32_t)crc32(0L, Z_NULL, 0);
+    for (size_t off = PFSPH__CKPT_HEADER; !el && off < len;) {
         size_t n = len - off > (1u << 30) ? (1u << 30) : len - off;
         crc = (uint32_t)crc32(crc, b + off, (uInt)n);
         off += n;
@@ -255,7 +270,7 @@ int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const c
     if ((rc = check_clock(pfsph_sim_scene(sim), fr, expect_frame, threads, &st, name, err))) return rc;
     pfsph_particles fluid, diff;
     memset(&diff, 0, sizeof diff);
-    rc = r_set(&r, &fluid, name, "fluid", err);
+    rc = el ? r_elided(&r, el, &fluid, name, err) : r_set(&r, &fluid, name, "fluid", err);
     if (rc) return rc;
     /* fluid particles are added only by emitters: the ids are those the scene made, then one per
      * emitted particle (checked below, once the emitters' counts are read) */
@@ -265,7 +280,7 @@ int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const c
                         "%s: corrupt checkpoint: fluid next id %u and %zu removed, the scene "
                         "makes %u fluid particles",
                         name, fluid.next_id, st.removed, c->fluid->next_id);
-        pfsph_particles_free(&fluid);
+        if (!el) pfsph_particles_free(&fluid);
         return rc;
     }
     uint8_t has_d = r_u8(&r);
@@ -274,7 +289,7 @@ int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const c
         created = r_u64(&r);
         refused = r_u64(&r);
         if ((rc = r_set(&r, &diff, name, "diffuse", err))) {
-            pfsph_particles_free(&fluid);
+            if (!el) pfsph_particles_free(&fluid);
             return rc;
         }
     }
@@ -341,7 +356,7 @@ int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const c
             pfsph_fail(err, rc, "%s: %s", name, msg);
         }
     }
-    pfsph_particles_free(&fluid);
+    if (!el) pfsph_particles_free(&fluid);
     if (has_d) pfsph_particles_free(&diff);
     free(bst);
     free(bids);
@@ -352,6 +367,12 @@ int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const c
         info->step = st.step;
     }
     return rc;
+}
+
+int pfsph__checkpoint_read(pfsph_sim *sim, const void *data, size_t len, const char *name, long expect_frame,
+                           pfsph_checkpoint_info *info, pfsph_error *err)
+{
+    return pfsph__checkpoint_read_elided(sim, data, len, name, expect_frame, NULL, info, err);
 }
 
 int pfsph_checkpoint_decode(pfsph_sim *sim, const void *data, size_t len, const char *name, pfsph_checkpoint_info *info,

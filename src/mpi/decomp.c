@@ -349,7 +349,7 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
         D->gathered = 0;
         share_clock(D, st);
     }
-    if (D->root_all) {
+    if (D->share) { /* a start or a resume: the root's clock and state */
         share_clock(D, st);
         if (st->df) { /* a resume: the diffuse totals the root restored (the ids go on from them) */
             size_t *nold;
@@ -403,10 +403,12 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     }
     D->d.own_lo = (size_t)(D->gofs[D->rank] - D->lofs[D->rank]);
     D->d.own_hi = (size_t)(D->gofs[D->rank + 1] - D->lofs[D->rank]);
+    D->own_g0 = D->gofs[D->rank];
     D->d.nglobal = (size_t)total;
     D->d.cell_lo = D->cut[D->rank];
     D->d.cell_hi = D->cut[D->rank + 1];
     D->root_all = 0;
+    D->share = 0;
     /* figures */
     const size_t own = D->d.own_hi - D->d.own_lo;
     if (!D->steps || own < D->own_min) D->own_min = own;
@@ -653,7 +655,9 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
                           D->resident_max,
                           0,
                           0,
-                          0};
+                          0,
+                          D->ckpt_bytes,
+                          D->ckpt_read};
     if (D->sim->st.df) {
         size_t *no;
         uint64_t *cr, *rf;
@@ -774,7 +778,8 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
         return PFSPH_ENOMEM;
     D->d.halo = halo;
     D->d.sum = sum;
-    pfsph_decomp_set_hooks(D); /* src/mpi/sets.c */
+    pfsph_decomp_set_hooks(D);  /* src/mpi/sets.c */
+    pfsph_decomp_ckpt_hooks(D); /* src/mpi/ckpt.c */
     D->d.rank = D->rank;
     D->d.nranks = D->size;
     D->d.agree = agree;
@@ -813,6 +818,7 @@ static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err)
     D->wall_slack = sl && atoi(sl) >= 0 ? (size_t)atoi(sl) : 25;
     D->walls_total = sim->boundary.n;
     D->root_all = 1;
+    D->share = 1;
     D->d.own_lo = 0;
     D->d.own_hi = D->rank == 0 ? sim->fluid.n : 0;
     D->d.nglobal = sim->fluid.n;

@@ -12,7 +12,7 @@
 #include "pfsph/sim.h"
 
 /* Commands the root broadcasts to the other ranks, which follow them (src/mpi/mpi_cli.c). */
-enum { PFSPH_MPI_CREATE = 1, PFSPH_MPI_STEP, PFSPH_MPI_FRAME, PFSPH_MPI_END };
+enum { PFSPH_MPI_CREATE = 1, PFSPH_MPI_STEP, PFSPH_MPI_FRAME, PFSPH_MPI_SAVE, PFSPH_MPI_LOAD, PFSPH_MPI_END };
 
 typedef struct pfsph_mpi_cmd {
     int cmd, rc;
@@ -27,6 +27,8 @@ typedef struct pfsph_mpi_fig {
     uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
     uint64_t rss_kb;      /* its resident memory at the frame */
     uint64_t diffuse;     /* diffuse particles it held at the frame (before the gather) */
+    uint64_t ckpt_bytes;  /* bytes it wrote of the last checkpoint (src/mpi/ckpt.c) */
+    uint64_t ckpt_read;   /* bytes it read of the checkpoint resumed from */
 } pfsph_mpi_fig;
 
 typedef struct pfsph_decomp {
@@ -34,10 +36,13 @@ typedef struct pfsph_decomp {
     MPI_Comm comm;
     int rank, size;
     pfsph_sim *sim;
-    int root_all;       /* the root holds every particle (the start, after a frame gather, a resume) */
-    int failed;         /* a stage failed on some rank: the other ranks left their command loop */
-    int gathered;       /* the root holds every particle for a frame, the others still their slices */
-    size_t root_own_hi; /* the root's own particles [0, root_own_hi) before the frame gather */
+    int root_all;                   /* the root holds every particle (the start) */
+    int share;                      /* the next exchange shares the root's clock and state (a start, a resume) */
+    uint64_t own_g0;                /* the global index of the local particle own_lo */
+    uint64_t ckpt_bytes, ckpt_read; /* figures: bytes of the last checkpoint written, of the one read */
+    int failed;                     /* a stage failed on some rank: the other ranks left their command loop */
+    int gathered;                   /* the root holds every particle for a frame, the others still their slices */
+    size_t root_own_hi;             /* the root's own particles [0, root_own_hi) before the frame gather */
     size_t ncells;
     size_t off;                             /* cells of key distance that a walk of the grid's reach can span */
     pfsph_cut C;                            /* the step's cut (src/mpi/cut.c); the four below point into it */
@@ -72,6 +77,12 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm);
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err);
 /* The hooks of src/mpi/sets.c: scan, any, allsum, migrate. */
 void pfsph_decomp_set_hooks(pfsph_decomp *D);
+/* The checkpoint hooks (src/mpi/ckpt.c): a file written and read by every rank with MPI-IO. */
+void pfsph_decomp_ckpt_hooks(pfsph_decomp *D);
+/* The collective write and read; the root gives the path (and the rest), the others NULL. */
+int pfsph_decomp_save(pfsph_decomp *D, const char *path, int frame, int durable, size_t *bytes, pfsph_error *err);
+int pfsph_decomp_load(pfsph_decomp *D, const char *path, long expect_frame, struct pfsph_checkpoint_info *info,
+                      pfsph_error *err);
 /* Broadcast a command from the root. */
 void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c);
 

@@ -60,7 +60,9 @@ static void report(pfsph_dist *d, void *json)
     cJSON *m = cJSON_AddObjectToObject(json, "mpi");
     if (!m) return;
     cJSON_AddNumberToObject(m, "ranks", D->size);
-    cJSON_AddStringToObject(m, "output", "gathered to rank 0 rank by rank through a bounded buffer, written by it");
+    cJSON_AddStringToObject(m, "output",
+                            "frames gathered to rank 0 rank by rank through a bounded buffer, written by it; "
+                            "checkpoints written and read by every rank (MPI-IO)");
     cJSON *cut = cJSON_AddObjectToObject(m, "cut"); /* src/mpi/cut.c: the histogram of occupied cells */
     if (cut) {
         cJSON_AddNumberToObject(cut, "coarse_buckets", (double)D->C.buckets);
@@ -92,6 +94,8 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(r, "wall_bytes_sent", (double)f->wall_bytes);
         cJSON_AddNumberToObject(r, "resident_particles_max", (double)f->resident_max);
         cJSON_AddNumberToObject(r, "diffuse_held_at_frame", (double)f->diffuse);
+        cJSON_AddNumberToObject(r, "checkpoint_bytes_written", (double)f->ckpt_bytes);
+        cJSON_AddNumberToObject(r, "checkpoint_bytes_read", (double)f->ckpt_read);
         cJSON_AddNumberToObject(r, "rss_mib_at_last_frame", (double)f->rss_kb / 1024.0);
         cJSON_AddNumberToObject(r, "peak_rss_mib", (double)f->peak_rss_kb / 1024.0);
         cJSON_AddItemToArray(ranks, r);
@@ -152,6 +156,11 @@ int pfsph_mpi_follow(int threads, int (*exit_code)(int))
             rc = pfsph_sim_step(sim, c.t, &err);
         } else if (c.cmd == PFSPH_MPI_FRAME) {
             rc = pfsph_decomp_gather(&g_D, &err);
+        } else if (c.cmd == PFSPH_MPI_SAVE) {
+            rc = pfsph_decomp_save(&g_D, NULL, 0, 0, NULL, &err);
+        } else if (c.cmd == PFSPH_MPI_LOAD) {
+            /* a rejected checkpoint is not the end: the root tries the previous one or ends the run */
+            pfsph_decomp_load(&g_D, NULL, 0, NULL, &err);
         } else {
             rc = c.rc;
             break;

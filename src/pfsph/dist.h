@@ -11,6 +11,7 @@
 #include "pfsph/types.h"
 
 struct pfsph_sim;
+struct pfsph_checkpoint_info;
 
 typedef struct pfsph_dist pfsph_dist;
 struct pfsph_dist {
@@ -48,6 +49,13 @@ struct pfsph_dist {
     int (*frame)(pfsph_dist *d, pfsph_error *err);
     /* the decomposition's figures into summary.json (a cJSON object) */
     void (*report)(pfsph_dist *d, void *json);
+    /* A checkpoint file written by every rank, each its part of the fluid (the serial file's
+     * bytes; atomic through a temporary name; durable: fsynced), *bytes (may be NULL) its size;
+     * and one read by every rank, each a range of the serial order (checked as the serial
+     * reader does, the frame against expect_frame when >= 0). NULL: the serial code. */
+    int (*save)(pfsph_dist *d, const char *path, int frame, int durable, size_t *bytes, pfsph_error *err);
+    int (*load)(pfsph_dist *d, const char *path, long expect_frame, struct pfsph_checkpoint_info *info,
+                pfsph_error *err);
     /* a simulation was created: take it over (insert the stages, share the work) */
     int (*attach)(pfsph_dist *d, struct pfsph_sim *sim, pfsph_error *err);
 };

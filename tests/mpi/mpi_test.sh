@@ -14,6 +14,10 @@
 #                                          holds stay under 1.5 N / NP + halo + walls of the scene
 #   mpi_test.sh diffuse SCENE END NP...   as compare, and the run made diffuse particles, some
 #                                          died, and a rank other than the root held some
+#   mpi_test.sh ckpt SCENE END NP...      as compare, and every checkpoint of -np NP holds the serial
+#                                          run's bytes (but the stage seconds, timings, and the CRCs
+#                                          over them), ranks other than the root wrote parts of it,
+#                                          and the serial program loads the last one
 #   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
 #                                          STATUS (default 2) from mpirun
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
@@ -36,6 +40,15 @@ mpi() { # NP args...
     np=$1
     shift
     "$MPIRUN" $ROOTOPT --oversubscribe -np "$np" "$BIN" "$@"
+}
+
+ckpt_same() { # A B: checkpoint files equal but for the CRC32s (bytes 33-40, 1-based) and the stage
+    # seconds (wall-clock timings: 8 S bytes from byte 145, S the u32 at offset 140; docs/checkpoints.md)
+    [ "$(wc -c <"$1")" = "$(wc -c <"$2")" ] || { echo "FAIL: $1 and $2 differ in length"; return 1; }
+    S=$(od -An -tu4 -j140 -N4 "$1" | tr -d ' ')
+    cmp -l "$1" "$2" | awk -v hi=$((144 + 8 * S)) -v a="$1" -v b="$2" '
+        $1 < 33 || ($1 > 40 && $1 < 145) || $1 > hi { if (!bad) printf "FAIL: %s and %s differ at byte %d\n", a, b, $1; bad++ }
+        END { exit bad > 0 }' || return 1
 }
 
 same() { # DIR_A DIR_B: frames, stats.csv (and bodies.csv) byte for byte
@@ -68,6 +81,29 @@ compare)
         same "$TMP/serial" "$TMP/np$np" || exit 1
         [ "$np" = 1 ] || grep -q '"ranks":' "$TMP/np$np/summary.json" ||
             { echo "FAIL: no per-rank figures in summary.json"; exit 1; }
+    done
+    ;;
+ckpt)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    nck=$(ls "$TMP/serial/checkpoints" | grep -c "^ckpt_")
+    [ "$nck" -gt 0 ] || { echo "FAIL: the serial run wrote no checkpoint"; exit 1; }
+    for np in "$@"; do
+        mpi "$np" run "$scene" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        [ "$(ls "$TMP/np$np/checkpoints")" = "$(ls "$TMP/serial/checkpoints")" ] ||
+            { echo "FAIL: -np $np: checkpoints $(ls "$TMP/np$np/checkpoints" | tr '\n' ' ')"; exit 1; }
+        for f in $(ls "$TMP/serial/checkpoints"); do
+            ckpt_same "$TMP/serial/checkpoints/$f" "$TMP/np$np/checkpoints/$f" || exit 1
+        done
+        awk -F'[:,]' '/"rank":/ { r = $2 + 0 } /"checkpoint_bytes_written":/ { if (r > 0 && $2 > 0) w++ }
+            END { if (!w) { print "FAIL: no rank but the root wrote a part of a checkpoint"; exit 1 }
+                  printf "ok: %d ranks besides the root wrote parts of the checkpoints\n", w }' \
+            "$TMP/np$np/summary.json" || exit 1
+        # the serial reader checks every CRC and value of the last one (a resume with nothing to run)
+        "$BIN" run --resume "$TMP/np$np" --quiet || { echo "FAIL: the serial program refuses -np $np's checkpoint"; exit 1; }
+        echo "ok: -np $np: $nck checkpoints hold the serial run's bytes"
     done
     ;;
 diffuse)
