@@ -35,6 +35,44 @@ void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r
 }
 
 PFSPH__CLONES
+void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const uint32_t *restrict idx,
+                           const pfsph_real *restrict tx, const pfsph_real *restrict ty, const pfsph_real *restrict tz,
+                           pfsph_real x, pfsph_real y, pfsph_real z, const pfsph_real *restrict aux,
+                           pfsph_real *restrict cx, pfsph_real *restrict cy, pfsph_real *restrict cz,
+                           pfsph_real *restrict cw, pfsph_real *restrict w)
+{
+    /* pcisph_lists.c's gather of x_ij (scalar: the compiler does not vectorise the indexed
+     * loads), then pfsph__terms_w and pfsph__terms_dwr from one sqrt with the mask beyond h in
+     * one vector loop; with aux, the products aux_j w and aux_j dW/r the passes formed from the
+     * masked terms (rounded once, as there) */
+    pfsph_real r2[PFSPH_LIST_TERMS_MAX], a[PFSPH_LIST_TERMS_MAX];
+    for (int q = 0; q < n; q++) {
+        const uint32_t j = idx[q];
+        const pfsph_real dx = x - tx[j], dy = y - ty[j], dz = z - tz[j];
+        cx[q] = dx;
+        cy[q] = dy;
+        cz[q] = dz;
+        r2[q] = dx * dx + dy * dy + dz * dz;
+    }
+    const pfsph_kernel K = *k;
+    if (aux) {
+        for (int q = 0; q < n; q++) a[q] = aux[idx[q]];
+        for (int q = 0; q < n; q++) {
+            const pfsph_real r = pfsph_sqrt(r2[q]);
+            const pfsph_real wq = r2[q] < h2 ? pfsph_kernel_w(&K, r) : 0;
+            const pfsph_real dq = r2[q] < h2 ? pfsph_kernel_dw_r(&K, r) : 0;
+            w[q] = a[q] * wq;
+            cw[q] = a[q] * dq;
+        }
+    } else
+        for (int q = 0; q < n; q++) {
+            const pfsph_real r = pfsph_sqrt(r2[q]);
+            w[q] = r2[q] < h2 ? pfsph_kernel_w(&K, r) : 0;
+            cw[q] = r2[q] < h2 ? pfsph_kernel_dw_r(&K, r) : 0;
+        }
+}
+
+PFSPH__CLONES
 void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const uint32_t *restrict jj,
                                 const pfsph_real *restrict dx, const pfsph_real *restrict dy,
                                 const pfsph_real *restrict dz, const pfsph_real *restrict r2, pfsph_real *restrict dw,

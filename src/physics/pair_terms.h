@@ -10,6 +10,16 @@ void pfsph__terms_w(const pfsph_kernel *k, int n, const pfsph_real *restrict r2,
 /* dw[e] = pfsph_kernel_dw_r(|x_ij|) */
 void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r2, pfsph_real *restrict dw);
 
+/* Per listed target j = idx[q], q < n, of point (x, y, z): x_ij into cx, cy, cz, and W (into w)
+ * and dW/r (into cw) of |x_ij| where |x_ij|^2 < h2, 0 beyond; with aux, both times aux[j]. The
+ * expressions of pfsph__terms_w / _dwr (the same bits). n <= PFSPH_LIST_TERMS_MAX. */
+#define PFSPH_LIST_TERMS_MAX 512
+void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const uint32_t *restrict idx,
+                           const pfsph_real *restrict tx, const pfsph_real *restrict ty, const pfsph_real *restrict tz,
+                           pfsph_real x, pfsph_real y, pfsph_real z, const pfsph_real *restrict aux,
+                           pfsph_real *restrict cx, pfsph_real *restrict cy, pfsph_real *restrict cz,
+                           pfsph_real *restrict cw, pfsph_real *restrict w);
+
 /* particle i and the fluid arrays, for pfsph__terms_visc_pressure */
 typedef struct pfsph_pair_in {
     pfsph_kernel k;
