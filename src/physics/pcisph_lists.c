@@ -256,41 +256,48 @@ void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, con
 
 void pfsph__pcisph_pressure_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb,
                                   const pfsph_real *nd, const pfsph_real *p, const pfsph_pcisph_pairs *cf,
-                                  const pfsph_pcisph_pairs *cb, pfsph_real *apx, pfsph_real *apy, pfsph_real *apz)
+                                  const pfsph_pcisph_pairs *cb, pfsph_real *pn, pfsph_real *apx, pfsph_real *apy,
+                                  pfsph_real *apz)
 {
     const pfsph_particles *f = ctx->fluid;
     const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
     const size_t n = f->n;
     const pfsph_real *restrict cx = cf->dx, *restrict cy = cf->dy, *restrict cz = cf->dz, *restrict cw = cf->dw;
     const pfsph_real *restrict bxs = cb->dx, *restrict bys = cb->dy, *restrict bzs = cb->dz, *restrict bws = cb->dw;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        const pfsph_real pi = p[i] / (nd[i] * nd[i]);
-        pfsph_real ax = 0, ay = 0, az = 0;
-        /* pfsph__pcisph_pressure's terms in its order; a pair beyond h adds s = 0 times x_ij */
-        for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end; e++) {
-            const uint32_t j = l->idx[e];
-            const pfsph_real s = (pi + p[j] / (nd[j] * nd[j])) * cw[e];
-            ax += s * cx[e];
-            ay += s * cy[e];
-            az += s * cz[e];
-        }
-        if (pi > 0) {
-            pfsph_real bx = 0, by = 0, bz = 0;
-            for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end; e++) {
-                const pfsph_real s = bws[e]; /* aux_j dW/r (pfsph__pcisph_density_pairs) */
-                bx += s * bxs[e];
-                by += s * bys[e];
-                bz += s * bzs[e];
+#pragma omp parallel
+    {
+        /* p / delta^2 once per particle, not once per pair (a division each): the same value */
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) pn[i] = p[i] / (nd[i] * nd[i]);
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real pi = pn[i];
+            pfsph_real ax = 0, ay = 0, az = 0;
+            /* pfsph__pcisph_pressure's terms in its order; a pair beyond h adds s = 0 times x_ij */
+            for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end; e++) {
+                const uint32_t j = l->idx[e];
+                const pfsph_real s = (pi + pn[j]) * cw[e];
+                ax += s * cx[e];
+                ay += s * cy[e];
+                az += s * cz[e];
             }
-            const pfsph_real wb = pi * inv_v0;
-            ax += wb * bx;
-            ay += wb * by;
-            az += wb * bz;
+            if (pi > 0) {
+                pfsph_real bx = 0, by = 0, bz = 0;
+                for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end; e++) {
+                    const pfsph_real s = bws[e]; /* aux_j dW/r (pfsph__pcisph_density_pairs) */
+                    bx += s * bxs[e];
+                    by += s * bys[e];
+                    bz += s * bzs[e];
+                }
+                const pfsph_real wb = pi * inv_v0;
+                ax += wb * bx;
+                ay += wb * by;
+                az += wb * bz;
+            }
+            const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
+            apx[i] = inv_m * ax;
+            apy[i] = inv_m * ay;
+            apz[i] = inv_m * az;
         }
-        const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
-        apx[i] = inv_m * ax;
-        apy[i] = inv_m * ay;
-        apz[i] = inv_m * az;
     }
 }
