@@ -35,6 +35,35 @@ void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r
 }
 
 PFSPH__CLONES
+void pfsph__terms_w_dwr(const pfsph_kernel *kk, const pfsph_kernel *k, int n, const pfsph_real *restrict r2,
+                        pfsph_real *restrict wk, pfsph_real *restrict w, pfsph_real *restrict dw)
+{
+    /* pfsph__terms_w with kk and k and pfsph__terms_dwr with k from one sqrt: the same bits */
+    const pfsph_kernel KK = *kk, K = *k;
+    if (wk && dw)
+        for (int e = 0; e < n; e++) {
+            const pfsph_real r = pfsph_sqrt(r2[e]);
+            wk[e] = pfsph_kernel_w(&KK, r);
+            w[e] = pfsph_kernel_w(&K, r);
+            dw[e] = pfsph_kernel_dw_r(&K, r);
+        }
+    else if (wk)
+        for (int e = 0; e < n; e++) {
+            const pfsph_real r = pfsph_sqrt(r2[e]);
+            wk[e] = pfsph_kernel_w(&KK, r);
+            w[e] = pfsph_kernel_w(&K, r);
+        }
+    else if (dw)
+        for (int e = 0; e < n; e++) {
+            const pfsph_real r = pfsph_sqrt(r2[e]);
+            w[e] = pfsph_kernel_w(&K, r);
+            dw[e] = pfsph_kernel_dw_r(&K, r);
+        }
+    else
+        for (int e = 0; e < n; e++) w[e] = pfsph_kernel_w(&K, pfsph_sqrt(r2[e]));
+}
+
+PFSPH__CLONES
 void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const uint32_t *restrict idx,
                            const pfsph_real *restrict tx, const pfsph_real *restrict ty, const pfsph_real *restrict tz,
                            pfsph_real x, pfsph_real y, pfsph_real z, const pfsph_real *restrict aux,

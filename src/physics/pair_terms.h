@@ -10,6 +10,11 @@ void pfsph__terms_w(const pfsph_kernel *k, int n, const pfsph_real *restrict r2,
 /* dw[e] = pfsph_kernel_dw_r(|x_ij|) */
 void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r2, pfsph_real *restrict dw);
 
+/* w[e] = W_k(|x_ij|) and, where not NULL, wk[e] = W_kk(|x_ij|) and dw[e] = dW_k/r, from one
+ * square root of r2[e], e < n: pfsph__terms_w and pfsph__terms_dwr's values (the same bits). */
+void pfsph__terms_w_dwr(const pfsph_kernel *kk, const pfsph_kernel *k, int n, const pfsph_real *restrict r2,
+                        pfsph_real *restrict wk, pfsph_real *restrict w, pfsph_real *restrict dw);
+
 /* Per listed target j = idx[q], q < n, of point (x, y, z): x_ij into cx, cy, cz, and W (into w)
  * and dW/r (into cw) of |x_ij| where |x_ij|^2 < h2, 0 beyond; with aux, both times aux[j]. The
  * expressions of pfsph__terms_w / _dwr (the same bits). n <= PFSPH_LIST_TERMS_MAX. */

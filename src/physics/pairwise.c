@@ -204,9 +204,11 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
     const int n = H->n;
     /* the per-pair cosine and kernel in vector code (pair_terms.c), over whole vectors */
     const int n16 = pfsph_hits_pad16(H);
-    if (J->filter) pfsph__terms_w(&J->kk, n16, H->r2, H->t0);
-    if (ds) { /* Eq. 23's sum (density.c) from the hits within h: W_h is 0 beyond h, and adds nothing */
-        pfsph__terms_w(&J->ctx->kern, n16, H->r2, H->t1);
+    if (!ds) {
+        if (J->filter) pfsph__terms_w(&J->kk, n16, H->r2, H->t0);
+    } else { /* Eq. 23's sum (density.c) from the hits within h: W_h is 0 beyond h, and adds nothing */
+        /* Eq. 7's kernel, W_h and (lists) dW_h / r from one sqrt */
+        pfsph__terms_w_dwr(&J->kk, &J->ctx->kern, n16, H->r2, J->filter ? H->t0 : NULL, H->t1, sk ? H->t2 : NULL);
         pfsph_real s = *ds;
         if (ps == J->ctx->fluid)
             for (int e = 0; e < n; e++) s += H->t1[e];
@@ -215,7 +217,6 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
         *ds = s;
         if (sk) { /* the pairs within h, as density.c lists them (dW/r of each) */
             const pfsph_real h2 = J->ctx->kern.h * J->ctx->kern.h;
-            pfsph__terms_dwr(&J->ctx->kern, n16, H->r2, H->t2);
             size_t pos = sk->pos;
             for (int e = 0; e < n; e++)
                 if (H->r2[e] < h2) {
