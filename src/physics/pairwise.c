@@ -218,14 +218,27 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
         if (sk) { /* the pairs within h, as density.c lists them (dW/r of each) */
             const pfsph_real h2 = J->ctx->kern.h * J->ctx->kern.h;
             size_t pos = sk->pos;
-            for (int e = 0; e < n; e++)
-                if (H->r2[e] < h2) {
-                    if (pos < sk->re) {
-                        sk->idx[pos] = H->j[e];
-                        sk->dw[pos] = H->t2[e];
-                    }
-                    pos++;
+            if (pos + (size_t)n <= sk->re) {
+                /* room for all: branch-free (each entry written, kept only within h), as about
+                 * a third of the k h hits lie within h and the branch mispredicted */
+                uint32_t *restrict idx = sk->idx + pos;
+                pfsph_real *restrict dw = sk->dw + pos;
+                size_t m = 0;
+                for (int e = 0; e < n; e++) {
+                    idx[m] = H->j[e];
+                    dw[m] = H->t2[e];
+                    m += H->r2[e] < h2;
                 }
+                pos += m;
+            } else
+                for (int e = 0; e < n; e++)
+                    if (H->r2[e] < h2) {
+                        if (pos < sk->re) {
+                            sk->idx[pos] = H->j[e];
+                            sk->dw[pos] = H->t2[e];
+                        }
+                        pos++;
+                    }
             sk->pos = pos;
         }
     }
