@@ -177,6 +177,20 @@ void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t
         for (int e = 0; e < n; e++) w[e] = r2[e] > 0 ? w[e] : 0;
 }
 
+PFSPH__CLONES
+void pfsph__terms_pair_sc_cf(double U_R, int n, const double *restrict cf, const pfsph_real *restrict r2,
+                             double *restrict sc, pfsph_real *restrict w)
+{
+    /* pfsph__terms_pair_sc's arithmetic loop with the coefficients given */
+    for (int e = 0; e < n; e++) {
+        const double r = __builtin_sqrt((double)r2[e]);
+        const double cr = (double)pfsph__cos_pair((float)(U_R * r)) / r;
+        sc[e] = r2[e] > 0 && cf[e] != 0.0 ? cf[e] * cr : 0.0;
+    }
+    if (w)
+        for (int e = 0; e < n; e++) w[e] = r2[e] > 0 ? w[e] : 0;
+}
+
 PFSPH__CLONES_DQ
 void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta)
 {

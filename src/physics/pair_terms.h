@@ -59,6 +59,11 @@ void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_r
                          const double *restrict mj, const double *restrict ndj, const double *restrict theta,
                          double *restrict t);
 
+/* sc[e] = cf[e] cos(U_R r) / r (0 where r2[e] = 0 or cf[e] = 0) and, with w, w[e] = 0 where
+ * r2[e] = 0, as pfsph__terms_pair_sc computes them once it has gathered cf (the same bits). */
+void pfsph__terms_pair_sc_cf(double U_R, int n, const double *restrict cf, const pfsph_real *restrict r2,
+                             double *restrict sc, pfsph_real *restrict w);
+
 /* theta[e] = pfsph_thermo_theta(key, idi, idj[e]) (the same bits), e < n. */
 void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta);
 
