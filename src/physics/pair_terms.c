@@ -35,6 +35,73 @@ void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r
 }
 
 PFSPH__CLONES
+void pfsph__terms_w_dwr(const pfsph_kernel *kk, const pfsph_kernel *k, int n, const pfsph_real *restrict r2,
+                        pfsph_real *restrict wk, pfsph_real *restrict w, pfsph_real *restrict dw)
+{
+    /* pfsph__terms_w with kk and k and pfsph__terms_dwr with k from one sqrt: the same bits */
+    const pfsph_kernel KK = *kk, K = *k;
+    if (wk && dw)
+        for (int e = 0; e < n; e++) {
+            const pfsph_real r = pfsph_sqrt(r2[e]);
+            wk[e] = pfsph_kernel_w(&KK, r);
+            w[e] = pfsph_kernel_w(&K, r);
+            dw[e] = pfsph_kernel_dw_r(&K, r);
+        }
+    else if (wk)
+        for (int e = 0; e < n; e++) {
+            const pfsph_real r = pfsph_sqrt(r2[e]);
+            wk[e] = pfsph_kernel_w(&KK, r);
+            w[e] = pfsph_kernel_w(&K, r);
+        }
+    else if (dw)
+        for (int e = 0; e < n; e++) {
+            const pfsph_real r = pfsph_sqrt(r2[e]);
+            w[e] = pfsph_kernel_w(&K, r);
+            dw[e] = pfsph_kernel_dw_r(&K, r);
+        }
+    else
+        for (int e = 0; e < n; e++) w[e] = pfsph_kernel_w(&K, pfsph_sqrt(r2[e]));
+}
+
+PFSPH__CLONES
+void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const uint32_t *restrict idx,
+                           const pfsph_real *restrict tx, const pfsph_real *restrict ty, const pfsph_real *restrict tz,
+                           pfsph_real x, pfsph_real y, pfsph_real z, const pfsph_real *restrict aux,
+                           pfsph_real *restrict cx, pfsph_real *restrict cy, pfsph_real *restrict cz,
+                           pfsph_real *restrict cw, pfsph_real *restrict w)
+{
+    /* pcisph_lists.c's gather of x_ij (scalar: the compiler does not vectorise the indexed
+     * loads), then pfsph__terms_w and pfsph__terms_dwr from one sqrt with the mask beyond h in
+     * one vector loop; with aux, the products aux_j w and aux_j dW/r the passes formed from the
+     * masked terms (rounded once, as there) */
+    pfsph_real r2[PFSPH_LIST_TERMS_MAX], a[PFSPH_LIST_TERMS_MAX];
+    for (int q = 0; q < n; q++) {
+        const uint32_t j = idx[q];
+        const pfsph_real dx = x - tx[j], dy = y - ty[j], dz = z - tz[j];
+        cx[q] = dx;
+        cy[q] = dy;
+        cz[q] = dz;
+        r2[q] = dx * dx + dy * dy + dz * dz;
+    }
+    const pfsph_kernel K = *k;
+    if (aux) {
+        for (int q = 0; q < n; q++) a[q] = aux[idx[q]];
+        for (int q = 0; q < n; q++) {
+            const pfsph_real r = pfsph_sqrt(r2[q]);
+            const pfsph_real wq = r2[q] < h2 ? pfsph_kernel_w(&K, r) : 0;
+            const pfsph_real dq = r2[q] < h2 ? pfsph_kernel_dw_r(&K, r) : 0;
+            w[q] = a[q] * wq;
+            cw[q] = a[q] * dq;
+        }
+    } else
+        for (int q = 0; q < n; q++) {
+            const pfsph_real r = pfsph_sqrt(r2[q]);
+            w[q] = r2[q] < h2 ? pfsph_kernel_w(&K, r) : 0;
+            cw[q] = r2[q] < h2 ? pfsph_kernel_dw_r(&K, r) : 0;
+        }
+}
+
+PFSPH__CLONES
 void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const uint32_t *restrict jj,
                                 const pfsph_real *restrict dx, const pfsph_real *restrict dy,
                                 const pfsph_real *restrict dz, const pfsph_real *restrict r2, pfsph_real *restrict dw,
@@ -58,6 +125,34 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
 }
 
 PFSPH__CLONES
+void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *restrict x,
+                            const pfsph_real *restrict y, const pfsph_real *restrict z, const uint8_t *restrict phase,
+                            const pfsph_real *restrict nu_phase, pfsph_real xi, pfsph_real yi, pfsph_real zi, int n,
+                            const uint32_t *restrict jj, const pfsph_real *restrict dw, pfsph_real *restrict dx,
+                            pfsph_real *restrict dy, pfsph_real *restrict dz, pfsph_real *restrict sv)
+{
+    /* the gather apart (scalar), then viscosity.c visc_pair's factor in a vector loop */
+    pfsph_real r2[PFSPH_LIST_TERMS_MAX], nuj[PFSPH_LIST_TERMS_MAX];
+    for (int e = 0; e < n; e++) {
+        const uint32_t j = jj[e];
+        const pfsph_real ex = xi - x[j], ey = yi - y[j], ez = zi - z[j];
+        dx[e] = ex;
+        dy[e] = ey;
+        dz[e] = ez;
+        r2[e] = ex * ex + ey * ey + ez * ez;
+        nuj[e] = nu_phase[phase[j]];
+    }
+    const pfsph_real *restrict vx = in->vx, *restrict vy = in->vy, *restrict vz = in->vz, *restrict nd = in->nd;
+    const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, nui = in->nui, eps = in->eps;
+    for (int e = 0; e < n; e++) {
+        const uint32_t j = jj[e];
+        const pfsph_real nu = (pfsph_real)0.5 * (nui + nuj[e]);
+        const pfsph_real vdx = (vxi - vx[j]) * dx[e] + (vyi - vy[j]) * dy[e] + (vzi - vz[j]) * dz[e];
+        sv[e] = nu / nd[j] * vdx / (r2[e] + eps) * dw[e];
+    }
+}
+
+PFSPH__CLONES
 void pfsph__terms_pair_cos(double U_R, int n, const pfsph_real *restrict r2, double *restrict cr)
 {
     for (int e = 0; e < n; e++) {
@@ -73,6 +168,20 @@ void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t
 {
     /* the gather apart, so that the arithmetic loop vectorises */
     for (int e = 0; e < n; e++) cf[e] = coef[phase[jj[e]]];
+    for (int e = 0; e < n; e++) {
+        const double r = __builtin_sqrt((double)r2[e]);
+        const double cr = (double)pfsph__cos_pair((float)(U_R * r)) / r;
+        sc[e] = r2[e] > 0 && cf[e] != 0.0 ? cf[e] * cr : 0.0;
+    }
+    if (w)
+        for (int e = 0; e < n; e++) w[e] = r2[e] > 0 ? w[e] : 0;
+}
+
+PFSPH__CLONES
+void pfsph__terms_pair_sc_cf(double U_R, int n, const double *restrict cf, const pfsph_real *restrict r2,
+                             double *restrict sc, pfsph_real *restrict w)
+{
+    /* pfsph__terms_pair_sc's arithmetic loop with the coefficients given */
     for (int e = 0; e < n; e++) {
         const double r = __builtin_sqrt((double)r2[e]);
         const double cr = (double)pfsph__cos_pair((float)(U_R * r)) / r;

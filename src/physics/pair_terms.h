@@ -10,6 +10,21 @@ void pfsph__terms_w(const pfsph_kernel *k, int n, const pfsph_real *restrict r2,
 /* dw[e] = pfsph_kernel_dw_r(|x_ij|) */
 void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r2, pfsph_real *restrict dw);
 
+/* w[e] = W_k(|x_ij|) and, where not NULL, wk[e] = W_kk(|x_ij|) and dw[e] = dW_k/r, from one
+ * square root of r2[e], e < n: pfsph__terms_w and pfsph__terms_dwr's values (the same bits). */
+void pfsph__terms_w_dwr(const pfsph_kernel *kk, const pfsph_kernel *k, int n, const pfsph_real *restrict r2,
+                        pfsph_real *restrict wk, pfsph_real *restrict w, pfsph_real *restrict dw);
+
+/* Per listed target j = idx[q], q < n, of point (x, y, z): x_ij into cx, cy, cz, and W (into w)
+ * and dW/r (into cw) of |x_ij| where |x_ij|^2 < h2, 0 beyond; with aux, both times aux[j]. The
+ * expressions of pfsph__terms_w / _dwr (the same bits). n <= PFSPH_LIST_TERMS_MAX. */
+#define PFSPH_LIST_TERMS_MAX 512
+void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const uint32_t *restrict idx,
+                           const pfsph_real *restrict tx, const pfsph_real *restrict ty, const pfsph_real *restrict tz,
+                           pfsph_real x, pfsph_real y, pfsph_real z, const pfsph_real *restrict aux,
+                           pfsph_real *restrict cx, pfsph_real *restrict cy, pfsph_real *restrict cz,
+                           pfsph_real *restrict cw, pfsph_real *restrict w);
+
 /* particle i and the fluid arrays, for pfsph__terms_visc_pressure */
 typedef struct pfsph_pair_in {
     pfsph_kernel k;
@@ -26,6 +41,16 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
                                 const pfsph_real *restrict dz, const pfsph_real *restrict r2, pfsph_real *restrict dw,
                                 pfsph_real *restrict sv, pfsph_real *restrict sp);
 
+/* Per listed fluid neighbour jj[e], e < n <= PFSPH_LIST_TERMS_MAX, of particle i at (xi, yi, zi)
+ * (the targets x, y, z, their phase and nu_phase[phase] their viscosity), with dw[e] its dW/r:
+ * x_ij into dx, dy, dz and sv[e] the Morris factor of pfsph__terms_visc_pressure (in's vx, vy,
+ * vz, nd, vxi, vyi, vzi, nui, eps; the same bits as viscosity.c visc_pair). */
+void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *restrict x,
+                            const pfsph_real *restrict y, const pfsph_real *restrict z, const uint8_t *restrict phase,
+                            const pfsph_real *restrict nu_phase, pfsph_real xi, pfsph_real yi, pfsph_real zi, int n,
+                            const uint32_t *restrict jj, const pfsph_real *restrict dw, pfsph_real *restrict dx,
+                            pfsph_real *restrict dy, pfsph_real *restrict dz, pfsph_real *restrict sv);
+
 /* Per fluid hit e of the thermostat (thermostat.h): t[e] = pfsph__thermo_fluid(amp_ts[e], nu[e],
  * mi, mj[e], ndi, ndj[e], r2[e], dw[e], eps, sqrt(r2[e]), theta[e]), the noise force over r,
  * for hits with r2 > 0 (others: not finite). */
@@ -33,6 +58,11 @@ void pfsph__terms_thermo(double mi, double ndi, double eps, int n, const pfsph_r
                          const pfsph_real *restrict dw, const double *restrict amp_ts, const double *restrict nu,
                          const double *restrict mj, const double *restrict ndj, const double *restrict theta,
                          double *restrict t);
+
+/* sc[e] = cf[e] cos(U_R r) / r (0 where r2[e] = 0 or cf[e] = 0) and, with w, w[e] = 0 where
+ * r2[e] = 0, as pfsph__terms_pair_sc computes them once it has gathered cf (the same bits). */
+void pfsph__terms_pair_sc_cf(double U_R, int n, const double *restrict cf, const pfsph_real *restrict r2,
+                             double *restrict sc, pfsph_real *restrict w);
 
 /* theta[e] = pfsph_thermo_theta(key, idi, idj[e]) (the same bits), e < n. */
 void pfsph__terms_theta(uint64_t key, uint32_t idi, int n, const uint32_t *restrict idj, double *restrict theta);

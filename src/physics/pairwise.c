@@ -192,6 +192,7 @@ typedef struct pw_sink {
 typedef struct pw_scratch {
     pfsph_hits H;
     double cr[PFSPH_HITS_CAP + PFSPH_HITS_PAD], sc[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
+    int sp[PFSPH_HITS_CAP + PFSPH_HITS_PAD]; /* hits that take Eq. 24 (sum_hits) */
 } pw_scratch;
 
 /* Adds the pairs in W->H (targets in ps) to P's four-lane sums (pair_terms.h): sc = c m_j f(r) / r
@@ -204,9 +205,11 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
     const int n = H->n;
     /* the per-pair cosine and kernel in vector code (pair_terms.c), over whole vectors */
     const int n16 = pfsph_hits_pad16(H);
-    if (J->filter) pfsph__terms_w(&J->kk, n16, H->r2, H->t0);
-    if (ds) { /* Eq. 23's sum (density.c) from the hits within h: W_h is 0 beyond h, and adds nothing */
-        pfsph__terms_w(&J->ctx->kern, n16, H->r2, H->t1);
+    if (!ds) {
+        if (J->filter) pfsph__terms_w(&J->kk, n16, H->r2, H->t0);
+    } else { /* Eq. 23's sum (density.c) from the hits within h: W_h is 0 beyond h, and adds nothing */
+        /* Eq. 7's kernel, W_h and (lists) dW_h / r from one sqrt */
+        pfsph__terms_w_dwr(&J->kk, &J->ctx->kern, n16, H->r2, J->filter ? H->t0 : NULL, H->t1, sk ? H->t2 : NULL);
         pfsph_real s = *ds;
         if (ps == J->ctx->fluid)
             for (int e = 0; e < n; e++) s += H->t1[e];
@@ -215,16 +218,28 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
         *ds = s;
         if (sk) { /* the pairs within h, as density.c lists them (dW/r of each) */
             const pfsph_real h2 = J->ctx->kern.h * J->ctx->kern.h;
-            pfsph__terms_dwr(&J->ctx->kern, n16, H->r2, H->t2);
             size_t pos = sk->pos;
-            for (int e = 0; e < n; e++)
-                if (H->r2[e] < h2) {
-                    if (pos < sk->re) {
-                        sk->idx[pos] = H->j[e];
-                        sk->dw[pos] = H->t2[e];
-                    }
-                    pos++;
+            if (pos + (size_t)n <= sk->re) {
+                /* room for all: branch-free (each entry written, kept only within h), as about
+                 * a third of the k h hits lie within h and the branch mispredicted */
+                uint32_t *restrict idx = sk->idx + pos;
+                pfsph_real *restrict dw = sk->dw + pos;
+                size_t m = 0;
+                for (int e = 0; e < n; e++) {
+                    idx[m] = H->j[e];
+                    dw[m] = H->t2[e];
+                    m += H->r2[e] < h2;
                 }
+                pos += m;
+            } else
+                for (int e = 0; e < n; e++)
+                    if (H->r2[e] < h2) {
+                        if (pos < sk->re) {
+                            sk->idx[pos] = H->j[e];
+                            sk->dw[pos] = H->t2[e];
+                        }
+                        pos++;
+                    }
             sk->pos = pos;
         }
     }
@@ -233,6 +248,28 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
          * direction, no force, and not in Eq. 7's sum. The cosine in float (pfsph__cos_pair,
          * error < 2e-7): the force is summed in double, its shape needs 1e-7. */
         pfsph__terms_pair_sc(J->U_R, coef, ps->phase, n16, H->j, H->r2, W->cr, W->sc, J->filter ? H->t0 : NULL);
+    } else if (!(ai > 0)) {
+        /* i has no film: coef[pb] for every hit but those with a film or in another bubble,
+         * which take Eq. 24 (pfsph_film_pair_c) in a second loop; then the cosine and sc in
+         * vector code. The same cf and sc per hit as the loop below. */
+        double *cf = W->cr; /* the hits' coefficients (the loop below keeps cos / r there) */
+        int *sp = W->sp, ns = 0;
+        for (int e = 0; e < n16; e++) {
+            const uint32_t j = H->j[e];
+            const int bj = ps->bubble[j];
+            cf[e] = coef[ps->phase[j]];
+            sp[ns] = e;
+            ns += e < n && (ps->film[j] > 0 || (bi && bj && bi != bj));
+        }
+        for (int q = 0; q < ns; q++) {
+            const int e = sp[q];
+            const uint32_t j = H->j[e];
+            const int pb = ps->phase[j];
+            const int bj = ps->bubble[j];
+            const bool apart = bi && bj && bi != bj;
+            cf[e] = pfsph_film_pair_c(J->c, J->film, pa, ai, pb, (double)ps->film[j], apart) * J->mass[pb];
+        }
+        pfsph__terms_pair_sc_cf(J->U_R, n16, cf, H->r2, W->sc, J->filter ? H->t0 : NULL);
     } else {
         pfsph__terms_pair_cos(J->U_R, n, H->r2, W->cr);
         for (int e = 0; e < n; e++) {

@@ -36,6 +36,8 @@ typedef struct pcisph {
     /* the interactive mode's once-per-step neighbour lists (pcisph_lists.h) */
     pfsph_nlist l, lb;
     pfsph_pcisph_pairs cf, cb; /* and an iteration's pairs, density pass to pressure pass */
+    pfsph_real *pn;            /* the pressure pass's p / delta^2 per particle */
+    size_t pn_cap;
 } pcisph;
 
 /* PCISPH scaling: |sum grad W|^2 + sum |grad W|^2 over a full lattice neighbourhood. */
@@ -63,7 +65,20 @@ static void destroy(void *state)
     pfsph_nlist_free(&p->lb);
     pfsph__pcisph_pairs_free(&p->cf);
     pfsph__pcisph_pairs_free(&p->cb);
+    free(p->pn);
     free(p);
+}
+
+/* room for n values in *a (capacity *cap): PFSPH_OK or PFSPH_ENOMEM (then as before) */
+static int reserve(pfsph_real **a, size_t *cap, size_t n)
+{
+    if (n <= *cap) return PFSPH_OK;
+    const size_t m = n + n / 8 + 64;
+    pfsph_real *q = realloc(*a, m * sizeof(pfsph_real));
+    if (!q) return PFSPH_ENOMEM;
+    *a = q;
+    *cap = m;
+    return PFSPH_OK;
 }
 
 static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsph_real *const *scr,
@@ -83,7 +98,7 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
     const int lists = c->interactive && L && LB;
     /* the pairs kept from each density pass for its pressure pass; the list walks when out of memory */
     const int pairs = lists && pfsph__pcisph_pairs_reserve(&P->cf, L->start[n]) == PFSPH_OK &&
-        pfsph__pcisph_pairs_reserve(&P->cb, LB->start[n]) == PFSPH_OK;
+        pfsph__pcisph_pairs_reserve(&P->cb, LB->start[n]) == PFSPH_OK && reserve(&P->pn, &P->pn_cap, n) == PFSPH_OK;
     const double dt = c->dt;
     pfsph_real *apx = ap[0], *apy = ap[1], *apz = ap[2];
     pfsph_real *xp = scr[XP], *yp = scr[YP], *zp = scr[ZP], *ndp = scr[NDP], *er = scr[ERR];
@@ -130,7 +145,7 @@ static void solve(void *state, const pfsph_ctx *c, pfsph_real *const ap[3], pfsp
         pfsph__halo(c, dens, 2);
         const size_t nall = pfsph__fluid_count(c);
         avg = nall ? pfsph__fluid_sum(c, er) / (double)nall : 0; /* the serial sum on any rank count */
-        if (pairs) pfsph__pcisph_pressure_pairs(c, L, LB, ndp, f->p, &P->cf, &P->cb, apx, apy, apz);
+        if (pairs) pfsph__pcisph_pressure_pairs(c, L, LB, ndp, f->p, &P->cf, &P->cb, P->pn, apx, apy, apz);
         else if (lists) pfsph__pcisph_pressure(c, L, LB, xp, yp, zp, ndp, f->p, apx, apy, apz);
         else pfsph__pressure_accel(c, xp, yp, zp, ndp, f->p, apx, apy, apz);
         it++;

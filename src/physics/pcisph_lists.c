@@ -214,30 +214,6 @@ void pfsph__pcisph_pairs_free(pfsph_pcisph_pairs *c)
     *c = (pfsph_pcisph_pairs){0};
 }
 
-/* The entries [e0, e1) of point (x, y, z) against targets (tx, ty, tz): x_ij and dW/r into C
- * (0 beyond h), W into w (0 beyond h) for the caller's sum; chunks of the hits' room. As
- * gather + pfsph__terms_w / _dwr: the same values for the pairs within h, zeros for the rest. */
-static inline void pairs_block(const pfsph_kernel *k, pfsph_real h2, pfsph_hits *H, const uint32_t *idx, uint32_t e0,
-                               uint32_t e1, const pfsph_real *tx, const pfsph_real *ty, const pfsph_real *tz,
-                               pfsph_real x, pfsph_real y, pfsph_real z, pfsph_pcisph_pairs *C)
-{
-    pfsph_real *restrict cx = C->dx + e0, *restrict cy = C->dy + e0, *restrict cz = C->dz + e0;
-    const int m = (int)(e1 - e0);
-    for (int q = 0; q < m; q++) {
-        const uint32_t j = idx[e0 + (uint32_t)q];
-        const pfsph_real dx = x - tx[j], dy = y - ty[j], dz = z - tz[j];
-        cx[q] = dx;
-        cy[q] = dy;
-        cz[q] = dz;
-        H->r2[q] = dx * dx + dy * dy + dz * dz;
-    }
-    pfsph__terms_w(k, m, H->r2, H->t0);
-    pfsph__terms_dwr(k, m, H->r2, C->dw + e0);
-    pfsph_real *restrict cw = C->dw + e0;
-    for (int q = 0; q < m; q++)
-        if (!(H->r2[q] < h2)) H->t0[q] = cw[q] = 0;
-}
-
 void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb, const pfsph_real *x,
                                  const pfsph_real *y, const pfsph_real *z, pfsph_real *nd, pfsph_pcisph_pairs *cf,
                                  pfsph_pcisph_pairs *cb)
@@ -249,23 +225,28 @@ void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, con
     const size_t n = ctx->fluid->n;
 #pragma omp parallel
     {
-        pfsph_hits H;
+        pfsph_real w[PFSPH_LIST_TERMS_MAX];
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const pfsph_real xi = x[i], yi = y[i], zi = z[i];
             /* the terms in the list's order, zeros for the pairs beyond h: pfsph__pcisph_density's sum */
             pfsph_real s = w0;
             for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end;) {
-                const uint32_t e1 = end - e > PFSPH_HITS_CAP ? e + PFSPH_HITS_CAP : end;
-                pairs_block(k, h2, &H, l->idx, e, e1, x, y, z, xi, yi, zi, cf);
-                for (uint32_t q = 0; q < e1 - e; q++) s += H.t0[q];
+                const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
+                const int m = (int)(e1 - e);
+                pfsph__terms_list_wdw(k, h2, m, l->idx + e, x, y, z, xi, yi, zi, NULL, cf->dx + e, cf->dy + e,
+                                      cf->dz + e, cf->dw + e, w);
+                for (int q = 0; q < m; q++) s += w[q];
                 e = e1;
             }
+            /* the walls' entries hold aux_j W and aux_j dW/r: the products both passes form */
             pfsph_real sb = 0;
             for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end;) {
-                const uint32_t e1 = end - e > PFSPH_HITS_CAP ? e + PFSPH_HITS_CAP : end;
-                pairs_block(k, h2, &H, lb->idx, e, e1, b->x, b->y, b->z, xi, yi, zi, cb);
-                for (uint32_t q = 0; q < e1 - e; q++) sb += b->aux[lb->idx[e + q]] * H.t0[q];
+                const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
+                const int m = (int)(e1 - e);
+                pfsph__terms_list_wdw(k, h2, m, lb->idx + e, b->x, b->y, b->z, xi, yi, zi, b->aux, cb->dx + e,
+                                      cb->dy + e, cb->dz + e, cb->dw + e, w);
+                for (int q = 0; q < m; q++) sb += w[q];
                 e = e1;
             }
             nd[i] = s + sb * inv_v0;
@@ -275,41 +256,48 @@ void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, con
 
 void pfsph__pcisph_pressure_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb,
                                   const pfsph_real *nd, const pfsph_real *p, const pfsph_pcisph_pairs *cf,
-                                  const pfsph_pcisph_pairs *cb, pfsph_real *apx, pfsph_real *apy, pfsph_real *apz)
+                                  const pfsph_pcisph_pairs *cb, pfsph_real *pn, pfsph_real *apx, pfsph_real *apy,
+                                  pfsph_real *apz)
 {
-    const pfsph_particles *f = ctx->fluid, *b = ctx->boundary;
+    const pfsph_particles *f = ctx->fluid;
     const pfsph_real inv_v0 = (pfsph_real)1 / ctx->V0;
     const size_t n = f->n;
     const pfsph_real *restrict cx = cf->dx, *restrict cy = cf->dy, *restrict cz = cf->dz, *restrict cw = cf->dw;
     const pfsph_real *restrict bxs = cb->dx, *restrict bys = cb->dy, *restrict bzs = cb->dz, *restrict bws = cb->dw;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        const pfsph_real pi = p[i] / (nd[i] * nd[i]);
-        pfsph_real ax = 0, ay = 0, az = 0;
-        /* pfsph__pcisph_pressure's terms in its order; a pair beyond h adds s = 0 times x_ij */
-        for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end; e++) {
-            const uint32_t j = l->idx[e];
-            const pfsph_real s = (pi + p[j] / (nd[j] * nd[j])) * cw[e];
-            ax += s * cx[e];
-            ay += s * cy[e];
-            az += s * cz[e];
-        }
-        if (pi > 0) {
-            pfsph_real bx = 0, by = 0, bz = 0;
-            for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end; e++) {
-                const pfsph_real s = b->aux[lb->idx[e]] * bws[e];
-                bx += s * bxs[e];
-                by += s * bys[e];
-                bz += s * bzs[e];
+#pragma omp parallel
+    {
+        /* p / delta^2 once per particle, not once per pair (a division each): the same value */
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) pn[i] = p[i] / (nd[i] * nd[i]);
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const pfsph_real pi = pn[i];
+            pfsph_real ax = 0, ay = 0, az = 0;
+            /* pfsph__pcisph_pressure's terms in its order; a pair beyond h adds s = 0 times x_ij */
+            for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end; e++) {
+                const uint32_t j = l->idx[e];
+                const pfsph_real s = (pi + pn[j]) * cw[e];
+                ax += s * cx[e];
+                ay += s * cy[e];
+                az += s * cz[e];
             }
-            const pfsph_real wb = pi * inv_v0;
-            ax += wb * bx;
-            ay += wb * by;
-            az += wb * bz;
+            if (pi > 0) {
+                pfsph_real bx = 0, by = 0, bz = 0;
+                for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end; e++) {
+                    const pfsph_real s = bws[e]; /* aux_j dW/r (pfsph__pcisph_density_pairs) */
+                    bx += s * bxs[e];
+                    by += s * bys[e];
+                    bz += s * bzs[e];
+                }
+                const pfsph_real wb = pi * inv_v0;
+                ax += wb * bx;
+                ay += wb * by;
+                az += wb * bz;
+            }
+            const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
+            apx[i] = inv_m * ax;
+            apy[i] = inv_m * ay;
+            apz[i] = inv_m * az;
         }
-        const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
-        apx[i] = inv_m * ax;
-        apy[i] = inv_m * ay;
-        apz[i] = inv_m * az;
     }
 }

@@ -224,7 +224,22 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
             /* the same terms in the same order from a list or a grid walk: the same bits */
             const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
             visc_acc acc = {0, 0, 0, 0, 0, 0};
-            if (nl) {
+            if (nl && !thermo) {
+                /* visc_pair's factor in vector code (pair_terms.c), added in the list's order */
+                const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, nd, NULL, vxi, vyi, vzi, nui, 0, eps};
+                for (uint32_t e = nl->start[i], end = nl->start[i + 1]; e < end;) {
+                    const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
+                    const int m = (int)(e1 - e);
+                    pfsph__terms_visc_list(&in, f->x, f->y, f->z, f->phase, ctx->nu, xi, yi, zi, m, nl->idx + e,
+                                           nl->dw + e, H.dx, H.dy, H.dz, H.t1);
+                    for (int q = 0; q < m; q++) {
+                        acc.ax += H.t1[q] * H.dx[q];
+                        acc.ay += H.t1[q] * H.dy[q];
+                        acc.az += H.t1[q] * H.dz[q];
+                    }
+                    e = e1;
+                }
+            } else if (nl) {
                 for (uint32_t e = nl->start[i]; e < nl->start[i + 1]; e++) {
                     const uint32_t j = nl->idx[e];
                     pfsph_real dx = xi - f->x[j], dy = yi - f->y[j], dz = zi - f->z[j];
