@@ -7,6 +7,7 @@
 #include <mpi.h>
 #include <stdint.h>
 
+#include "mpi/cost.h"
 #include "mpi/cut.h"
 #include "pfsph/dist.h"
 #include "pfsph/sim.h"
@@ -24,12 +25,16 @@ typedef struct pfsph_mpi_fig {
     uint64_t steps, owned, own_min, own_max, halo_particles, halo_calls, bytes_sent, migr_bytes, messages;
     uint64_t walls, walls_max, wall_trims, wall_fetches, wall_bytes; /* static walls held, their moves */
     uint64_t resident_max;                                           /* fluid (own + halo) + walls, most */
-    uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
-    uint64_t rss_kb;      /* its resident memory at the frame */
-    uint64_t diffuse;     /* diffuse particles it held at the frame (before the gather) */
+    uint64_t peak_rss_kb;          /* getrusage: the rank's peak resident memory (the set-up included) */
+    uint64_t rss_kb;               /* its resident memory at the frame */
+    uint64_t diffuse;              /* diffuse particles it held at the frame (before the gather) */
+    uint64_t cost_samples, weight; /* steps measured; its particles' weight at the last cut (0: count) */
+    double work_cpu, comm_cpu;     /* CPU s outside / inside the decomposition's code (src/mpi/cost.c) */
+    double work_step_max;          /* the costliest step's CPU s outside it */
+    double per_particle;           /* the smoothed CPU s per owned particle and step */
 } pfsph_mpi_fig;
 
-typedef struct pfsph_decomp {
+struct pfsph_decomp {
     pfsph_dist d; /* first: the hooks the step calls */
     MPI_Comm comm;
     int rank, size;
@@ -64,7 +69,8 @@ typedef struct pfsph_decomp {
     size_t *qa, *qb, *qc;
     int *cnt2, *rcnt2;
     uint64_t *scan_all; /* 8 size: every rank's counters of a scan (sets.c) */
-} pfsph_decomp;
+    pfsph_cost cost;    /* this rank's measured cost, its particles' weight at the cut (cost.c) */
+};
 
 /* The decomposition of the world communicator (not yet attached to a simulation). */
 int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm);
