@@ -81,6 +81,17 @@ void pfsph_cost_weigh(pfsph_decomp *D, double max_per_particle)
     k->weight = w >= 1 ? (uint64_t)w : 1; /* c <= max: at most PFSPH_CUT_WEIGHT_MAX */
 }
 
+void pfsph_cost_figures(const pfsph_decomp *D, pfsph_mpi_fig *f)
+{
+    const pfsph_cost *k = &D->cost;
+    f->cost_samples = k->samples;
+    f->weight = D->C.weighted ? k->weight : 0;
+    f->work_cpu = k->work_cpu;
+    f->comm_cpu = k->comm_cpu;
+    f->work_step_max = k->step_max;
+    f->per_particle = k->per_particle;
+}
+
 int pfsph_cost_env_mode(void)
 {
     const char *v = getenv("PFSPH_MPI_CUT");

@@ -10,6 +10,7 @@
 #include "pfsph/dist.h"
 
 typedef struct pfsph_decomp pfsph_decomp;
+struct pfsph_mpi_fig;
 
 typedef struct pfsph_cost {
     int by_cost;         /* PFSPH_MPI_CUT: 1 "cost" (the default), 0 "count" (every particle weighs 1) */
@@ -47,5 +48,7 @@ void pfsph_cost_sample(pfsph_decomp *D, int first);
  * particle, and from the largest the weight of its particles at the next cut. */
 double pfsph_cost_local(const pfsph_decomp *D);
 void pfsph_cost_weigh(pfsph_decomp *D, double max_per_particle);
+/* This rank's cost figures into its summary.json record (gathered at every frame). */
+void pfsph_cost_figures(const pfsph_decomp *D, struct pfsph_mpi_fig *f);
 
 #endif

@@ -685,13 +685,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
                           0,
                           0,
                           0};
-    const pfsph_cost *k = &D->cost;
-    mine.cost_samples = k->samples;
-    mine.weight = D->C.weighted ? k->weight : 0;
-    mine.work_cpu = k->work_cpu;
-    mine.comm_cpu = k->comm_cpu;
-    mine.work_step_max = k->step_max;
-    mine.per_particle = k->per_particle;
+    pfsph_cost_figures(D, &mine);
     if (D->sim->st.df) {
         size_t *no;
         uint64_t *cr, *rf;

@@ -19,8 +19,9 @@
 #                                          every rank's owned count swung by at least 1.3x
 #   mpi_test.sh diffuse SCENE END NP...   as compare, and the run made diffuse particles, some
 #                                          died, and a rank other than the root held some
-#   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
-#                                          STATUS (default 2) from mpirun
+#   mpi_test.sh refuse SCENE NP [STATUS [VAR=VALUE]]  refused or stopped with one message and exit
+#                                          status STATUS (default 2) from mpirun; VAR=VALUE: set
+#                                          in the environment, the message names VAR
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
 # Exit 77 (skipped) when the build has no MPI or mpirun is missing.
 set -u
@@ -208,12 +209,14 @@ kill)
     same "$TMP/serial" "$TMP/k" || exit 1
     ;;
 refuse)
-    scene=$SRC/$1 np=$2 want=${3:-2}
+    scene=$SRC/$1 np=$2 want=${3:-2} env=${4:-}
+    [ -z "$env" ] || export "${env?}" # a bad setting: the message must name the variable
     mpi "$np" run "$scene" -o "$TMP/bad" --end 0.04 --quiet 2>"$TMP/err"
     rc=$?
     [ "$rc" = "$want" ] || { echo "FAIL: exit status $rc, not $want"; cat "$TMP/err"; exit 1; }
     n=$(grep -c '^pfsph: ' "$TMP/err")
     [ "$n" = 1 ] || { echo "FAIL: $n messages, not 1:"; cat "$TMP/err"; exit 1; }
+    [ -z "$env" ] || grep -q "^pfsph: ${env%%=*}: " "$TMP/err" || { echo "FAIL: the message names no ${env%%=*}"; exit 1; }
     echo "ok: exit status $rc and one message: $(grep '^pfsph: ' "$TMP/err")"
     ;;
 *)
