@@ -81,15 +81,12 @@ void pfsph_cost_weigh(pfsph_decomp *D, double max_per_particle)
     k->weight = w >= 1 ? (uint64_t)w : 1; /* c <= max: at most PFSPH_CUT_WEIGHT_MAX */
 }
 
-void pfsph_cost_figures(const pfsph_decomp *D, pfsph_mpi_fig *f)
+void pfsph_cost_gather(pfsph_decomp *D)
 {
     const pfsph_cost *k = &D->cost;
-    f->cost_samples = k->samples;
-    f->weight = D->C.weighted ? k->weight : 0;
-    f->work_cpu = k->work_cpu;
-    f->comm_cpu = k->comm_cpu;
-    f->work_step_max = k->step_max;
-    f->per_particle = k->per_particle;
+    pfsph_cost_fig mine = {k->samples,     D->C.weighted ? k->weight : 0, k->work_cpu, k->comm_cpu, k->step_max,
+                           k->per_particle};
+    MPI_Gather(&mine, sizeof mine, MPI_BYTE, k->fig, sizeof mine, MPI_BYTE, 0, D->comm);
 }
 
 int pfsph_cost_env_mode(void)
@@ -161,10 +158,11 @@ static int t_agree(pfsph_dist *d, int rc, pfsph_error *err)
     return rc;
 }
 
-void pfsph_cost_init(pfsph_decomp *D)
+int pfsph_cost_init(pfsph_decomp *D)
 {
     pfsph_cost *k = &D->cost;
     memset(k, 0, sizeof *k);
+    k->fig = calloc((size_t)D->size, sizeof *k->fig);
     int mode = pfsph_cost_env_mode(); /* the program refused anything else (pfsph_mpi_check_scene) */
     MPI_Bcast(&mode, 1, MPI_INT, 0, D->comm);
     k->by_cost = mode != 0;
@@ -179,4 +177,5 @@ void pfsph_cost_init(pfsph_decomp *D)
     D->d.scan = t_scan;
     D->d.migrate = t_migrate;
     D->d.agree = t_agree;
+    return k->fig ? PFSPH_OK : PFSPH_ENOMEM;
 }

@@ -10,7 +10,14 @@
 #include "pfsph/dist.h"
 
 typedef struct pfsph_decomp pfsph_decomp;
-struct pfsph_mpi_fig;
+
+/* One rank's figures for summary.json, gathered by the root at every frame. */
+typedef struct pfsph_cost_fig {
+    uint64_t samples, weight;  /* steps measured; its particles' weight at the last cut (0: count) */
+    double work_cpu, comm_cpu; /* CPU s outside / inside the decomposition's code */
+    double step_max;           /* the costliest step's CPU s outside it */
+    double per_particle;       /* the smoothed CPU s per owned particle and step */
+} pfsph_cost_fig;
 
 typedef struct pfsph_cost {
     int by_cost;         /* PFSPH_MPI_CUT: 1 "cost" (the default), 0 "count" (every particle weighs 1) */
@@ -26,13 +33,14 @@ typedef struct pfsph_cost {
     double per_particle; /* smoothed CPU seconds per owned particle and step; 0: none yet */
     uint64_t weight;     /* this rank's particles' weight at the next cut; 0: the count cut */
     uint64_t weighted_cuts;
+    pfsph_cost_fig *fig; /* size; the root: every rank's, as of the last frame */
     /* the hooks of the decomposition, timed by the wrappers cost.c installs */
     pfsph_dist hooks;
 } pfsph_cost;
 
 /* Read PFSPH_MPI_CUT (the root's, broadcast) and PFSPH_MPI_COST_SKEW and wrap the hooks D->d holds
- * so that their time counts as the decomposition's. Collective. */
-void pfsph_cost_init(pfsph_decomp *D);
+ * so that their time counts as the decomposition's. Collective. PFSPH_ENOMEM or 0. */
+int pfsph_cost_init(pfsph_decomp *D);
 /* PFSPH_MPI_CUT's value on this rank: 1 cost, 0 count, -1 neither (the program refuses it) */
 int pfsph_cost_env_mode(void);
 /* The decomposition's code begins or ends (nested calls count once). */
@@ -48,7 +56,7 @@ void pfsph_cost_sample(pfsph_decomp *D, int first);
  * particle, and from the largest the weight of its particles at the next cut. */
 double pfsph_cost_local(const pfsph_decomp *D);
 void pfsph_cost_weigh(pfsph_decomp *D, double max_per_particle);
-/* This rank's cost figures into its summary.json record (gathered at every frame). */
-void pfsph_cost_figures(const pfsph_decomp *D, struct pfsph_mpi_fig *f);
+/* Every rank's figures to the root (a frame's gather, collective). */
+void pfsph_cost_gather(pfsph_decomp *D);
 
 #endif

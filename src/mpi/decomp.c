@@ -1,8 +1,9 @@
 /* The domain decomposition: the fluid cut along the grid's cell order (row-major keys, the order
  * the serial sort leaves the particles in) into one contiguous range of cells per rank, by
- * measured cost (or particle count), re-cut every step; each rank holds its cells plus every cell a neighbour walk
- * from them can reach (a key interval), so its particles are a contiguous slice of the serial
- * order and every walk visits the same neighbours in the same order as a serial run. */
+ * measured cost (or particle count), re-cut every step; each rank holds its cells plus every
+ * cell a neighbour walk from them can reach (a key interval), so its particles are a contiguous
+ * slice of the serial order and every walk visits the same neighbours in the same order as a
+ * serial run. */
 #include "mpi/decomp.h"
 
 #include <math.h>
@@ -678,14 +679,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
                           D->resident_max,
                           0,
                           0,
-                          0,
-                          0,
-                          0,
-                          0,
-                          0,
-                          0,
                           0};
-    pfsph_cost_figures(D, &mine);
     if (D->sim->st.df) {
         size_t *no;
         uint64_t *cr, *rf;
@@ -699,6 +693,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         mine.rss_kb = (uint64_t)pages_res * (uint64_t)sysconf(_SC_PAGESIZE) / 1024;
     if (sm) fclose(sm);
     MPI_Gather(&mine, sizeof mine, MPI_BYTE, D->fig, sizeof mine, MPI_BYTE, 0, D->comm);
+    pfsph_cost_gather(D); /* the ranks' cost figures, beside */
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
@@ -813,8 +808,7 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.step_begin = step_begin;
     D->d.frame = frame;
     D->d.attach = attach;
-    pfsph_cost_init(D); /* times the hooks above */
-    return PFSPH_OK;
+    return pfsph_cost_init(D); /* times the hooks above */
 }
 
 /* Take the simulation over: the stages, the cut's arrays; the root holds every particle. */

@@ -25,13 +25,9 @@ typedef struct pfsph_mpi_fig {
     uint64_t steps, owned, own_min, own_max, halo_particles, halo_calls, bytes_sent, migr_bytes, messages;
     uint64_t walls, walls_max, wall_trims, wall_fetches, wall_bytes; /* static walls held, their moves */
     uint64_t resident_max;                                           /* fluid (own + halo) + walls, most */
-    uint64_t peak_rss_kb;          /* getrusage: the rank's peak resident memory (the set-up included) */
-    uint64_t rss_kb;               /* its resident memory at the frame */
-    uint64_t diffuse;              /* diffuse particles it held at the frame (before the gather) */
-    uint64_t cost_samples, weight; /* steps measured; its particles' weight at the last cut (0: count) */
-    double work_cpu, comm_cpu;     /* CPU s outside / inside the decomposition's code (src/mpi/cost.c) */
-    double work_step_max;          /* the costliest step's CPU s outside it */
-    double per_particle;           /* the smoothed CPU s per owned particle and step */
+    uint64_t peak_rss_kb; /* getrusage: the rank's peak resident memory (the set-up included) */
+    uint64_t rss_kb;      /* its resident memory at the frame */
+    uint64_t diffuse;     /* diffuse particles it held at the frame (before the gather) */
 } pfsph_mpi_fig;
 
 struct pfsph_decomp {

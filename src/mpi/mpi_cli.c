@@ -78,8 +78,8 @@ static void report(pfsph_dist *d, void *json)
     /* the ranks' work: CPU s outside the decomposition's code, the largest against the mean */
     double wmax = 0, wsum = 0;
     for (int q = 0; q < D->size; q++) {
-        wsum += D->fig[q].work_cpu;
-        if (D->fig[q].work_cpu > wmax) wmax = D->fig[q].work_cpu;
+        wsum += D->cost.fig[q].work_cpu;
+        if (D->cost.fig[q].work_cpu > wmax) wmax = D->cost.fig[q].work_cpu;
     }
     if (wsum > 0) cJSON_AddNumberToObject(m, "work_imbalance_max_over_mean", wmax * D->size / wsum);
     cJSON *ranks = cJSON_AddArrayToObject(m, "per_rank");
@@ -107,14 +107,15 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(r, "diffuse_held_at_frame", (double)f->diffuse);
         cJSON_AddNumberToObject(r, "rss_mib_at_last_frame", (double)f->rss_kb / 1024.0);
         cJSON_AddNumberToObject(r, "peak_rss_mib", (double)f->peak_rss_kb / 1024.0);
-        const double ms = f->cost_samples ? 1e3 / (double)f->cost_samples : 0;
-        cJSON_AddNumberToObject(r, "steps_measured", (double)f->cost_samples);
-        cJSON_AddNumberToObject(r, "work_cpu_s", f->work_cpu);
-        cJSON_AddNumberToObject(r, "work_cpu_ms_per_step", f->work_cpu * ms);
-        cJSON_AddNumberToObject(r, "work_cpu_ms_most_in_a_step", f->work_step_max * 1e3);
-        cJSON_AddNumberToObject(r, "decomposition_cpu_s", f->comm_cpu);
-        cJSON_AddNumberToObject(r, "work_us_per_owned_particle", f->per_particle * 1e6);
-        cJSON_AddNumberToObject(r, "cut_weight_last", (double)f->weight);
+        const pfsph_cost_fig *k = &D->cost.fig[q]; /* src/mpi/cost.c */
+        const double ms = k->samples ? 1e3 / (double)k->samples : 0;
+        cJSON_AddNumberToObject(r, "steps_measured", (double)k->samples);
+        cJSON_AddNumberToObject(r, "work_cpu_s", k->work_cpu);
+        cJSON_AddNumberToObject(r, "work_cpu_ms_per_step", k->work_cpu * ms);
+        cJSON_AddNumberToObject(r, "work_cpu_ms_most_in_a_step", k->step_max * 1e3);
+        cJSON_AddNumberToObject(r, "decomposition_cpu_s", k->comm_cpu);
+        cJSON_AddNumberToObject(r, "work_us_per_owned_particle", k->per_particle * 1e6);
+        cJSON_AddNumberToObject(r, "cut_weight_last", (double)k->weight);
         cJSON_AddItemToArray(ranks, r);
     }
 }
