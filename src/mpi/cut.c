@@ -3,7 +3,8 @@
  * counts exactly, cell by cell, the windows of at most 2 w cells in which a cut, or a halo bound
  * off cells from it, can fall. Each rank counts its keys radix-sorted, so its work is its own
  * particles plus the windows, never the whole grid. The cut is the first cell with q / size of
- * the particles before it, exactly as the dense histogram gives it (pfsph_cut_dense). */
+ * the particles' weight before it, exactly as the dense histogram gives it (pfsph_cut_dense).
+ * Weights are integers summed in integers: the same cut on every rank in any reduction order. */
 #include "mpi/cut.h"
 
 #include <stdlib.h>
@@ -11,16 +12,17 @@
 
 #include "pfsph.h"
 
-/* The exact cut from the cells' prefix counts pre[0..nc] (pre[k]: particles before cell k):
- * rank q starts at the first cell whose prefix reaches q / size of the total; its global
- * offset and its halo window's local bounds, off cells either side. */
-static void cut_from_prefix(pfsph_cut *C, const uint64_t *pre, size_t nc, int size, size_t off)
+/* The exact cut from the cells' prefix counts pre[0..nc] (pre[k]: particles before cell k) and
+ * weights wpre (the same array in the count cut): rank q starts at the first cell whose weight
+ * prefix reaches q / size of the total; its global offset and its halo window's local bounds, off
+ * cells either side. */
+static void cut_from_prefix(pfsph_cut *C, const uint64_t *pre, const uint64_t *wpre, size_t nc, int size, size_t off)
 {
-    const uint64_t total = pre[nc], P = (uint64_t)size;
+    const uint64_t total = pre[nc], wtotal = wpre[nc], P = (uint64_t)size;
     C->cut[0] = 0;
     int q = 1;
     for (size_t k = 0; k <= nc && q < size; k++)
-        while (q < size && pre[k] * P >= (uint64_t)q * total) C->cut[q++] = (uint32_t)k;
+        while (q < size && wpre[k] * P >= (uint64_t)q * wtotal) C->cut[q++] = (uint32_t)k;
     C->cut[size] = (uint32_t)nc;
     for (q = 0; q < size; q++) {
         const size_t a = C->cut[q] > off ? C->cut[q] - off : 0;
@@ -32,10 +34,11 @@ static void cut_from_prefix(pfsph_cut *C, const uint64_t *pre, size_t nc, int si
     C->gofs[size] = total;
 }
 
-/* A window of cells [s, e) counted exactly: F(k), the particles before cell k, for k in [s, e]. */
+/* A window of cells [s, e) counted exactly: F(k), the particles before cell k, for k in [s, e];
+ * the cut's own window also their weight, W(k) (wcnt the same as cnt in the count cut). */
 typedef struct window {
-    uint64_t s, e, Fs;
-    uint32_t *cnt;
+    uint64_t s, e, Fs, Ws;
+    uint64_t *cnt, *wcnt;
 } window;
 
 int pfsph_cut_init(pfsph_cut *C, int size, uint64_t buckets)
@@ -47,14 +50,15 @@ int pfsph_cut_init(pfsph_cut *C, int size, uint64_t buckets)
     C->gofs = calloc(P + 1, sizeof(uint64_t));
     C->lofs = calloc(P, sizeof(uint64_t));
     C->lend = calloc(P, sizeof(uint64_t));
-    /* round 1 always fits: a failure later is then agreed through it */
-    C->cnt_cap = (size_t)C->buckets + 2;
-    C->cnt = malloc(C->cnt_cap * sizeof(uint32_t));
+    /* round 1 always fits, weighted or not: a failure later is then agreed through it */
+    C->cnt_cap = 2 * (size_t)C->buckets + 2;
+    C->cnt = malloc(C->cnt_cap * sizeof(uint64_t));
     C->pre = malloc(((size_t)C->buckets + 1) * sizeof(uint64_t));
+    C->wpre = malloc(((size_t)C->buckets + 1) * sizeof(uint64_t));
     C->win = calloc(3 * P, sizeof(window));
     C->a_q = calloc(P, sizeof(uint64_t));
     C->b_q = calloc(P, sizeof(uint64_t));
-    if (!C->cut || !C->gofs || !C->lofs || !C->lend || !C->cnt || !C->pre || !C->win || !C->a_q || !C->b_q)
+    if (!C->cut || !C->gofs || !C->lofs || !C->lend || !C->cnt || !C->pre || !C->wpre || !C->win || !C->a_q || !C->b_q)
         return PFSPH_ENOMEM;
     return PFSPH_OK;
 }
@@ -67,6 +71,7 @@ void pfsph_cut_free(pfsph_cut *C)
     free(C->lend);
     free(C->cnt);
     free(C->pre);
+    free(C->wpre);
     free(C->win);
     free(C->a_q);
     free(C->b_q);
@@ -108,7 +113,14 @@ static uint64_t F_at(const window *W, uint64_t k)
     return F;
 }
 
-int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m, size_t nc, size_t off)
+static uint64_t W_at(const window *W, uint64_t k)
+{
+    uint64_t F = W->Ws;
+    for (uint64_t x = W->s; x < k; x++) F += W->wcnt[x - W->s];
+    return F;
+}
+
+int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m, size_t nc, size_t off, uint64_t wt)
 {
     int rank, size;
     MPI_Comm_rank(comm, &rank);
@@ -116,13 +128,16 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
     const uint64_t P = (uint64_t)size, B = C->buckets;
     const uint64_t w = nc <= B ? 1 : (nc + B - 1) / B;
     const size_t nb = (size_t)((nc + w - 1) / w);
-    const size_t win = (size_t)(2 * w + 2), nwin = 3 * (size_t)(size - 1);
+    const int weighted = wt > 0;
+    /* round 2: 3 count windows per cut, and the cut's own window's weights */
+    const size_t win = (size_t)(2 * w + 2), nwin = 3 * (size_t)(size - 1),
+                 need = nwin * win + (weighted ? (size_t)(size - 1) * win : 0);
     uint32_t fail = 0;
-    if (w > 1 && nwin * win > C->cnt_cap) {
-        uint32_t *p = realloc(C->cnt, nwin * win * sizeof(uint32_t));
+    if (w > 1 && need > C->cnt_cap) {
+        uint64_t *p = realloc(C->cnt, need * sizeof(uint64_t));
         if (p) {
             C->cnt = p;
-            C->cnt_cap = nwin * win;
+            C->cnt_cap = need;
         } else {
             fail = 1;
         }
@@ -134,24 +149,34 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
         if (a && t) C->sorted_cap = m;
         else fail = 1;
     }
-    /* round 1: the coarse histogram, the particles leaving the domain, any rank's failure */
-    uint32_t *h = C->cnt;
-    memset(h, 0, (nb + 2) * sizeof(uint32_t));
+    /* round 1: the coarse histogram, the particles leaving the domain, any rank's failure, then
+     * (weighted) each bucket's weight: this rank's particles all weigh wt */
+    uint64_t *h = C->cnt;
+    const size_t nh = nb + 2 + (weighted ? nb : 0);
+    memset(h, 0, nh * sizeof(uint64_t));
     for (size_t i = 0; i < m; i++) {
         if (key[i] == UINT32_MAX) h[nb]++;
         else h[key[i] / w]++;
     }
     h[nb + 1] = fail;
-    MPI_Allreduce(MPI_IN_PLACE, h, (int)(nb + 2), MPI_UINT32_T, MPI_SUM, comm);
+    if (weighted)
+        for (size_t j = 0; j < nb; j++) h[nb + 2 + j] = h[j] * wt;
+    MPI_Allreduce(MPI_IN_PLACE, h, (int)nh, MPI_UINT64_T, MPI_SUM, comm);
     if (h[nb + 1]) return PFSPH_ENOMEM;
     C->removed = h[nb];
-    uint64_t *pre = C->pre; /* pre[j]: particles before cell j w */
+    uint64_t *pre = C->pre, *wpre = weighted ? C->wpre : C->pre; /* pre[j]: particles before cell j w */
     pre[0] = 0;
     for (size_t j = 0; j < nb; j++) pre[j + 1] = pre[j] + h[j];
-    const uint64_t total = pre[nb];
+    if (weighted) {
+        wpre[0] = 0;
+        for (size_t j = 0; j < nb; j++) wpre[j + 1] = wpre[j] + h[nb + 2 + j];
+    }
+    const uint64_t total = pre[nb], wtotal = wpre[nb];
     C->total = total;
+    C->wtotal = wtotal;
+    C->weighted = weighted;
     C->rounds = 1;
-    C->hist_counters = nb + 2;
+    C->hist_counters = nh;
     C->cut[0] = 0;
     C->cut[size] = (uint32_t)nc;
     C->gofs[0] = 0;
@@ -161,7 +186,7 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
         return PFSPH_OK;
     }
     if (w == 1) { /* exact already: the dense cut */
-        cut_from_prefix(C, pre, nc, size, off);
+        cut_from_prefix(C, pre, wpre, nc, size, off);
         return PFSPH_OK;
     }
     /* round 2: per cut q, the bucket (a, b] it falls in and the windows of its halo bounds */
@@ -170,7 +195,7 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
     uint64_t *a_q = C->a_q, *b_q = C->b_q;
     size_t j = 1;
     for (int q = 1; q < size; q++) {
-        while (j < nb && pre[j] * P < (uint64_t)q * total) j++;
+        while (j < nb && wpre[j] * P < (uint64_t)q * wtotal) j++;
         const uint64_t a = (uint64_t)(j - 1) * w, b = (uint64_t)j * w < nc ? (uint64_t)j * w : nc;
         a_q[q] = a;
         b_q[q] = b;
@@ -186,19 +211,29 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
             if (X[t].e < X[t].s) X[t].e = X[t].s;
             X[t].Fs = pre[X[t].s / w];
             X[t].cnt = C->cnt + (size_t)(3 * (q - 1) + t) * win;
-            memset(X[t].cnt, 0, win * sizeof(uint32_t));
+            memset(X[t].cnt, 0, win * sizeof(uint64_t));
             for (size_t i = lower_bound(s, m, X[t].s); i < m && s[i] < X[t].e; i++) X[t].cnt[s[i] - X[t].s]++;
         }
+        X[0].Ws = wpre[X[0].s / w];
+        X[0].wcnt = X[0].cnt;
+        if (weighted) {
+            X[0].wcnt = C->cnt + nwin * win + (size_t)(q - 1) * win;
+            for (size_t x = 0; x < win; x++) X[0].wcnt[x] = X[0].cnt[x] * wt;
+        }
     }
-    MPI_Allreduce(MPI_IN_PLACE, C->cnt, (int)(nwin * win), MPI_UINT32_T, MPI_SUM, comm);
+    MPI_Allreduce(MPI_IN_PLACE, C->cnt, (int)need, MPI_UINT64_T, MPI_SUM, comm);
     C->rounds = 2;
-    C->hist_counters += nwin * win;
+    C->hist_counters += need;
     C->lofs[0] = 0;
     C->lend[size - 1] = total;
     for (int q = 1; q < size; q++) {
         const window *X = &W[3 * (q - 1)];
-        uint64_t k = a_q[q] + 1, F = F_at(&X[0], k);
-        while (k < b_q[q] && F * P < (uint64_t)q * total) F += X[0].cnt[k++ - X[0].s];
+        uint64_t k = a_q[q] + 1, F = F_at(&X[0], k), Wk = W_at(&X[0], k);
+        while (k < b_q[q] && Wk * P < (uint64_t)q * wtotal) {
+            F += X[0].cnt[k - X[0].s];
+            Wk += X[0].wcnt[k - X[0].s];
+            k++;
+        }
         C->cut[q] = (uint32_t)k;
         C->gofs[q] = F;
         C->lofs[q] = k > off ? F_at(&X[1], k - off) : 0;
@@ -207,24 +242,35 @@ int pfsph_cut_compute(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m
     return PFSPH_OK;
 }
 
-int pfsph_cut_dense(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m, size_t nc, size_t off)
+int pfsph_cut_dense(pfsph_cut *C, MPI_Comm comm, const uint32_t *key, size_t m, size_t nc, size_t off, uint64_t wt)
 {
     int size;
     MPI_Comm_size(comm, &size);
-    uint32_t *hist = calloc(nc + 1, sizeof(uint32_t));
-    uint64_t *pre = malloc((nc + 1) * sizeof(uint64_t));
-    if (!hist || !pre) MPI_Abort(comm, 1); /* a test's or a check's allocation */
+    const int weighted = wt > 0;
+    const size_t nh = nc + 1 + (weighted ? nc : 0);
+    uint64_t *hist = calloc(nh, sizeof(uint64_t));
+    uint64_t *pre = malloc((nc + 1) * sizeof(uint64_t)), *wpre = weighted ? malloc((nc + 1) * sizeof(uint64_t)) : pre;
+    if (!hist || !pre || !wpre) MPI_Abort(comm, 1); /* a test's or a check's allocation */
     for (size_t i = 0; i < m; i++) {
         if (key[i] == UINT32_MAX) hist[nc]++;
         else hist[key[i]]++;
     }
-    MPI_Allreduce(MPI_IN_PLACE, hist, (int)(nc + 1), MPI_UINT32_T, MPI_SUM, comm);
+    if (weighted)
+        for (size_t k = 0; k < nc; k++) hist[nc + 1 + k] = hist[k] * wt;
+    MPI_Allreduce(MPI_IN_PLACE, hist, (int)nh, MPI_UINT64_T, MPI_SUM, comm);
     pre[0] = 0;
     for (size_t k = 0; k < nc; k++) pre[k + 1] = pre[k] + hist[k];
+    if (weighted) {
+        wpre[0] = 0;
+        for (size_t k = 0; k < nc; k++) wpre[k + 1] = wpre[k] + hist[nc + 1 + k];
+    }
     C->removed = hist[nc];
     C->total = pre[nc];
-    cut_from_prefix(C, pre, nc, size, off);
+    C->wtotal = wpre[nc];
+    C->weighted = weighted;
+    cut_from_prefix(C, pre, wpre, nc, size, off);
     free(hist);
     free(pre);
+    if (weighted) free(wpre);
     return PFSPH_OK;
 }

@@ -1,8 +1,9 @@
 /* The domain decomposition: the fluid cut along the grid's cell order (row-major keys, the order
  * the serial sort leaves the particles in) into one contiguous range of cells per rank, by
- * particle count, re-cut every step; each rank holds its cells plus every cell a neighbour walk
- * from them can reach (a key interval), so its particles are a contiguous slice of the serial
- * order and every walk visits the same neighbours in the same order as a serial run. */
+ * measured cost (or particle count), re-cut every step; each rank holds its cells plus every
+ * cell a neighbour walk from them can reach (a key interval), so its particles are a contiguous
+ * slice of the serial order and every walk visits the same neighbours in the same order as a
+ * serial run. */
 #include "mpi/decomp.h"
 
 #include <math.h>
@@ -219,7 +220,7 @@ static int check_cut(pfsph_decomp *D, const uint32_t *key, size_t m, pfsph_error
 {
     pfsph_cut E;
     if (pfsph_cut_init(&E, D->size, 1)) MPI_Abort(D->comm, 1); /* a check's allocation */
-    pfsph_cut_dense(&E, D->comm, key, m, D->ncells, D->off);
+    pfsph_cut_dense(&E, D->comm, key, m, D->ncells, D->off, D->cost.weight);
     int bad = E.removed != D->C.removed || E.total != D->C.total;
     for (int q = 0; q <= D->size; q++) bad |= E.cut[q] != D->cut[q] || E.gofs[q] != D->gofs[q];
     for (int q = 0; q < D->size; q++) bad |= E.lofs[q] != D->lofs[q] || E.lend[q] != D->lend[q];
@@ -337,10 +338,8 @@ static int scatter_root(pfsph_decomp *D, pfsph_step *st, const uint32_t *key, si
  * frame) go to every rank that holds their new cell. Each rank sends its particles in its
  * order, the receivers take them in rank order, so the grid's stable sort then gives them the
  * serial order: by cell, ties by the previous step's order. */
-static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+static int exchange_body(pfsph_decomp *D, pfsph_step *st, pfsph_error *err)
 {
-    (void)bad;
-    pfsph_decomp *D = state;
     pfsph_ctx *c = st->ctx;
     pfsph_particles *f = c->fluid;
     const pfsph_grid *g = c->grid;
@@ -381,7 +380,7 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     if (!key) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the exchange's keys");
     D->key = key;
     for (size_t i = 0; i < m; i++) key[i] = cell_key(g, f, lo + i);
-    if (pfsph_cut_compute(&D->C, D->comm, key, m, nc, D->off))
+    if (pfsph_cut_compute(&D->C, D->comm, key, m, nc, D->off, D->cost.weight))
         return pfsph_fail(err, PFSPH_ENOMEM, "out of memory for the cut"); /* every rank returns it */
     if (D->check_cut && (rc = check_cut(D, key, m, err))) return rc;
     if (D->trim_walls && (rc = walls_update(D, err))) return rc;
@@ -420,7 +419,22 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
             D->migr_bytes += (uint64_t)D->scount[q];
             D->messages++;
         }
+    D->cost.weighted_cuts += D->C.weighted;
     return PFSPH_OK;
+}
+
+/* The exchange is the decomposition's: it closes the last step's measured work (the first step
+ * after a start or a resume scattered the fluid and touched fresh memory: not measured) */
+static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
+{
+    (void)bad;
+    pfsph_decomp *D = state;
+    pfsph_cost_enter(D);
+    pfsph_cost_sample(D, D->steps < 2);
+    const int rc = exchange_body(D, st, err);
+    D->cost.own = D->d.own_hi - D->d.own_lo;
+    pfsph_cost_leave(D);
+    return rc;
 }
 
 static const pfsph_stage_ops stage_exchange = {.name = "mpi_exchange",
@@ -545,7 +559,7 @@ static int halo_pos_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     (void)err;
     pfsph_particles *f = st->ctx->fluid;
     pfsph_real *const a[3] = {f->x, f->y, f->z};
-    halo(st->ctx->dist, a, 3);
+    st->ctx->dist->halo(st->ctx->dist, a, 3); /* timed as the decomposition's (cost.c) */
     return PFSPH_OK;
 }
 
@@ -561,7 +575,7 @@ static int halo_density_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsp
     (void)bad;
     (void)err;
     pfsph_real *const a[1] = {st->ctx->nd};
-    halo(st->ctx->dist, a, 1);
+    st->ctx->dist->halo(st->ctx->dist, a, 1);
     return PFSPH_OK;
 }
 
@@ -571,18 +585,22 @@ static const pfsph_stage_ops stage_halo_density = {.name = "mpi_halo_density",
                                                    .writes = PFSPH_D_DENSITY,
                                                    .run = halo_density_run};
 
-/* the integration measured its own particles: the bounds the next step's time step needs */
+/* the integration measured its own particles: the bounds the next step's time step needs; with
+ * them the largest cost per particle, which scales each rank's weight at the next cut */
 static int stats_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_error *err)
 {
     (void)bad;
     (void)err;
     pfsph_decomp *D = state;
-    double v[4] = {st->amax, st->amax_np, st->stats.density_err_max, st->stats.vmax};
-    MPI_Allreduce(MPI_IN_PLACE, v, 4, MPI_DOUBLE, MPI_MAX, D->comm);
+    pfsph_cost_enter(D);
+    double v[5] = {st->amax, st->amax_np, st->stats.density_err_max, st->stats.vmax, pfsph_cost_local(D)};
+    MPI_Allreduce(MPI_IN_PLACE, v, 5, MPI_DOUBLE, MPI_MAX, D->comm);
     st->amax = v[0];
     st->amax_np = v[1];
     st->stats.density_err_max = v[2];
     st->stats.vmax = v[3];
+    pfsph_cost_weigh(D, v[4]);
+    pfsph_cost_leave(D);
     return PFSPH_OK;
 }
 
@@ -633,7 +651,15 @@ static int frame(pfsph_dist *d, pfsph_error *err)
     return pfsph_decomp_gather(D, err);
 }
 
-void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c) { MPI_Bcast(c, sizeof *c, MPI_BYTE, 0, D->comm); }
+/* what ran since the decomposition's code was last left (the root's frame writing, the others'
+ * wait for the command) is no step's work */
+void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c)
+{
+    pfsph_cost_drop(D);
+    pfsph_cost_enter(D);
+    MPI_Bcast(c, sizeof *c, MPI_BYTE, 0, D->comm);
+    pfsph_cost_leave(D);
+}
 
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
 {
@@ -671,6 +697,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         mine.rss_kb = (uint64_t)pages_res * (uint64_t)sysconf(_SC_PAGESIZE) / 1024;
     if (sm) fclose(sm);
     MPI_Gather(&mine, sizeof mine, MPI_BYTE, D->fig, sizeof mine, MPI_BYTE, 0, D->comm);
+    pfsph_cost_gather(D); /* the ranks' cost figures, beside */
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
@@ -786,7 +813,7 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.step_begin = step_begin;
     D->d.frame = frame;
     D->d.attach = attach;
-    return PFSPH_OK;
+    return pfsph_cost_init(D); /* times the hooks above */
 }
 
 /* Take the simulation over: the stages, the cut's arrays; the root holds every particle. */

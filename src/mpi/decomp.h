@@ -7,6 +7,7 @@
 #include <mpi.h>
 #include <stdint.h>
 
+#include "mpi/cost.h"
 #include "mpi/cut.h"
 #include "pfsph/dist.h"
 #include "pfsph/sim.h"
@@ -31,7 +32,7 @@ typedef struct pfsph_mpi_fig {
     uint64_t ckpt_read;   /* bytes it read of the checkpoint resumed from */
 } pfsph_mpi_fig;
 
-typedef struct pfsph_decomp {
+struct pfsph_decomp {
     pfsph_dist d; /* first: the hooks the step calls */
     MPI_Comm comm;
     int rank, size;
@@ -69,7 +70,8 @@ typedef struct pfsph_decomp {
     size_t *qa, *qb, *qc;
     int *cnt2, *rcnt2;
     uint64_t *scan_all; /* 8 size: every rank's counters of a scan (sets.c) */
-} pfsph_decomp;
+    pfsph_cost cost;    /* this rank's measured cost, its particles' weight at the cut (cost.c) */
+};
 
 /* The decomposition of the world communicator (not yet attached to a simulation). */
 int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm);

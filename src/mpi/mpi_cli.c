@@ -42,6 +42,9 @@ int pfsph_mpi_size(void) { return g_size; }
 int pfsph_mpi_check_scene(const pfsph_scene *s, pfsph_error *err)
 {
     if (g_size < 2) return PFSPH_OK;
+    if (pfsph_cost_env_mode() < 0) /* the cut: src/mpi/cost.c */
+        return pfsph_fail(err, PFSPH_EINPUT, "PFSPH_MPI_CUT: \"%s\" is not a cut (\"cost\", the default, or \"count\")",
+                          getenv("PFSPH_MPI_CUT"));
     const char *no = NULL, *key = NULL;
     const char *solver = pfsph_scene_solver_name(s);
     if (strcmp(solver, "pcisph") && strcmp(solver, "wcsph") && strcmp(solver, "dfsph") && strcmp(solver, "iisph"))
@@ -70,7 +73,17 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(cut, "reductions_last_step", D->C.rounds);
         cJSON_AddNumberToObject(cut, "counters_last_step", (double)D->C.hist_counters);
         cJSON_AddNumberToObject(cut, "checked_against_dense", (double)D->cuts_checked);
+        /* by measured cost (src/mpi/cost.c) or by particle count (PFSPH_MPI_CUT=count) */
+        cJSON_AddStringToObject(cut, "by", D->cost.by_cost ? "cost" : "count");
+        cJSON_AddNumberToObject(cut, "weighted_cuts", (double)D->cost.weighted_cuts);
     }
+    /* the ranks' work: CPU s outside the decomposition's code, the largest against the mean */
+    double wmax = 0, wsum = 0;
+    for (int q = 0; q < D->size; q++) {
+        wsum += D->cost.fig[q].work_cpu;
+        if (D->cost.fig[q].work_cpu > wmax) wmax = D->cost.fig[q].work_cpu;
+    }
+    if (wsum > 0) cJSON_AddNumberToObject(m, "work_imbalance_max_over_mean", wmax * D->size / wsum);
     cJSON *ranks = cJSON_AddArrayToObject(m, "per_rank");
     for (int q = 0; q < D->size && ranks; q++) {
         const pfsph_mpi_fig *f = &D->fig[q];
@@ -98,6 +111,15 @@ static void report(pfsph_dist *d, void *json)
         cJSON_AddNumberToObject(r, "checkpoint_bytes_read", (double)f->ckpt_read);
         cJSON_AddNumberToObject(r, "rss_mib_at_last_frame", (double)f->rss_kb / 1024.0);
         cJSON_AddNumberToObject(r, "peak_rss_mib", (double)f->peak_rss_kb / 1024.0);
+        const pfsph_cost_fig *k = &D->cost.fig[q]; /* src/mpi/cost.c */
+        const double ms = k->samples ? 1e3 / (double)k->samples : 0;
+        cJSON_AddNumberToObject(r, "steps_measured", (double)k->samples);
+        cJSON_AddNumberToObject(r, "work_cpu_s", k->work_cpu);
+        cJSON_AddNumberToObject(r, "work_cpu_ms_per_step", k->work_cpu * ms);
+        cJSON_AddNumberToObject(r, "work_cpu_ms_most_in_a_step", k->step_max * 1e3);
+        cJSON_AddNumberToObject(r, "decomposition_cpu_s", k->comm_cpu);
+        cJSON_AddNumberToObject(r, "work_us_per_owned_particle", k->per_particle * 1e6);
+        cJSON_AddNumberToObject(r, "cut_weight_last", (double)k->weight);
         cJSON_AddItemToArray(ranks, r);
     }
 }
