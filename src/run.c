@@ -383,9 +383,13 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, pfsph_s
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     double t = pfsph_sim_time(sim);
     int rc = PFSPH_OK;
-    /* Without particle files ("formats": [], a benchmark or a meshes-only run) the frame-derived
-     * fields have no reader: skipping them saved 6.5 s a frame at 493k */
-    if (s->output.vtp || s->output.ply) {
+    /* a distributed run whose root does not hold the fluid: every rank writes its slice of the
+     * fluid frames (src/mpi/frame_io.c, with the same fields) */
+    if ((s->output.vtp || s->output.ply) && c->dist && !c->dist->fluid_whole) {
+        rc = c->dist->write_fluid(c->dist, dir, frame, t, err);
+    } else if (s->output.vtp || s->output.ply) {
+        /* Without particle files ("formats": [], a benchmark or a meshes-only run) the frame-derived
+         * fields have no reader: skipping them saved 6.5 s a frame at 493k */
         /* the outer two layers of surface particles (docs/film.md) and, with pair forces, the
          * mechanical pressure (Laplace's law holds for that one): the output stages' fields */
         if ((rc = pfsph_sim_output(sim, err))) {
@@ -421,12 +425,19 @@ static int write_frame(const pfsph_scene *s, const char *dir, int frame, pfsph_s
     return rc;
 }
 
+/* The fluid's particle count: a distributed run's root may hold only its slice. */
+static size_t fluid_count(const pfsph_sim *sim)
+{
+    const pfsph_ctx *c = pfsph_sim_ctx(sim);
+    return c->dist && !c->dist->fluid_whole ? c->dist->nglobal : c->fluid->n;
+}
+
 static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
 {
     const pfsph_step_stats *st = pfsph_sim_stats(sim);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     fprintf(f, "%d,%.9g,%.6g,%llu,%zu,%zu,%.6g,%.6g,%.6g,%.9g,%d", frame, pfsph_sim_time(sim), st->dt,
-            (unsigned long long)pfsph_sim_steps(sim), c->fluid->n, pfsph_sim_removed(sim), st->vmax,
+            (unsigned long long)pfsph_sim_steps(sim), fluid_count(sim), pfsph_sim_removed(sim), st->vmax,
             st->density_err_avg, st->density_err_max, st->ekin, st->iterations);
     if (c->diffuse->enabled) {
         size_t cnt[3];
@@ -462,7 +473,7 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
     if (sim) {
         const pfsph_ctx *c = pfsph_sim_ctx(sim);
         cJSON *n = cJSON_AddObjectToObject(j, "particles");
-        cJSON_AddNumberToObject(n, "fluid", (double)c->fluid->n);
+        cJSON_AddNumberToObject(n, "fluid", (double)fluid_count(sim));
         cJSON_AddNumberToObject(n, "boundary", (double)c->boundary->n);
         cJSON_AddNumberToObject(n, "removed", (double)pfsph_sim_removed(sim));
         const pfsph_particles *d = pfsph_sim_diffuse(sim);
@@ -764,9 +775,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     const double time0 = pfsph_sim_time(sim);
     double last_report = omp_get_wtime();
     if (o && o->progress) { /* at once, before the first step */
-        pfsph_progress p = {
-            frame0, nframes, time0, end, pfsph_sim_steps(sim), last_report - w0, 0, pfsph_sim_ctx(sim)->fluid->n,
-            time0,  true};
+        pfsph_progress p = {frame0, nframes,          time0, end, pfsph_sim_steps(sim), last_report - w0,
+                            0,      fluid_count(sim), time0, true};
         o->progress(&p, o->user);
     }
     const uint64_t steps0 = pfsph_sim_steps(sim);
@@ -791,7 +801,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
                                     pfsph_sim_steps(sim),
                                     wall,
                                     wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
-                                    pfsph_sim_ctx(sim)->fluid->n,
+                                    fluid_count(sim),
                                     time0,
                                     true};
                 o->progress(&p, o->user);
@@ -833,7 +843,9 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (!rc && ci > 0 && (frame % ci == 0 || frame == nframes)) {
             double c0 = omp_get_wtime();
             size_t bytes = 0;
-            rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &bytes, err);
+            const pfsph_ctx *c = pfsph_sim_ctx(sim); /* a distributed run: the root gathers the fluid */
+            if (c->dist && !c->dist->fluid_whole) rc = c->dist->gather(c->dist, err);
+            if (!rc) rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &bytes, err);
             if (!rc) { /* only a checkpoint on disk, renamed into place, goes into summary.json */
                 ckpt_s = omp_get_wtime() - c0;
                 ckpt_frame = frame;
@@ -841,8 +853,11 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
             }
         }
         /* written beside the old stash and renamed over it: should this fail (a full disk), the
-         * previous frame's state stays the last good one, and the run stops with the error */
-        if (!rc && (rc = pfsph_checkpoint_stash(stash, sim, frame, err)) == PFSPH_OK) {
+         * previous frame's state stays the last good one, and the run stops with the error. A
+         * distributed run whose root does not hold the fluid (collective frames) keeps the stash
+         * of the last frame it did hold it (a checkpoint's): no gather of the whole fluid a frame */
+        const pfsph_dist *dist = pfsph_sim_ctx(sim)->dist;
+        if (!rc && (!dist || dist->fluid_whole) && (rc = pfsph_checkpoint_stash(stash, sim, frame, err)) == PFSPH_OK) {
             good = 1;
             good_frame = frame;
         }
@@ -857,7 +872,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
                                 pfsph_sim_steps(sim),
                                 wall,
                                 wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
-                                pfsph_sim_ctx(sim)->fluid->n,
+                                fluid_count(sim),
                                 time0,
                                 false};
             o->progress(&p, o->user);

@@ -20,6 +20,9 @@
 /* particles per message of the frame gather (its buffers: 3 MB) */
 #define GATHER_RUN ((size_t)65536)
 
+static void frame_figures(pfsph_decomp *D);
+static void diffuse_to_root(pfsph_decomp *D);
+
 /* The cell key of the serial sort (pfsph_grid_sort_in), UINT32_MAX for a particle it removes. */
 static uint32_t cell_key(const pfsph_grid *g, const pfsph_particles *f, size_t i)
 {
@@ -344,9 +347,9 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     pfsph_ctx *c = st->ctx;
     pfsph_particles *f = c->fluid;
     const pfsph_grid *g = c->grid;
-    if (D->gathered) { /* after a frame: the root's own slice again, the clock as the root has it */
-        if (D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
-        D->gathered = 0;
+    if (D->gathered || D->framed) { /* after a frame: the root's own slice again, the clock as the root has it */
+        if (D->gathered && D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
+        D->gathered = D->framed = 0;
         share_clock(D, st);
     }
     if (D->root_all) {
@@ -407,6 +410,7 @@ static int exchange_run(void *state, pfsph_step *st, pfsph_blowup *bad, pfsph_er
     D->d.cell_lo = D->cut[D->rank];
     D->d.cell_hi = D->cut[D->rank + 1];
     D->root_all = 0;
+    D->d.fluid_whole = 0;
     /* figures */
     const size_t own = D->d.own_hi - D->d.own_lo;
     if (!D->steps || own < D->own_min) D->own_min = own;
@@ -628,14 +632,34 @@ static int frame(pfsph_dist *d, pfsph_error *err)
         pfsph_mpi_cmd c = {PFSPH_MPI_FRAME, 0, 0};
         pfsph_decomp_cmd(D, &c);
     }
+    return pfsph_decomp_frame(D, err);
+}
+
+/* The root's side of a gather asked for after a collective frame (a checkpoint's). */
+static int gather_now(pfsph_dist *d, pfsph_error *err)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    if (D->root_all || D->gathered) return PFSPH_OK;
+    pfsph_mpi_cmd c = {PFSPH_MPI_GATHER, 0, 0};
+    pfsph_decomp_cmd(D, &c);
     return pfsph_decomp_gather(D, err);
+}
+
+int pfsph_decomp_frame(pfsph_decomp *D, pfsph_error *err)
+{
+    if (D->root_all || D->gathered || D->framed) return PFSPH_OK;
+    if (!pfsph_mpi_frames_collective(D)) return pfsph_decomp_gather(D, err);
+    frame_figures(D);
+    diffuse_to_root(D);
+    D->framed = 1;
+    return PFSPH_OK;
 }
 
 void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c) { MPI_Bcast(c, sizeof *c, MPI_BYTE, 0, D->comm); }
 
-int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
+/* Every rank's figures to the root (summary.json), as of this frame. */
+static void frame_figures(pfsph_decomp *D)
 {
-    if (D->root_all || D->gathered) return PFSPH_OK;
     pfsph_mpi_fig mine = {D->steps,
                           D->d.own_hi - D->d.own_lo,
                           D->own_min,
@@ -667,6 +691,23 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
         mine.rss_kb = (uint64_t)pages_res * (uint64_t)sysconf(_SC_PAGESIZE) / 1024;
     if (sm) fclose(sm);
     MPI_Gather(&mine, sizeof mine, MPI_BYTE, D->fig, sizeof mine, MPI_BYTE, 0, D->comm);
+}
+
+/* The diffuse particles, in the serial order, to the root, which keeps them: the next step's
+ * diffuse stage sends each to the owner of its cell again. */
+static void diffuse_to_root(pfsph_decomp *D)
+{
+    if (!D->sim->st.df) return;
+    size_t *nold;
+    uint64_t *cr, *rf;
+    pfsph_particles *ds = pfsph__diffuse_set(D->sim->st.df, &nold, &cr, &rf);
+    D->d.migrate(&D->d, ds, nold, NULL);
+}
+
+int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
+{
+    if (D->root_all || D->gathered) return PFSPH_OK;
+    if (!D->framed) frame_figures(D); /* after a collective frame: sent with it */
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
@@ -726,17 +767,11 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
             MPI_Send(D->sbuf, (int)(k * REC), MPI_BYTE, 0, 30, D->comm);
         }
     }
-    /* the diffuse particles, in the serial order, to the root, which keeps them: the next
-     * step's diffuse stage sends each to the owner of its cell again */
-    if (sim->st.df) {
-        size_t *nold;
-        uint64_t *cr, *rf;
-        pfsph_particles *ds = pfsph__diffuse_set(sim->st.df, &nold, &cr, &rf);
-        D->d.migrate(&D->d, ds, nold, NULL);
-    }
+    if (!D->framed) diffuse_to_root(D);
     /* every rank keeps its slice: the next exchange goes on from it (the root's own particles
      * are untouched at the front of its arrays), only the clock is shared again */
     D->gathered = 1;
+    D->d.fluid_whole = 1;
     return PFSPH_OK;
 }
 
@@ -780,6 +815,8 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.agree = agree;
     D->d.step_begin = step_begin;
     D->d.frame = frame;
+    D->d.gather = gather_now;
+    D->d.write_fluid = pfsph_mpi_write_fluid; /* src/mpi/frame_io.c */
     D->d.attach = attach;
     return PFSPH_OK;
 }
@@ -813,6 +850,7 @@ static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err)
     D->wall_slack = sl && atoi(sl) >= 0 ? (size_t)atoi(sl) : 25;
     D->walls_total = sim->boundary.n;
     D->root_all = 1;
+    D->d.fluid_whole = 1;
     D->d.own_lo = 0;
     D->d.own_hi = D->rank == 0 ? sim->fluid.n : 0;
     D->d.nglobal = sim->fluid.n;
