@@ -19,6 +19,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "io/frame_layout.h"
 #include "io/io_internal.h"
 #include "pfsph/checkpoint.h"
 #include "pfsph/dist.h"
@@ -86,8 +87,17 @@ static int frame_file(const char *name, long *num)
         int digits = 0;
         while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
         if (!digits) return 0;
-        if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj") ||
-            !strcmp(p, ".geo") || !strcmp(p, ".bgeo") || !strcmp(p, ".vdb")) {
+        if (*p == '_' && p[1] >= '0' && p[1] <= '9') { /* a piece: "fluid_NNNNN_QQQQ.vtp" */
+            const char *q = p + 1;
+            while (*q >= '0' && *q <= '9') q++;
+            if (!strcmp(q, ".vtp")) {
+                *num = v;
+                return 1;
+            }
+            return 0;
+        }
+        if (!strcmp(p, ".vtp") || !strcmp(p, ".pvtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") ||
+            !strcmp(p, ".obj") || !strcmp(p, ".geo") || !strcmp(p, ".bgeo") || !strcmp(p, ".vdb")) {
             *num = v;
             return 1;
         }
@@ -278,7 +288,14 @@ static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name,
                        .write_film = film,
                        .diffuse = !strcmp(name, "diffuse")};
     int rc;
-    if (s->output.vtp) {
+    if (s->output.vtp && s->output.pieces && !strcmp(name, "fluid")) { /* one piece (docs/cluster.md) */
+        char base[32];
+        snprintf(base, sizeof base, "%s_%05d", name, frame);
+        snprintf(path, sizeof path, "%s/frames/%s_0000.vtp", dir, base);
+        if ((rc = pfsph_write_vtp(path, ps, &o, err))) return rc;
+        snprintf(path, sizeof path, "%s/frames/%s.pvtp", dir, base);
+        if ((rc = pfsph__write_pvtp(path, &o, base, 1, err))) return rc;
+    } else if (s->output.vtp) {
         snprintf(path, sizeof path, "%s/frames/%s_%05d.vtp", dir, name, frame);
         if ((rc = pfsph_write_vtp(path, ps, &o, err))) return rc;
     }

@@ -142,15 +142,13 @@ typedef struct vtp_array {
     size_t per;
 } vtp_array;
 
-int pfsph__vtp_layout(pfsph__frame_layout *L, uint64_t n, const pfsph_io_opts *o)
+/* The arrays of a VTP frame of n particles, in the file's order; their count. */
+static int vtp_arrays(const pfsph_io_opts *o, uint64_t n, vtp_array *arr)
 {
-    begin(L, n, o);
-    o = &L->o;
     const size_t rs = sizeof(pfsph_real);
     const int idx64 = n > (uint64_t)INT32_MAX;
     const size_t is = idx64 ? 8 : 4;
     const char *itype = idx64 ? "Int64" : "Int32";
-    vtp_array arr[14];
     int na = 0;
     arr[na++] = (vtp_array){0, "TimeValue", "Float64", 1, 0};
     arr[na++] = (vtp_array){V_VEL, "velocity", REAL_VTK, 3, 3 * rs};
@@ -167,7 +165,15 @@ int pfsph__vtp_layout(pfsph__frame_layout *L, uint64_t n, const pfsph_io_opts *o
     arr[na++] = (vtp_array){V_POINTS, "Points", REAL_VTK, 3, 3 * rs};
     arr[na++] = (vtp_array){V_CONN, "connectivity", itype, 1, is};
     arr[na++] = (vtp_array){V_OFFS, "offsets", itype, 1, is};
+    return na;
+}
 
+int pfsph__vtp_layout(pfsph__frame_layout *L, uint64_t n, const pfsph_io_opts *o)
+{
+    begin(L, n, o);
+    o = &L->o;
+    vtp_array arr[14];
+    const int na = vtp_arrays(o, n, arr);
     /* XML header: every array's offset is the running sum of (8-byte header + data). */
     uint64_t off = 0;
     lit_printf(L, "<?xml version=\"1.0\"?>\n");
@@ -325,4 +331,35 @@ int pfsph__frame_write(const char *path, const pfsph__frame_layout *L, const pfs
     }
     free(buf);
     return pfsph__enc_commit(&e, &af, err);
+}
+
+int pfsph__write_pvtp(const char *path, const pfsph_io_opts *o, const char *base, int npieces, pfsph_error *err)
+{
+    pfsph__frame_layout L; /* a text builder here */
+    begin(&L, 0, o);
+    vtp_array arr[14];
+    const int na = vtp_arrays(&L.o, 0, arr); /* the pieces' arrays (each piece below 2^31 points) */
+    lit_printf(&L, "<?xml version=\"1.0\"?>\n");
+    lit_printf(&L,
+               "<VTKFile type=\"PPolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+               "header_type=\"UInt64\">\n  <PPolyData GhostLevel=\"0\">\n");
+    lit_printf(&L, "    <PPointData Scalars=\"%s\" Vectors=\"velocity\">\n", L.o.diffuse ? "type" : "density");
+    for (int k = 0; k < na; k++) {
+        const vtp_array *a = &arr[k];
+        if (a->kind == V_POINTS) lit_printf(&L, "    </PPointData>\n    <PPoints>\n");
+        if (a->kind == V_CONN) break; /* the cells are each piece's own */
+        if (a->kind)
+            lit_printf(&L, "      <PDataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\"/>\n", a->type, a->name,
+                       a->ncomp);
+    }
+    lit_printf(&L, "    </PPoints>\n");
+    for (int q = 0; q < npieces; q++) lit_printf(&L, "    <Piece Source=\"%s_%04d.vtp\"/>\n", base, q);
+    lit_printf(&L, "  </PPolyData>\n</VTKFile>\n");
+    if (L.failed) {
+        pfsph__frame_layout_free(&L);
+        return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
+    }
+    int rc = pfsph_write_file_atomic(path, L.text, L.text_len, err);
+    pfsph__frame_layout_free(&L);
+    return rc;
 }

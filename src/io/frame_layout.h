@@ -47,4 +47,8 @@ void pfsph__frame_encode(const pfsph__frame_layout *L, int k, const pfsph_partic
 /* The whole file from one process, atomically (the serial writers). */
 int pfsph__frame_write(const char *path, const pfsph__frame_layout *L, const pfsph_particles *ps, pfsph_error *err);
 
+/* ParaView's index of a frame written in pieces ("<base>_0000.vtp" ... in the .pvtp's folder,
+ * each a VTP of the same arrays), atomically. */
+int pfsph__write_pvtp(const char *path, const pfsph_io_opts *o, const char *base, int npieces, pfsph_error *err);
+
 #endif

@@ -111,6 +111,31 @@ static int write_one(pfsph_decomp *D, const char *path, long pid, const pfsph__f
     return rc;
 }
 
+/* output.pieces: every rank writes its own particles as one VTP piece ("fluid_NNNNN_QQQQ.vtp",
+ * Q its rank), then the root the .pvtp that names them, once every piece is in place. */
+static int write_pieces(pfsph_decomp *D, const char *dir, int frame, const pfsph_io_opts *o, pfsph_error *err)
+{
+    const pfsph_particles *f = D->sim->ctx.fluid;
+    const size_t lo = D->d.own_lo, n = (size_t)owned_count(D, D->rank);
+    pfsph_particles v = *f; /* a view of the owned slice */
+    for (int k = 0; k < PFSPH_NFIELDS; k++) v.f[k] = f->f[k] + lo;
+    v.phase = f->phase + lo;
+    v.wall = f->wall + lo;
+    v.bubble = f->bubble + lo;
+    v.id = f->id + lo;
+    v.n = n;
+    pfsph_io_opts po = *o;
+    if (o->surface_layer) po.surface_layer = o->surface_layer + lo;
+    char base[32], path[PFSPH_PATH_LEN + 96];
+    snprintf(base, sizeof base, "fluid_%05d", frame);
+    snprintf(path, sizeof path, "%s/frames/%s_%04d.vtp", dir, base, D->rank);
+    int rc = pfsph_write_vtp(path, &v, &po, err);
+    if ((rc = D->d.agree(&D->d, rc, err))) return rc;
+    snprintf(path, sizeof path, "%s/frames/%s.pvtp", dir, base);
+    if (D->rank == 0) rc = pfsph__write_pvtp(path, o, base, D->size, err);
+    return D->d.agree(&D->d, rc, err);
+}
+
 /* Every rank: the frame's derived fields for its particles, then each fluid format. */
 static int write_frames(pfsph_decomp *D, const char *dir, int frame, double time, long pid, pfsph_error *err)
 {
@@ -133,6 +158,10 @@ static int write_frames(pfsph_decomp *D, const char *dir, int frame, double time
     char path[PFSPH_PATH_LEN + 64];
     for (int fmt = 0; fmt < 2 && !rc; fmt++) { /* the serial writer's order: VTP, then PLY */
         if (!(fmt ? s->output.ply : s->output.vtp)) continue;
+        if (!fmt && s->output.pieces) {
+            rc = write_pieces(D, dir, frame, &o, err);
+            continue;
+        }
         snprintf(path, sizeof path, "%s/frames/fluid_%05d.%s", dir, frame, fmt ? "ply" : "vtp");
         pfsph__frame_layout L;
         int lr = fmt ? pfsph__ply_layout(&L, D->d.nglobal, &o) : pfsph__vtp_layout(&L, D->d.nglobal, &o);
