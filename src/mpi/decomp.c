@@ -92,10 +92,11 @@ static void held_cells(const pfsph_decomp *D, int q, size_t *lo, size_t *hi)
 
 /* A rank other than the root holds its slice alone: the whole scene's arrays it was created with
  * (every rank samples the scene) are cut down to the slice, so that its memory follows its share.
- * They grow again through the step's reserve if its slice grows. */
+ * They grow again through the step's reserve if its slice grows. The root too when the frames
+ * are written collectively (it gathers the fluid only for a checkpoint, and grows again then). */
 static int fit(pfsph_decomp *D, pfsph_particles *f, size_t n)
 {
-    if (D->rank == 0 || f->cap <= 2 * n + 4096) return PFSPH_OK;
+    if ((D->rank == 0 && !pfsph_mpi_frames_collective(D)) || f->cap <= 2 * n + 4096) return PFSPH_OK;
     const size_t cap = n + n / 4 + 1024;
     for (int k = 0; k < PFSPH_NFIELDS; k++) {
         void *q = realloc(f->f[k], cap * sizeof(pfsph_real));
