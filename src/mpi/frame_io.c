@@ -103,10 +103,14 @@ static int write_one(pfsph_decomp *D, const char *path, long pid, const pfsph__f
     e = MPI_File_close(&fh);
     if (e != MPI_SUCCESS && !bad) MPI_Error_string(e, msg, &len), bad = 1;
     if (bad) pfsph_fail(err, PFSPH_EIO, "%s: rank %d: write failed: %s", path, D->rank, msg);
-    else if (D->rank == 0 && pfsph__write_fault(path)) /* the full-disk test hook */
-        bad = 1, pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", path, strerror(ENOSPC));
-    if (!bad && D->rank == 0 && pfsph__rename_durable(tmp, path, err)) bad = 1;
-    const int rc = D->d.agree(&D->d, bad ? PFSPH_EIO : PFSPH_OK, err);
+    /* every rank wrote its part before the root renames: else only the temporary goes */
+    int rc = D->d.agree(&D->d, bad ? PFSPH_EIO : PFSPH_OK, err);
+    if (!rc && D->rank == 0) {
+        if (pfsph__write_fault(path)) /* the full-disk test hook */
+            bad = 1, pfsph_fail(err, PFSPH_EIO, "%s: write failed: %s", path, strerror(ENOSPC));
+        else if (pfsph__rename_durable(tmp, path, err)) bad = 1;
+    }
+    if (!rc) rc = D->d.agree(&D->d, bad ? PFSPH_EIO : PFSPH_OK, err);
     if (rc && D->rank == 0) unlink(tmp);
     return rc;
 }

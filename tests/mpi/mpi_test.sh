@@ -18,6 +18,8 @@
 #                                          a frame: the fluid frames written collectively)
 #   mpi_test.sh pieces SCENE END NP...    as collective with output.pieces: each frame's .pvtp names
 #                                          NP pieces, which read back are the serial frame's particles
+#   mpi_test.sh fault SCENE END NP FILE   a collective frame FILE that fails on rank 0's disk: exit
+#                                          1, nothing under its name, no temporary left
 #   mpi_test.sh refuse SCENE NP [STATUS]   refused or stopped with one message and exit status
 #                                          STATUS (default 2) from mpirun
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
@@ -185,6 +187,21 @@ collective | pieces)
         [ "$k" -gt 1 ] || { echo "FAIL: fewer than 2 VTP frames to compare"; exit 1; }
         echo "ok: -np $np: $k frames in $np pieces each equal the serial frames; $(tail -n 1 "$TMP/check")"
     done
+    ;;
+fault)
+    # a collective frame that fails (the full-disk hook on rank 0, after every rank wrote its
+    # part): exit status 1 with the one message, nothing under the frame's name, no temporary
+    scene=$SRC/$1 end=$2 np=$3 frame=$4
+    sed 's/"checkpoint_interval": *[0-9]*/"checkpoint_interval": 0/' "$scene" >"$TMP/nock.json"
+    "$MPIRUN" $ROOTOPT --oversubscribe -x PFSPH_FAULT_WRITE="$frame" -np "$np" "$BIN" run "$TMP/nock.json" \
+        -o "$TMP/f" --end "$end" --quiet 2>"$TMP/err"
+    rc=$?
+    [ "$rc" = 1 ] || { echo "FAIL: exit status $rc, not 1"; cat "$TMP/err"; exit 1; }
+    grep -q "^pfsph: .*$frame: write failed: No space left on device" "$TMP/err" ||
+        { echo "FAIL: no message naming $frame:"; cat "$TMP/err"; exit 1; }
+    [ ! -e "$TMP/f/frames/$frame" ] || { echo "FAIL: $frame was renamed into place"; exit 1; }
+    if ls "$TMP/f/frames" | grep -q '\.tmp\.'; then echo "FAIL: temporaries left"; exit 1; fi
+    echo "ok: exit status 1, $frame not written, no temporary left"
     ;;
 resume)
     scene=$SRC/$1 t1=$2 t2=$3 np1=$4 np2=$5
