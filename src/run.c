@@ -2,8 +2,6 @@
 #include "pfsph/run.h"
 
 #include "pfsph/bodies.h"
-#include "pfsph/meshing.h"
-#include "pfsph/surface_io.h"
 
 #include <cjson/cJSON.h>
 #include <dirent.h>
@@ -24,7 +22,6 @@
 #include "pfsph/dist.h"
 #include "pfsph/io.h"
 #include "pfsph/sim.h"
-#include "pfsph/solid_mesh.h"
 #include "pfsph/thermostat.h"
 #include "run_control.h"
 
@@ -86,8 +83,17 @@ static int frame_file(const char *name, long *num)
         int digits = 0;
         while (*p >= '0' && *p <= '9' && digits < 10) v = v * 10 + (*p++ - '0'), digits++;
         if (!digits) return 0;
-        if (!strcmp(p, ".vtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") || !strcmp(p, ".obj") ||
-            !strcmp(p, ".geo") || !strcmp(p, ".bgeo") || !strcmp(p, ".vdb")) {
+        if (*p == '_' && p[1] >= '0' && p[1] <= '9') { /* a piece: "fluid_NNNNN_QQQQ.vtp" */
+            const char *q = p + 1;
+            while (*q >= '0' && *q <= '9') q++;
+            if (!strcmp(q, ".vtp")) {
+                *num = v;
+                return 1;
+            }
+            return 0;
+        }
+        if (!strcmp(p, ".vtp") || !strcmp(p, ".pvtp") || !strcmp(p, ".ply") || !strcmp(p, ".png") ||
+            !strcmp(p, ".obj") || !strcmp(p, ".geo") || !strcmp(p, ".bgeo") || !strcmp(p, ".vdb")) {
             *num = v;
             return 1;
         }
@@ -264,89 +270,6 @@ static double cpu_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* layer: the fluid's surface layers (NULL for other sets); film: bubbles' film fractions */
-static int write_set_ex(const pfsph_scene *s, const char *dir, const char *name, int frame, const pfsph_particles *ps,
-                        const char *aux, double time, const uint8_t *layer, bool film, pfsph_error *err)
-{
-    char path[PFSPH_PATH_LEN + 64];
-    pfsph_io_opts o = {.dim = s->dim,
-                       .write_id = (s->output.fields & PFSPH_OUT_ID) != 0,
-                       .write_speed = (s->output.fields & PFSPH_OUT_SPEED) != 0,
-                       .aux_name = aux,
-                       .time = time,
-                       .surface_layer = layer,
-                       .write_film = film,
-                       .diffuse = !strcmp(name, "diffuse")};
-    int rc;
-    if (s->output.vtp) {
-        snprintf(path, sizeof path, "%s/frames/%s_%05d.vtp", dir, name, frame);
-        if ((rc = pfsph_write_vtp(path, ps, &o, err))) return rc;
-    }
-    if (s->output.ply) {
-        snprintf(path, sizeof path, "%s/frames/%s_%05d.ply", dir, name, frame);
-        if ((rc = pfsph_write_ply(path, ps, &o, err))) return rc;
-    }
-    return PFSPH_OK;
-}
-
-static int write_set(const pfsph_scene *s, const char *dir, const char *name, int frame, const pfsph_particles *ps,
-                     const char *aux, double time, pfsph_error *err)
-{
-    return write_set_ex(s, dir, name, frame, ps, aux, time, NULL, false, err);
-}
-
-/* The boundary particles with ids >= first (bodies) or below it (static solids) as one set. */
-static int write_boundary_part(const pfsph_scene *s, const char *dir, const char *name, int frame,
-                               const pfsph_particles *b, uint32_t first, bool bodies, double t, pfsph_error *err)
-{
-    pfsph_particles ps;
-    if (pfsph_particles_init(&ps, b->n ? b->n : 1)) return pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-    for (size_t j = 0; j < b->n; j++) {
-        if ((b->id[j] >= first) != bodies) continue;
-        for (int k = 0; k < PFSPH_NFIELDS; k++) ps.f[k][ps.n] = b->f[k][j];
-        ps.phase[ps.n] = b->phase[j];
-        ps.id[ps.n] = b->id[j];
-        ps.n++;
-    }
-    int rc = write_set(s, dir, name, frame, &ps, "volume", t, err);
-    pfsph_particles_free(&ps);
-    return rc;
-}
-
-/* Bodies of a frame: their particles ("bodies_NNNNN", like the other sets) and their
- * surfaces ("surfaces_NNNNN", triangle meshes with each body's pose). */
-static int write_bodies(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *b,
-                        const pfsph_bodies *B, double t, pfsph_error *err)
-{
-    const int nb = pfsph_bodies_count(B);
-    int rc = write_boundary_part(s, dir, "bodies", frame, b, pfsph_bodies_first_id(B), true, t, err);
-    if (rc) return rc;
-    pfsph_mesh *m = calloc((size_t)nb, sizeof *m);
-    pfsph_body_pose *pose = calloc((size_t)nb, sizeof *pose);
-    if (!m || !pose) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-    for (int i = 0; i < nb && !rc; i++) {
-        pfsph_body_state st;
-        pfsph_bodies_get_state(B, i, &st);
-        pose[i].name = pfsph_bodies_name(B, i);
-        memcpy(pose[i].x, st.x, sizeof st.x);
-        memcpy(pose[i].q, st.q, sizeof st.q);
-        if (pfsph_bodies_world_mesh(B, i, &m[i])) rc = pfsph_fail(err, PFSPH_ENOMEM, "out of memory");
-    }
-    char path[PFSPH_PATH_LEN + 64];
-    if (!rc && s->output.vtp) {
-        snprintf(path, sizeof path, "%s/frames/surfaces_%05d.vtp", dir, frame);
-        rc = pfsph_write_surfaces_vtp(path, m, nb, pose, t, err);
-    }
-    if (!rc && s->output.ply) {
-        snprintf(path, sizeof path, "%s/frames/surfaces_%05d.ply", dir, frame);
-        rc = pfsph_write_surfaces_ply(path, m, nb, pose, t, err);
-    }
-    for (int i = 0; m && i < nb; i++) pfsph_mesh_free(&m[i]);
-    free(m);
-    free(pose);
-    return rc;
-}
-
 static void bodies_rows(FILE *f, int frame, const pfsph_sim *sim)
 {
     const pfsph_bodies *B = pfsph_sim_bodies(sim);
@@ -367,58 +290,11 @@ static void bodies_rows(FILE *f, int frame, const pfsph_sim *sim)
     fflush(f);
 }
 
-/* Liquid surface meshes (output.surface) and the .pvd collections, after a frame's sets. */
-static int write_frame_extras(const pfsph_scene *s, const char *dir, int frame, const pfsph_particles *fluid, double t,
-                              pfsph_error *err)
-{
-    int rc = PFSPH_OK;
-    if (s->output.surface.on) rc = pfsph_mesh_frame(s, dir, frame, fluid, t, NULL, err);
-    if (!rc && (s->output.vtp || (s->output.surface.on && s->output.surface.vtp)))
-        rc = pfsph_write_pvd_collections(dir, s->output.frame_interval / s->fps, err);
-    return rc;
-}
-
-static int write_frame(const pfsph_scene *s, const char *dir, int frame, pfsph_sim *sim, pfsph_error *err)
+/* The fluid's particle count: a distributed run's root may hold only its slice. */
+static size_t fluid_count(const pfsph_sim *sim)
 {
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
-    double t = pfsph_sim_time(sim);
-    int rc = PFSPH_OK;
-    /* Without particle files ("formats": [], a benchmark or a meshes-only run) the frame-derived
-     * fields have no reader: skipping them saved 6.5 s a frame at 493k */
-    if (s->output.vtp || s->output.ply) {
-        /* the outer two layers of surface particles (docs/film.md) and, with pair forces, the
-         * mechanical pressure (Laplace's law holds for that one): the output stages' fields */
-        if ((rc = pfsph_sim_output(sim, err))) {
-            char msg[sizeof err->msg];
-            snprintf(msg, sizeof msg, "%s", err->msg);
-            return pfsph_fail(err, rc, "frame %d: %s", frame, msg);
-        }
-        const uint8_t *layer = pfsph_sim_output_surface_layer(sim);
-        const pfsph_real *mech = pfsph_sim_output_mechanical_pressure(sim);
-        const bool film = s->film.nbubbles > 0;
-        if (mech) {
-            pfsph_particles fl = *c->fluid;
-            fl.aux = (pfsph_real *)mech; /* read only: the writer reads aux as the extra field */
-            rc = write_set_ex(s, dir, "fluid", frame, &fl, "mechanical_pressure", t, layer, film, err);
-        } else {
-            rc = write_set_ex(s, dir, "fluid", frame, c->fluid, NULL, t, layer, film, err);
-        }
-    }
-    const pfsph_bodies *B = pfsph_sim_bodies(sim);
-    if (!rc && frame == 0 && c->boundary->n && s->output.write_boundary) {
-        if (!B) rc = write_set(s, dir, "boundary", frame, c->boundary, "volume", t, err);
-        else /* the static part; body particles go to bodies_NNNNN every frame */
-            rc = write_boundary_part(s, dir, "boundary", frame, c->boundary, pfsph_bodies_first_id(B), false, t, err);
-    }
-    if (!rc && frame == 0) { /* the static solids as meshes, once (docs/artists.md#static-solids) */
-        int nsolid;
-        rc = pfsph_write_solids(s, dir, &nsolid, err);
-    }
-    const pfsph_particles *d = pfsph_sim_diffuse(sim);
-    if (!rc && d) rc = write_set(s, dir, "diffuse", frame, d, "lifetime", t, err);
-    if (!rc && B) rc = write_bodies(s, dir, frame, c->boundary, B, t, err);
-    if (!rc) rc = write_frame_extras(s, dir, frame, c->fluid, t, err);
-    return rc;
+    return c->dist && !c->dist->fluid_whole ? c->dist->nglobal : c->fluid->n;
 }
 
 static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
@@ -426,7 +302,7 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
     const pfsph_step_stats *st = pfsph_sim_stats(sim);
     const pfsph_ctx *c = pfsph_sim_ctx(sim);
     fprintf(f, "%d,%.9g,%.6g,%llu,%zu,%zu,%.6g,%.6g,%.6g,%.9g,%d", frame, pfsph_sim_time(sim), st->dt,
-            (unsigned long long)pfsph_sim_steps(sim), c->fluid->n, pfsph_sim_removed(sim), st->vmax,
+            (unsigned long long)pfsph_sim_steps(sim), fluid_count(sim), pfsph_sim_removed(sim), st->vmax,
             st->density_err_avg, st->density_err_max, st->ekin, st->iterations);
     if (c->diffuse->enabled) {
         size_t cnt[3];
@@ -462,7 +338,7 @@ static int write_summary(const char *dir, const pfsph_scene *s, const pfsph_sim 
     if (sim) {
         const pfsph_ctx *c = pfsph_sim_ctx(sim);
         cJSON *n = cJSON_AddObjectToObject(j, "particles");
-        cJSON_AddNumberToObject(n, "fluid", (double)c->fluid->n);
+        cJSON_AddNumberToObject(n, "fluid", (double)fluid_count(sim));
         cJSON_AddNumberToObject(n, "boundary", (double)c->boundary->n);
         cJSON_AddNumberToObject(n, "removed", (double)pfsph_sim_removed(sim));
         const pfsph_particles *d = pfsph_sim_diffuse(sim);
@@ -739,7 +615,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         pfsph_sim_prime_output(sim);
         setup_note("sorted the fluid, its densities and pressures", omp_get_wtime() - t0, cpu_s() - c0, (void *)o);
         t0 = omp_get_wtime(), c0 = cpu_s();
-        rc = write_frame(s, dir, 0, sim, err);
+        rc = pfsph__run_frame_files(s, dir, 0, sim, err);
         setup_note("wrote frame 0", omp_get_wtime() - t0, cpu_s() - c0, (void *)o);
         if (!rc) written++;
         csv_row(csv, 0, sim);
@@ -764,9 +640,8 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
     const double time0 = pfsph_sim_time(sim);
     double last_report = omp_get_wtime();
     if (o && o->progress) { /* at once, before the first step */
-        pfsph_progress p = {
-            frame0, nframes, time0, end, pfsph_sim_steps(sim), last_report - w0, 0, pfsph_sim_ctx(sim)->fluid->n,
-            time0,  true};
+        pfsph_progress p = {frame0, nframes,          time0, end, pfsph_sim_steps(sim), last_report - w0,
+                            0,      fluid_count(sim), time0, true};
         o->progress(&p, o->user);
     }
     const uint64_t steps0 = pfsph_sim_steps(sim);
@@ -791,7 +666,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
                                     pfsph_sim_steps(sim),
                                     wall,
                                     wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
-                                    pfsph_sim_ctx(sim)->fluid->n,
+                                    fluid_count(sim),
                                     time0,
                                     true};
                 o->progress(&p, o->user);
@@ -822,7 +697,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (rc) break;
         double t0 = omp_get_wtime();
         if (frame % fi == 0) {
-            rc = write_frame(s, dir, frame / fi, sim, err);
+            rc = pfsph__run_frame_files(s, dir, frame / fi, sim, err);
             if (!rc) written++;
         }
         csv_row(csv, frame, sim);
@@ -833,7 +708,11 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
         if (!rc && ci > 0 && (frame % ci == 0 || frame == nframes)) {
             double c0 = omp_get_wtime();
             size_t bytes = 0;
-            rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &bytes, err);
+            /* a distributed run whose checkpoints the root writes alone (PFSPH_MPI_CHECKPOINTS=root):
+             * the root gathers the fluid first; otherwise every rank writes its slice */
+            const pfsph_ctx *c = pfsph_sim_ctx(sim);
+            if (c->dist && !c->dist->fluid_whole && !c->dist->save) rc = c->dist->gather(c->dist, err);
+            if (!rc) rc = pfsph_checkpoint_write_run(dir, sim, frame, PFSPH_CHECKPOINT_KEEP, &bytes, err);
             if (!rc) { /* only a checkpoint on disk, renamed into place, goes into summary.json */
                 ckpt_s = omp_get_wtime() - c0;
                 ckpt_frame = frame;
@@ -841,8 +720,13 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
             }
         }
         /* written beside the old stash and renamed over it: should this fail (a full disk), the
-         * previous frame's state stays the last good one, and the run stops with the error */
-        if (!rc && (rc = pfsph_checkpoint_stash(stash, sim, frame, err)) == PFSPH_OK) {
+         * previous frame's state stays the last good one, and the run stops with the error. A
+         * distributed run writes it collectively (every rank its slice); one whose root writes
+         * checkpoints alone keeps, under collective frames, the stash of the last frame the root
+         * held the fluid (a checkpoint's): no gather of the whole fluid a frame */
+        const pfsph_dist *dist = pfsph_sim_ctx(sim)->dist;
+        if (!rc && (!dist || dist->fluid_whole || dist->save) &&
+            (rc = pfsph_checkpoint_stash(stash, sim, frame, err)) == PFSPH_OK) {
             good = 1;
             good_frame = frame;
         }
@@ -857,7 +741,7 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
                                 pfsph_sim_steps(sim),
                                 wall,
                                 wall > 0 ? (double)(pfsph_sim_steps(sim) - steps0) / wall : 0,
-                                pfsph_sim_ctx(sim)->fluid->n,
+                                fluid_count(sim),
                                 time0,
                                 false};
             o->progress(&p, o->user);
@@ -894,5 +778,5 @@ static int run_locked(const pfsph_scene *s, const pfsph_run_opts *o, const char 
 
 int pfsph__run_write_frame(pfsph_sim *sim, const char *dir, int frame, pfsph_error *err)
 {
-    return write_frame(pfsph_sim_scene(sim), dir, frame, sim, err);
+    return pfsph__run_frame_files(pfsph_sim_scene(sim), dir, frame, sim, err);
 }

@@ -8,6 +8,7 @@
 
 #include "core/hits.h"
 #include "core/stage.h"
+#include "pfsph/dist.h"
 
 /* The targets a peel walks for particle i: every target of the grid ranges rg (j == NULL), or
  * the ones a float SIMD filter kept from them (j[0..n), in walk order): all within a radius
@@ -176,6 +177,22 @@ static void peel(const pfsph_ctx *ctx, const pfsph_surface_opts *o, double radiu
 #undef PEEL_WALL
 }
 
+/* A distributed run (docs/cluster.md): a peel reads its neighbours' layers, and a halo copy's
+ * layer is right only where its owner computed it (its neighbourhood may leave the halo), so the
+ * halo copies take their owners' layers before the next peel. Out of memory ends the process (the
+ * other ranks wait in the refresh: mpirun then stops them), as in the diffuse stage's paths. */
+static void halo_layers(const pfsph_ctx *ctx, uint8_t *layer)
+{
+    const size_t n = ctx->fluid->n;
+    pfsph_real *a = malloc((n ? n : 1) * sizeof *a);
+    if (!a) abort();
+    for (size_t i = 0; i < n; i++) a[i] = (pfsph_real)layer[i];
+    pfsph_real *const arr[1] = {a};
+    ctx->dist->halo(ctx->dist, arr, 1);
+    for (size_t i = 0; i < n; i++) layer[i] = (uint8_t)a[i];
+    free(a);
+}
+
 void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uint8_t *layer, uint8_t *work)
 {
     const size_t n = ctx->fluid->n;
@@ -187,6 +204,7 @@ void pfsph_surface_detect(const pfsph_ctx *ctx, const pfsph_surface_opts *o, uin
     int layers = o->layers < 1 ? 1 : o->layers > PFSPH_SURFACE_MAX_LAYERS ? PFSPH_SURFACE_MAX_LAYERS : o->layers;
     peel(ctx, o, radius, reach, true, layer, layer);
     for (int L = 2; L <= layers; L++) {
+        if (ctx->dist && !ctx->dist->fluid_whole) halo_layers(ctx, layer);
         peel(ctx, o, radius, reach, false, layer, work);
         for (size_t i = 0; i < n; i++)
             if (work[i]) layer[i] = (uint8_t)L;

@@ -421,16 +421,18 @@ int pfsph_write_pvd_collections(const char *dir, double frame_dt, pfsph_error *e
     long *num[NSETS] = {NULL};
     size_t n[NSETS] = {0}, cap[NSETS] = {0};
     int rc = PFSPH_OK;
-    /* one pass over the directory: the frame numbers of "<set>_NNNNN.vtp" */
+    /* one pass over the directory: the frame numbers of "<set>_NNNNN.vtp", or of "<set>_NNNNN.pvtp"
+     * (a frame in pieces: output.pieces, docs/cluster.md), as 2 N + (1 for a .pvtp) */
     DIR *d = opendir(frames_dir);
     if (!d) return PFSPH_OK;
     for (struct dirent *de; (de = readdir(d)) && !rc;) {
         const char *nm = de->d_name;
         size_t len = strlen(nm);
-        if (len < 11 || strcmp(nm + len - 4, ".vtp")) continue;
+        const int pv = len >= 12 && !strcmp(nm + len - 5, ".pvtp");
+        if (len < 11 || (!pv && strcmp(nm + len - 4, ".vtp"))) continue;
         for (int k = 0; k < NSETS; k++) {
             size_t ls = strlen(sets[k]);
-            if (len != ls + 10 || strncmp(nm, sets[k], ls) || nm[ls] != '_') continue;
+            if (len != ls + 10 + (size_t)pv || strncmp(nm, sets[k], ls) || nm[ls] != '_') continue;
             long v = 0;
             int ok = 1;
             for (int i = 0; i < 5; i++) {
@@ -449,7 +451,7 @@ int pfsph_write_pvd_collections(const char *dir, double frame_dt, pfsph_error *e
                 num[k] = t;
                 cap[k] = nc;
             }
-            num[k][n[k]++] = v;
+            num[k][n[k]++] = 2 * v + pv;
         }
     }
     closedir(d);
@@ -467,9 +469,9 @@ int pfsph_write_pvd_collections(const char *dir, double frame_dt, pfsph_error *e
                                 "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" "
                                 "version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n");
         for (size_t i = 0; i < n[k]; i++)
-            len += (size_t)snprintf(buf + len, line,
-                                    "<DataSet timestep=\"%.9g\" group=\"\" part=\"0\" file=\"frames/%s_%05ld.vtp\"/>\n",
-                                    (double)num[k][i] * frame_dt, sets[k], num[k][i]);
+            len += (size_t)snprintf(
+                buf + len, line, "<DataSet timestep=\"%.9g\" group=\"\" part=\"0\" file=\"frames/%s_%05ld.%s\"/>\n",
+                (double)(num[k][i] / 2) * frame_dt, sets[k], num[k][i] / 2, num[k][i] % 2 ? "pvtp" : "vtp");
         len += (size_t)snprintf(buf + len, bcap - len, "</Collection>\n</VTKFile>\n");
         snprintf(path, sizeof path, "%s/%s.pvd", dir, sets[k]);
         rc = pfsph_write_file_atomic(path, buf, len, err);

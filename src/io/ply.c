@@ -5,64 +5,22 @@
 #include <stdbool.h>
 #include <stdlib.h>
 
+#include "io/frame_layout.h"
 #include "io/io_internal.h"
 #include "io/ply_header.h"
 #include "pfsph/io.h"
 
-#define REAL_PLY (sizeof(pfsph_real) == 4 ? "float" : "double")
-
 int pfsph_write_ply(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o, pfsph_error *err)
 {
-    pfsph_io_opts def = {.dim = 3};
-    if (!o) o = &def;
-    if (o->aux_name) {
+    if (o && o->aux_name) {
         int r = pfsph__check_aux_name(path, o->aux_name, err);
         if (r != PFSPH_OK) return r;
     }
-    const size_t n = ps->n, rs = sizeof(pfsph_real);
-    pfsph__afile af;
-    pfsph__enc e;
-    int rc = pfsph__enc_open(&e, &af, path, err);
-    if (rc != PFSPH_OK) return rc;
-    pfsph__enc_printf(&e, "ply\nformat binary_little_endian 1.0\ncomment pfsph %s\n", PFSPH_VERSION);
-    /* %.17g round-trips every double exactly. */
-    pfsph__enc_printf(&e, "comment time %.17g\n", o->time);
-    pfsph__enc_printf(&e, "element vertex %zu\n", n);
-    static const char *const names[] = {"x", "y", "z", "vx", "vy", "vz", "density", "pressure"};
-    const int nreal = o->diffuse ? 6 : 8; /* diffuse sets: no density, pressure */
-    for (int k = 0; k < nreal; k++) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, names[k]);
-    pfsph__enc_printf(&e, "property uchar %s\n", o->diffuse ? "type" : "phase");
-    if (o->write_id) pfsph__enc_printf(&e, "property uint id\n");
-    if (o->write_speed) pfsph__enc_printf(&e, "property %s speed\n", REAL_PLY);
-    if (o->aux_name) pfsph__enc_printf(&e, "property %s %s\n", REAL_PLY, o->aux_name);
-    if (o->surface_layer) pfsph__enc_printf(&e, "property uchar surface_layer\n");
-    if (o->write_film) pfsph__enc_printf(&e, "property %s film\n", REAL_PLY);
-    pfsph__enc_printf(&e, "end_header\n");
-    const pfsph_real zero = 0;
-    const bool d2 = o->dim == 2;
-    for (size_t i = 0; i < n; i++) {
-        pfsph__enc_put(&e, &ps->x[i], rs);
-        pfsph__enc_put(&e, &ps->y[i], rs);
-        pfsph__enc_put(&e, d2 ? &zero : &ps->z[i], rs);
-        pfsph__enc_put(&e, &ps->vx[i], rs);
-        pfsph__enc_put(&e, &ps->vy[i], rs);
-        pfsph__enc_put(&e, d2 ? &zero : &ps->vz[i], rs);
-        if (!o->diffuse) {
-            pfsph__enc_put(&e, &ps->rho[i], rs);
-            pfsph__enc_put(&e, &ps->p[i], rs);
-        }
-        pfsph__enc_put(&e, &ps->phase[i], 1);
-        if (o->write_id) pfsph__enc_put(&e, &ps->id[i], 4);
-        if (o->write_speed) {
-            double vx = ps->vx[i], vy = ps->vy[i], vz = ps->vz[i];
-            pfsph_real s = (pfsph_real)sqrt(vx * vx + vy * vy + vz * vz);
-            pfsph__enc_put(&e, &s, rs);
-        }
-        if (o->aux_name) pfsph__enc_put(&e, &ps->aux[i], rs);
-        if (o->surface_layer) pfsph__enc_put(&e, &o->surface_layer[i], 1);
-        if (o->write_film) pfsph__enc_put(&e, &ps->film[i], rs);
-    }
-    return pfsph__enc_commit(&e, &af, err);
+    pfsph__frame_layout L; /* the header and the record: io/frame_layout.c */
+    if (pfsph__ply_layout(&L, ps->n, o)) return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
+    int rc = pfsph__frame_write(path, &L, ps, err);
+    pfsph__frame_layout_free(&L);
+    return rc;
 }
 
 /* ---- reader ---------------------------------------------------------------------------- */

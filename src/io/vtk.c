@@ -5,31 +5,9 @@
 #include <stdbool.h>
 #include <stdlib.h>
 
+#include "io/frame_layout.h"
 #include "io/io_internal.h"
 #include "pfsph/io.h"
-
-#define REAL_VTK (sizeof(pfsph_real) == 4 ? "Float32" : "Float64")
-
-/* One appended array: what the header says and how many bytes its block holds. */
-enum { A_TIME, A_VEL, A_RHO, A_P, A_PHASE, A_ID, A_SPEED, A_AUX, A_LAYER, A_FILM, A_POINTS, A_CONN, A_OFFS };
-typedef struct vtp_array {
-    int kind;
-    const char *name;
-    const char *type;
-    int ncomp;
-    uint64_t nbytes;
-} vtp_array;
-
-static double speed_of(const pfsph_particles *ps, size_t i)
-{
-    double vx = ps->vx[i], vy = ps->vy[i], vz = ps->vz[i];
-    return sqrt(vx * vx + vy * vy + vz * vz);
-}
-
-static void put_reals(pfsph__enc *e, const pfsph_real *a, size_t n)
-{
-    for (size_t i = 0; i < n; i++) pfsph__enc_put(e, &a[i], sizeof(pfsph_real));
-}
 
 /* Checks an aux field name: it goes into an XML attribute (VTP) or a header word (PLY) and must
  * not collide with the fixed fields. */
@@ -57,138 +35,15 @@ int pfsph__check_aux_name(const char *path, const char *name, pfsph_error *err)
 
 int pfsph_write_vtp(const char *path, const pfsph_particles *ps, const pfsph_io_opts *o, pfsph_error *err)
 {
-    pfsph_io_opts def = {.dim = 3};
-    if (!o) o = &def;
-    const size_t n = ps->n;
-    const uint64_t rs = sizeof(pfsph_real);
-    const bool idx64 = n > (size_t)INT32_MAX;
-    const uint64_t is = idx64 ? 8 : 4;
-    const char *itype = idx64 ? "Int64" : "Int32";
-    if (o->aux_name) {
+    if (o && o->aux_name) {
         int r = pfsph__check_aux_name(path, o->aux_name, err);
         if (r != PFSPH_OK) return r;
     }
-
-    vtp_array arr[14];
-    int na = 0;
-    arr[na++] = (vtp_array){A_TIME, "TimeValue", "Float64", 1, 8};
-    arr[na++] = (vtp_array){A_VEL, "velocity", REAL_VTK, 3, 3 * rs * n};
-    if (!o->diffuse) {
-        arr[na++] = (vtp_array){A_RHO, "density", REAL_VTK, 1, rs * n};
-        arr[na++] = (vtp_array){A_P, "pressure", REAL_VTK, 1, rs * n};
-    }
-    arr[na++] = (vtp_array){A_PHASE, o->diffuse ? "type" : "phase", "UInt8", 1, n};
-    if (o->write_id) arr[na++] = (vtp_array){A_ID, "id", "UInt32", 1, 4 * (uint64_t)n};
-    if (o->write_speed) arr[na++] = (vtp_array){A_SPEED, "speed", REAL_VTK, 1, rs * n};
-    if (o->aux_name) arr[na++] = (vtp_array){A_AUX, o->aux_name, REAL_VTK, 1, rs * n};
-    if (o->surface_layer) arr[na++] = (vtp_array){A_LAYER, "surface_layer", "UInt8", 1, n};
-    if (o->write_film) arr[na++] = (vtp_array){A_FILM, "film", REAL_VTK, 1, rs * n};
-    arr[na++] = (vtp_array){A_POINTS, "Points", REAL_VTK, 3, 3 * rs * n};
-    arr[na++] = (vtp_array){A_CONN, "connectivity", itype, 1, is * n};
-    arr[na++] = (vtp_array){A_OFFS, "offsets", itype, 1, is * n};
-
-    pfsph__afile af;
-    pfsph__enc e;
-    int rc = pfsph__enc_open(&e, &af, path, err);
-    if (rc != PFSPH_OK) return rc;
-
-    /* XML header: every array's offset is the running sum of (8-byte header + data). */
-    uint64_t off = 0;
-    pfsph__enc_printf(&e, "<?xml version=\"1.0\"?>\n");
-    pfsph__enc_printf(&e,
-                      "<VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" "
-                      "header_type=\"UInt64\">\n  <PolyData>\n");
-    for (int k = 0; k < na; k++) {
-        const vtp_array *a = &arr[k];
-        switch (a->kind) {
-        case A_TIME: pfsph__enc_printf(&e, "    <FieldData>\n"); break;
-        case A_VEL:
-            pfsph__enc_printf(&e,
-                              "    <Piece NumberOfPoints=\"%zu\" NumberOfVerts=\"%zu\" NumberOfLines=\"0\" "
-                              "NumberOfStrips=\"0\" NumberOfPolys=\"0\">\n",
-                              n, n);
-            pfsph__enc_printf(&e, "      <PointData Scalars=\"%s\" Vectors=\"velocity\">\n",
-                              o->diffuse ? "type" : "density");
-            break;
-        case A_POINTS: pfsph__enc_printf(&e, "      </PointData>\n      <Points>\n"); break;
-        case A_CONN: pfsph__enc_printf(&e, "      </Points>\n      <Verts>\n"); break;
-        default: break;
-        }
-        if (a->kind == A_TIME)
-            pfsph__enc_printf(&e,
-                              "      <DataArray type=\"%s\" Name=\"%s\" NumberOfTuples=\"1\" "
-                              "format=\"appended\" offset=\"%" PRIu64 "\"/>\n    </FieldData>\n",
-                              a->type, a->name, off);
-        else
-            pfsph__enc_printf(&e,
-                              "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" "
-                              "format=\"appended\" offset=\"%" PRIu64 "\"/>\n",
-                              a->type, a->name, a->ncomp, off);
-        off += 8 + a->nbytes;
-    }
-    pfsph__enc_printf(&e, "      </Verts>\n    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _");
-
-    /* Appended blocks, in the header's order. */
-    const pfsph_real zero = 0;
-    for (int k = 0; k < na; k++) {
-        const vtp_array *a = &arr[k];
-        pfsph__enc_put(&e, &a->nbytes, 8);
-        switch (a->kind) {
-        case A_TIME: {
-            double t = o->time;
-            pfsph__enc_put(&e, &t, 8);
-            break;
-        }
-        case A_VEL:
-            for (size_t i = 0; i < n; i++) {
-                pfsph__enc_put(&e, &ps->vx[i], rs);
-                pfsph__enc_put(&e, &ps->vy[i], rs);
-                pfsph__enc_put(&e, o->dim == 2 ? &zero : &ps->vz[i], rs);
-            }
-            break;
-        case A_RHO: put_reals(&e, ps->rho, n); break;
-        case A_P: put_reals(&e, ps->p, n); break;
-        case A_PHASE:
-            for (size_t i = 0; i < n; i++) pfsph__enc_put(&e, &ps->phase[i], 1);
-            break;
-        case A_ID:
-            for (size_t i = 0; i < n; i++) pfsph__enc_put(&e, &ps->id[i], 4);
-            break;
-        case A_SPEED:
-            for (size_t i = 0; i < n; i++) {
-                pfsph_real s = (pfsph_real)speed_of(ps, i);
-                pfsph__enc_put(&e, &s, rs);
-            }
-            break;
-        case A_AUX: put_reals(&e, ps->aux, n); break;
-        case A_LAYER:
-            for (size_t i = 0; i < n; i++) pfsph__enc_put(&e, &o->surface_layer[i], 1);
-            break;
-        case A_FILM: put_reals(&e, ps->film, n); break;
-        case A_POINTS:
-            for (size_t i = 0; i < n; i++) {
-                pfsph__enc_put(&e, &ps->x[i], rs);
-                pfsph__enc_put(&e, &ps->y[i], rs);
-                pfsph__enc_put(&e, o->dim == 2 ? &zero : &ps->z[i], rs);
-            }
-            break;
-        case A_CONN:
-        case A_OFFS:
-            for (size_t i = 0; i < n; i++) {
-                uint64_t v = a->kind == A_OFFS ? i + 1 : i;
-                if (idx64) {
-                    int64_t w = (int64_t)v;
-                    pfsph__enc_put(&e, &w, 8);
-                } else {
-                    int32_t w = (int32_t)v;
-                    pfsph__enc_put(&e, &w, 4);
-                }
-            }
-            break;
-        }
-    }
-    pfsph__enc_printf(&e, "\n  </AppendedData>\n</VTKFile>\n");
-    return pfsph__enc_commit(&e, &af, err);
+    pfsph__frame_layout L; /* the header and the appended arrays: io/frame_layout.c */
+    if (pfsph__vtp_layout(&L, ps->n, o)) return pfsph_fail(err, PFSPH_ENOMEM, "%s: out of memory", path);
+    int rc = pfsph__frame_write(path, &L, ps, err);
+    pfsph__frame_layout_free(&L);
+    return rc;
 }
 
 /* ---- reader ---------------------------------------------------------------------------- */

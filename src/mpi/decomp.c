@@ -21,6 +21,9 @@
 /* particles per message of the frame gather (its buffers: 3 MB) */
 #define GATHER_RUN ((size_t)65536)
 
+static void frame_figures(pfsph_decomp *D);
+static void diffuse_to_root(pfsph_decomp *D);
+
 /* The cell key of the serial sort (pfsph_grid_sort_in), UINT32_MAX for a particle it removes. */
 static uint32_t cell_key(const pfsph_grid *g, const pfsph_particles *f, size_t i)
 {
@@ -90,10 +93,11 @@ static void held_cells(const pfsph_decomp *D, int q, size_t *lo, size_t *hi)
 
 /* A rank other than the root holds its slice alone: the whole scene's arrays it was created with
  * (every rank samples the scene) are cut down to the slice, so that its memory follows its share.
- * They grow again through the step's reserve if its slice grows. */
+ * They grow again through the step's reserve if its slice grows. The root too when the frames
+ * are written collectively (it gathers the fluid only for a checkpoint, and grows again then). */
 static int fit(pfsph_decomp *D, pfsph_particles *f, size_t n)
 {
-    if (D->rank == 0 || f->cap <= 2 * n + 4096) return PFSPH_OK;
+    if ((D->rank == 0 && !pfsph_mpi_frames_collective(D)) || f->cap <= 2 * n + 4096) return PFSPH_OK;
     const size_t cap = n + n / 4 + 1024;
     for (int k = 0; k < PFSPH_NFIELDS; k++) {
         void *q = realloc(f->f[k], cap * sizeof(pfsph_real));
@@ -343,9 +347,9 @@ static int exchange_body(pfsph_decomp *D, pfsph_step *st, pfsph_error *err)
     pfsph_ctx *c = st->ctx;
     pfsph_particles *f = c->fluid;
     const pfsph_grid *g = c->grid;
-    if (D->gathered) { /* after a frame: the root's own slice again, the clock as the root has it */
-        if (D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
-        D->gathered = 0;
+    if (D->gathered || D->framed) { /* after a frame: the root's own slice again, the clock as the root has it */
+        if (D->gathered && D->rank == 0) f->n = D->lend[0], D->d.own_lo = 0, D->d.own_hi = D->root_own_hi;
+        D->gathered = D->framed = 0;
         share_clock(D, st);
     }
     if (D->share) { /* a start or a resume: the root's clock and state */
@@ -408,6 +412,7 @@ static int exchange_body(pfsph_decomp *D, pfsph_step *st, pfsph_error *err)
     D->d.cell_hi = D->cut[D->rank + 1];
     D->root_all = 0;
     D->share = 0;
+    D->d.fluid_whole = 0;
     /* figures */
     const size_t own = D->d.own_hi - D->d.own_lo;
     if (!D->steps || own < D->own_min) D->own_min = own;
@@ -648,7 +653,27 @@ static int frame(pfsph_dist *d, pfsph_error *err)
         pfsph_mpi_cmd c = {PFSPH_MPI_FRAME, 0, 0};
         pfsph_decomp_cmd(D, &c);
     }
+    return pfsph_decomp_frame(D, err);
+}
+
+/* The root's side of a gather asked for after a collective frame (a checkpoint's). */
+static int gather_now(pfsph_dist *d, pfsph_error *err)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    if (D->root_all || D->gathered) return PFSPH_OK;
+    pfsph_mpi_cmd c = {PFSPH_MPI_GATHER, 0, 0};
+    pfsph_decomp_cmd(D, &c);
     return pfsph_decomp_gather(D, err);
+}
+
+int pfsph_decomp_frame(pfsph_decomp *D, pfsph_error *err)
+{
+    if (D->root_all || D->gathered || D->framed) return PFSPH_OK;
+    if (!pfsph_mpi_frames_collective(D)) return pfsph_decomp_gather(D, err);
+    frame_figures(D);
+    diffuse_to_root(D);
+    D->framed = 1;
+    return PFSPH_OK;
 }
 
 /* what ran since the decomposition's code was last left (the root's frame writing, the others'
@@ -661,9 +686,9 @@ void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c)
     pfsph_cost_leave(D);
 }
 
-int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
+/* Every rank's figures to the root (summary.json), as of this frame. */
+static void frame_figures(pfsph_decomp *D)
 {
-    if (D->root_all || D->gathered) return PFSPH_OK;
     pfsph_mpi_fig mine = {D->steps,
                           D->d.own_hi - D->d.own_lo,
                           D->own_min,
@@ -698,6 +723,23 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
     if (sm) fclose(sm);
     MPI_Gather(&mine, sizeof mine, MPI_BYTE, D->fig, sizeof mine, MPI_BYTE, 0, D->comm);
     pfsph_cost_gather(D); /* the ranks' cost figures, beside */
+}
+
+/* The diffuse particles, in the serial order, to the root, which keeps them: the next step's
+ * diffuse stage sends each to the owner of its cell again. */
+static void diffuse_to_root(pfsph_decomp *D)
+{
+    if (!D->sim->st.df) return;
+    size_t *nold;
+    uint64_t *cr, *rf;
+    pfsph_particles *ds = pfsph__diffuse_set(D->sim->st.df, &nold, &cr, &rf);
+    D->d.migrate(&D->d, ds, nold, NULL);
+}
+
+int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
+{
+    if (D->root_all || D->gathered) return PFSPH_OK;
+    if (!D->framed) frame_figures(D); /* after a collective frame: sent with it */
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
@@ -757,17 +799,11 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
             MPI_Send(D->sbuf, (int)(k * REC), MPI_BYTE, 0, 30, D->comm);
         }
     }
-    /* the diffuse particles, in the serial order, to the root, which keeps them: the next
-     * step's diffuse stage sends each to the owner of its cell again */
-    if (sim->st.df) {
-        size_t *nold;
-        uint64_t *cr, *rf;
-        pfsph_particles *ds = pfsph__diffuse_set(sim->st.df, &nold, &cr, &rf);
-        D->d.migrate(&D->d, ds, nold, NULL);
-    }
+    if (!D->framed) diffuse_to_root(D);
     /* every rank keeps its slice: the next exchange goes on from it (the root's own particles
      * are untouched at the front of its arrays), only the clock is shared again */
     D->gathered = 1;
+    D->d.fluid_whole = 1;
     return PFSPH_OK;
 }
 
@@ -812,6 +848,8 @@ int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm)
     D->d.agree = agree;
     D->d.step_begin = step_begin;
     D->d.frame = frame;
+    D->d.gather = gather_now;
+    D->d.write_fluid = pfsph_mpi_write_fluid; /* src/mpi/frame_io.c */
     D->d.attach = attach;
     return pfsph_cost_init(D); /* times the hooks above */
 }
@@ -846,6 +884,7 @@ static int attach(pfsph_dist *d, pfsph_sim *sim, pfsph_error *err)
     D->walls_total = sim->boundary.n;
     D->root_all = 1;
     D->share = 1;
+    D->d.fluid_whole = 1;
     D->d.own_lo = 0;
     D->d.own_hi = D->rank == 0 ? sim->fluid.n : 0;
     D->d.nglobal = sim->fluid.n;

@@ -13,7 +13,16 @@
 #include "pfsph/sim.h"
 
 /* Commands the root broadcasts to the other ranks, which follow them (src/mpi/mpi_cli.c). */
-enum { PFSPH_MPI_CREATE = 1, PFSPH_MPI_STEP, PFSPH_MPI_FRAME, PFSPH_MPI_SAVE, PFSPH_MPI_LOAD, PFSPH_MPI_END };
+enum {
+    PFSPH_MPI_CREATE = 1,
+    PFSPH_MPI_STEP,
+    PFSPH_MPI_FRAME,
+    PFSPH_MPI_SAVE,
+    PFSPH_MPI_LOAD,
+    PFSPH_MPI_END,
+    PFSPH_MPI_WRITE,
+    PFSPH_MPI_GATHER
+};
 
 typedef struct pfsph_mpi_cmd {
     int cmd, rc;
@@ -42,8 +51,9 @@ struct pfsph_decomp {
     uint64_t own_g0;                /* the global index of the local particle own_lo */
     uint64_t ckpt_bytes, ckpt_read; /* figures: bytes of the last checkpoint written, of the one read */
     int failed;                     /* a stage failed on some rank: the other ranks left their command loop */
-    int gathered;                   /* the root holds every particle for a frame, the others still their slices */
-    size_t root_own_hi;             /* the root's own particles [0, root_own_hi) before the frame gather */
+    int framed;         /* a frame time passed without a gather: its fluid frames are written collectively */
+    int gathered;       /* the root holds every particle for a frame, the others still their slices */
+    size_t root_own_hi; /* the root's own particles [0, root_own_hi) before the frame gather */
     size_t ncells;
     size_t off;                             /* cells of key distance that a walk of the grid's reach can span */
     pfsph_cut C;                            /* the step's cut (src/mpi/cut.c); the four below point into it */
@@ -77,6 +87,14 @@ struct pfsph_decomp {
 int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm);
 /* The frame gather: every rank's owned particles to the root, in the serial order. */
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err);
+/* A frame time on every rank: the gather, or only the figures and the diffuse set where the
+ * scene's fluid frames are written collectively (pfsph_mpi_frames_collective). */
+int pfsph_decomp_frame(pfsph_decomp *D, pfsph_error *err);
+/* src/mpi/frame_io.c: whether this scene's fluid frames can be written collectively; the
+ * root's hook that has every rank write them (the others then call pfsph_mpi_frame_follow). */
+int pfsph_mpi_frames_collective(const pfsph_decomp *D);
+int pfsph_mpi_write_fluid(pfsph_dist *d, const char *dir, int frame, double time, pfsph_error *err);
+int pfsph_mpi_frame_follow(pfsph_decomp *D, const pfsph_mpi_cmd *c, pfsph_error *err);
 /* The hooks of src/mpi/sets.c: scan, any, allsum, migrate. */
 void pfsph_decomp_set_hooks(pfsph_decomp *D);
 /* The checkpoint hooks (src/mpi/ckpt.c): a file written and read by every rank with MPI-IO. */

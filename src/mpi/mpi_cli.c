@@ -63,9 +63,13 @@ static void report(pfsph_dist *d, void *json)
     cJSON *m = cJSON_AddObjectToObject(json, "mpi");
     if (!m) return;
     cJSON_AddNumberToObject(m, "ranks", D->size);
-    cJSON_AddStringToObject(m, "output",
-                            "frames gathered to rank 0 rank by rank through a bounded buffer, written by it; "
-                            "checkpoints written and read by every rank (MPI-IO)");
+    cJSON_AddStringToObject(
+        m, "output",
+        pfsph_mpi_frames_collective(D)
+            ? "fluid frames written collectively (MPI-IO), each rank its slice; checkpoints written "
+              "and read by every rank (MPI-IO)"
+            : "frames gathered to rank 0 rank by rank through a bounded buffer, written by it; "
+              "checkpoints written and read by every rank (MPI-IO)");
     cJSON *cut = cJSON_AddObjectToObject(m, "cut"); /* src/mpi/cut.c: the histogram of occupied cells */
     if (cut) {
         cJSON_AddNumberToObject(cut, "coarse_buckets", (double)D->C.buckets);
@@ -177,6 +181,10 @@ int pfsph_mpi_follow(int threads, int (*exit_code)(int))
         } else if (c.cmd == PFSPH_MPI_STEP) {
             rc = pfsph_sim_step(sim, c.t, &err);
         } else if (c.cmd == PFSPH_MPI_FRAME) {
+            rc = pfsph_decomp_frame(&g_D, &err);
+        } else if (c.cmd == PFSPH_MPI_WRITE) {
+            rc = pfsph_mpi_frame_follow(&g_D, &c, &err);
+        } else if (c.cmd == PFSPH_MPI_GATHER) {
             rc = pfsph_decomp_gather(&g_D, &err);
         } else if (c.cmd == PFSPH_MPI_SAVE) {
             rc = pfsph_decomp_save(&g_D, NULL, 0, 0, NULL, &err);

@@ -45,8 +45,16 @@ struct pfsph_dist {
     int (*agree)(pfsph_dist *d, int rc, pfsph_error *err);
     /* a step begins (the root tells the other ranks to follow) */
     void (*step_begin)(pfsph_dist *d, double t_limit);
-    /* a frame time reached: the root gathers the whole fluid in the serial order */
+    /* a frame time reached: the root gathers the whole fluid in the serial order, or, where the
+     * scene's fluid frames can be written collectively, only the frame's figures */
     int (*frame)(pfsph_dist *d, pfsph_error *err);
+    /* the root holds every fluid particle (the start, a resume, after a gather): the serial code
+     * applies; else each rank holds its slice and the fluid frames are written collectively */
+    int fluid_whole;
+    /* the root only (src/run.c): the fluid frames of `frame` into dir, every rank its slice */
+    int (*write_fluid)(pfsph_dist *d, const char *dir, int frame, double time, pfsph_error *err);
+    /* the root only: gather the whole fluid now (a checkpoint after a collective frame) */
+    int (*gather)(pfsph_dist *d, pfsph_error *err);
     /* the decomposition's figures into summary.json (a cJSON object) */
     void (*report)(pfsph_dist *d, void *json);
     /* A checkpoint file written by every rank, each its part of the fluid (the serial file's

@@ -56,5 +56,7 @@ int pfsph_run(const pfsph_scene *s, const pfsph_run_opts *o, pfsph_error *err);
 /* One frame as pfsph_run writes it (its own writer), into dir/frames, which must exist: for the
  * embedding API's pfsph_sim_write_frame. */
 int pfsph__run_write_frame(pfsph_sim *sim, const char *dir, int frame, pfsph_error *err);
+/* The same with the scene given (src/run_frame.c; the driver passes its own). */
+int pfsph__run_frame_files(const pfsph_scene *s, const char *dir, int frame, pfsph_sim *sim, pfsph_error *err);
 
 #endif

@@ -128,6 +128,7 @@ typedef struct pfsph_output {
     unsigned fields;          /* bitmask of extra fields, see PFSPH_OUT_* */
     int frame_interval;       /* write every n-th frame (1 = every frame) */
     int checkpoint_interval;  /* checkpoint every n-th frame (0 = never); docs/checkpoints.md */
+    bool pieces;              /* the fluid's VTP frames as ParaView pieces (.pvtp), one per MPI rank */
     bool surface_layer;       /* the fluid frames' surface_layer field (docs/film.md): a peel of
                                * the surface each frame, 20 min at frame 0 of 1.9e8 particles */
     pfsph_surface_output surface;

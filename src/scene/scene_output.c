@@ -94,7 +94,7 @@ int pfsph__scene_parse_output(parser *p, const cJSON *root)
     const cJSON *v = get(root, "output");
     if (!v) return PFSPH_OK;
     static const char *const keys[] = {"directory",           "formats", "fields",        "boundary", "frame_interval",
-                                       "checkpoint_interval", "surface", "surface_layer", NULL};
+                                       "checkpoint_interval", "surface", "surface_layer", "pieces",   NULL};
     const char *P = "$.output";
     TRY(pfsph__json_check_keys(v, P, keys, &p->ctx));
     TRY(parse_surface(p, get(v, "surface")));
@@ -102,6 +102,7 @@ int pfsph__scene_parse_output(parser *p, const cJSON *root)
     if (get(v, "directory") && !o->dir[0]) return pfsph__json_fail(&p->ctx, "$.output.directory", "must not be empty");
     TRY(pfsph__json_bool(v, P, "boundary", &o->write_boundary, &p->ctx));
     TRY(pfsph__json_bool(v, P, "surface_layer", &o->surface_layer, &p->ctx));
+    TRY(pfsph__json_bool(v, P, "pieces", &o->pieces, &p->ctx));
     TRY(pfsph__json_int(v, P, "frame_interval", 1, 1000000, &o->frame_interval, &p->ctx));
     TRY(pfsph__json_int(v, P, "checkpoint_interval", 0, 1000000, &o->checkpoint_interval, &p->ctx));
     const cJSON *f = get(v, "formats");
@@ -140,6 +141,8 @@ int pfsph__scene_parse_output(parser *p, const cJSON *root)
             o->fields |= bits[idx];
         }
     }
+    if (o->pieces && !o->vtp)
+        return pfsph__json_fail(&p->ctx, "$.output.pieces", "pieces are VTP files: needs \"vtp\" in $.output.formats");
     return PFSPH_OK;
 }
 

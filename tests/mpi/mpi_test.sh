@@ -26,6 +26,12 @@
 #   mpi_test.sh refuse SCENE NP [STATUS [VAR=VALUE]]  refused or stopped with one message and exit
 #                                          status STATUS (default 2) from mpirun; VAR=VALUE: set
 #                                          in the environment, the message names VAR
+#   mpi_test.sh collective SCENE END NP... as compare, the scene without checkpoints (no gather at
+#                                          a frame: the fluid frames written collectively)
+#   mpi_test.sh pieces SCENE END NP...    as collective with output.pieces: each frame's .pvtp names
+#                                          NP pieces, which read back are the serial frame's particles
+#   mpi_test.sh fault SCENE END NP FILE   a collective frame FILE that fails on rank 0's disk: exit
+#                                          1, nothing under its name, no temporary left
 # Environment: PFSPH_BIN (the program), PFSPH_MPI_BUILD (ON/OFF), PFSPH_MPIRUN (mpirun or empty).
 # Exit 77 (skipped) when the build has no MPI or mpirun is missing.
 set -u
@@ -212,6 +218,66 @@ walls)
             }' "$TMP/np$np/summary.json" || exit 1
     done
     ;;
+collective | pieces)
+    # the scene without a checkpoint a frame (no gather: every fluid frame written collectively
+    # from the slices); pieces: also "output.pieces", each .pvtp's pieces read back and compared
+    # with the serial frame (tests/mpi/pieces_check.c), the PLY frames byte for byte
+    scene=$SRC/$1 end=$2
+    shift 2
+    sed 's/"checkpoint_interval": *[0-9]*/"checkpoint_interval": 0/' "$scene" >"$TMP/whole.json"
+    grep -q '"checkpoint_interval": 0' "$TMP/whole.json" || { echo "FAIL: the scene sets no checkpoint_interval"; exit 1; }
+    "$BIN" run "$TMP/whole.json" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    run=$TMP/whole.json
+    if [ "$mode" = pieces ]; then
+        sed 's/"output": *{/"output": {"pieces": true, /' "$TMP/whole.json" >"$TMP/pieces.json"
+        run=$TMP/pieces.json
+    fi
+    for np in "$@"; do
+        mpi "$np" run "$run" -o "$TMP/np$np" --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        if ls "$TMP/np$np/frames" | grep -q '\.tmp\.'; then echo "FAIL: temporaries left"; exit 1; fi
+        [ "$np" = 1 ] || grep -q 'written collectively' "$TMP/np$np/summary.json" ||
+            { echo "FAIL: -np $np: the frames were not written collectively"; exit 1; }
+        if [ "$mode" = collective ]; then
+            same "$TMP/serial" "$TMP/np$np" || exit 1
+            continue
+        fi
+        cmp -s "$TMP/serial/stats.csv" "$TMP/np$np/stats.csv" || { echo "FAIL: stats.csv differs"; exit 1; }
+        for f in "$TMP/serial/frames/"fluid_*.ply; do
+            [ -e "$f" ] || continue
+            cmp -s "$f" "$TMP/np$np/frames/${f##*/}" || { echo "FAIL: -np $np: ${f##*/} differs"; exit 1; }
+        done
+        k=0
+        for f in "$TMP/serial/frames/"fluid_*.vtp; do
+            b=${f##*/}
+            pv=$TMP/np$np/frames/${b%.vtp}.pvtp
+            [ -f "$pv" ] || { echo "FAIL: -np $np: no ${b%.vtp}.pvtp"; exit 1; }
+            want=$np # frame 0 is written before the first cut, by the root: one piece
+            [ "$b" = fluid_00000.vtp ] && want=1
+            [ "$(grep -c '<Piece Source=' "$pv")" = "$want" ] || { echo "FAIL: $pv names no $want pieces"; exit 1; }
+            "${PFSPH_PIECES_CHECK:?PFSPH_PIECES_CHECK}" "$f" "$pv" >"$TMP/check" || { cat "$TMP/check"; exit 1; }
+            grep -q "file=\"frames/${b%.vtp}.pvtp\"" "$TMP/np$np/fluid.pvd" ||
+                { echo "FAIL: fluid.pvd does not list ${b%.vtp}.pvtp"; exit 1; }
+            k=$((k + 1))
+        done
+        [ "$k" -gt 1 ] || { echo "FAIL: fewer than 2 VTP frames to compare"; exit 1; }
+        echo "ok: -np $np: $k frames in $np pieces each equal the serial frames; $(tail -n 1 "$TMP/check")"
+    done
+    ;;
+fault)
+    # a collective frame that fails (the full-disk hook on rank 0, after every rank wrote its
+    # part): exit status 1 with the one message, nothing under the frame's name, no temporary
+    scene=$SRC/$1 end=$2 np=$3 frame=$4
+    sed 's/"checkpoint_interval": *[0-9]*/"checkpoint_interval": 0/' "$scene" >"$TMP/nock.json"
+    "$MPIRUN" $ROOTOPT --oversubscribe -x PFSPH_FAULT_WRITE="$frame" -np "$np" "$BIN" run "$TMP/nock.json" \
+        -o "$TMP/f" --end "$end" --quiet 2>"$TMP/err"
+    rc=$?
+    [ "$rc" = 1 ] || { echo "FAIL: exit status $rc, not 1"; cat "$TMP/err"; exit 1; }
+    grep -q "^pfsph: .*$frame: write failed: No space left on device" "$TMP/err" ||
+        { echo "FAIL: no message naming $frame:"; cat "$TMP/err"; exit 1; }
+    [ ! -e "$TMP/f/frames/$frame" ] || { echo "FAIL: $frame was renamed into place"; exit 1; }
+    if ls "$TMP/f/frames" | grep -q '\.tmp\.'; then echo "FAIL: temporaries left"; exit 1; fi
+    echo "ok: exit status 1, $frame not written, no temporary left"
+    ;;
 resume)
     scene=$SRC/$1 t1=$2 t2=$3 np1=$4 np2=$5
     "$BIN" run "$scene" -o "$TMP/serial" --end "$t2" --quiet || { echo "FAIL: the serial run"; exit 1; }
@@ -256,7 +322,7 @@ refuse)
     echo "ok: exit status $rc and one message: $(grep '^pfsph: ' "$TMP/err")"
     ;;
 *)
-    echo "usage: mpi_test.sh compare|cutcheck|costskew|walls|resume|kill|refuse ..."
+    echo "usage: mpi_test.sh compare|cutcheck|costskew|walls|collective|pieces|ckpt|resume|kill|refuse ..."
     exit 2
     ;;
 esac

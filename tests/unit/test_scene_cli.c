@@ -53,6 +53,14 @@ static const cli_case cases[] = {
      "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
      "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"solver\":{\"type\":\"dfsph\",\"neighbour_lists\":\"never\"}}",
      "$.solver.neighbour_lists: expected true, false or \"auto\", got \"never\""},
+    {"pieces.json", /* issue 29: the fluid's VTP frames in ParaView pieces, true or false */
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"output\":{\"pieces\":\"yes\"}}",
+     "$.output.pieces: expected true or false, got a string"},
+    {"pieces_ply.json", /* pieces are VTP files */
+     "{\"domain\":{\"min\":[0,0,0],\"max\":[1,1,1]},\"fluid\":[{\"shape\":\"box\","
+     "\"min\":[0,0,0],\"max\":[0.2,0.2,0.2]}],\"output\":{\"pieces\":true,\"formats\":[\"ply\"]}}",
+     "$.output.pieces: pieces are VTP files: needs \"vtp\" in $.output.formats"},
 };
 #define NCASES (sizeof cases / sizeof cases[0])
 
