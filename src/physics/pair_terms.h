@@ -14,7 +14,7 @@ void pfsph__terms_dwr(const pfsph_kernel *k, int n, const pfsph_real *restrict r
 typedef struct pfsph_pair_in {
     pfsph_kernel k;
     const pfsph_real *vx, *vy, *vz, *nd, *p;
-    const pfsph_real *nuj; /* per hit: nu of j's phase */
+    const pfsph_real *nuj; /* per hit: the pair's nu (viscosity.h, pfsph__visc_pair_nu) */
     pfsph_real vxi, vyi, vzi, nui, pi, eps;
 } pfsph_pair_in;
 
