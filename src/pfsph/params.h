@@ -170,11 +170,14 @@ double pfsph_pairwise_visc_struct(int dim, double theta);
 /* The bulk viscosity of the hot pair-force liquid, nu_eff / nu_0, for the Morris viscosity
  * x = nu_morris / nu_0 (nu_0 = sqrt(sigma d / rho), sigma the phase's own tension at temperature,
  * d the spacing, rho its rest density), measured wall-free at the default temperature of
- * dimension dim (docs/viscosity.md; 2D applies the Morris viscosity as set and uses its table
- * only for the expectation); NAN where no table applies (theta more than 25 % from the
- * default). pfsph_pairwise_visc_morris is its inverse: the x that gives nu_eff / nu_0 = y. */
+ * dimension dim (2D: at 0.01, its default, and at 0.04, where it is Newtonian and the table
+ * serves only the expectation; docs/viscosity.md); NAN where no table applies (theta more than
+ * 25 % from a table's). pfsph_pairwise_visc_morris is its inverse: the x that gives nu_eff / nu_0 = y. */
 double pfsph_pairwise_visc_eff(int dim, double theta, double x);
 double pfsph_pairwise_visc_morris(int dim, double theta, double y);
+/* Whether `viscosity_correction` applies the table at theta: 3D at its default temperature, 2D
+ * at its default 0.01; not 2D at 0.04 (Newtonian there: the Morris viscosity as set). */
+bool pfsph_pairwise_visc_corrects(int dim, double theta);
 /* The smallest Morris viscosity the correction applies, in units of sqrt(sigma d / rho): the
  * thermostat's noise is the fluctuation-dissipation partner of that friction, and at 0.047 of
  * the unit the kinetic temperature already reads 0.89 of its value at 0.16 (docs/thermostat.md). */

@@ -121,11 +121,12 @@ static void lap_study(pfsph_sim *sim, const pfsph_ctx *c, double sigma)
         sgg += (pg / ng - pw / nw) * (pg / ng - pw / nw);
         ns++;
         if (ns % 200 == 0)
-            printf("lap t=%.2f: p_gas %.2f p_water %.2f jump %.2f Pa (sigma/R_e %.2f), circ %.4f\n", pfsph_sim_time(sim),
-                   sg / ns, sw / ns, (sg - sw) / ns, sigma / Re, b.circ);
+            printf("lap t=%.2f: p_gas %.2f p_water %.2f jump %.2f Pa (sigma/R_e %.2f), circ %.4f\n",
+                   pfsph_sim_time(sim), sg / ns, sw / ns, (sg - sw) / ns, sigma / Re, b.circ);
     }
     const double m = (sg - sw) / ns, sd = sqrt(fmax(0, sgg / ns - m * m));
-    printf("lap summary: %ld samples, jump %.2f Pa (sample sd %.1f), gas %.2f, water %.2f\n", ns, m, sd, sg / ns, sw / ns);
+    printf("lap summary: %ld samples, jump %.2f Pa (sample sd %.1f), gas %.2f, water %.2f\n", ns, m, sd, sg / ns,
+           sw / ns);
     free(mp);
 }
 
@@ -136,8 +137,9 @@ static void run_case(int cs, int n, series *r)
     char json[8192], seed[64] = "";
     if (getenv("PF_SEED")) snprintf(seed, sizeof seed, "\"seed\": %d,", (int)tu_env_num("PF_SEED", 0));
     snprintf(json, sizeof json, SCENE, 0.5 * d, -tu_env_num("PF_G", 0.98), -w - d, -w - d, 1 + w + d, 2 + w + d,
-             tu_env("PF_SOLVER", cs == 1 ? "pcisph" : "wcsph\", \"pressure_scale\": \"common"), seed, tu_env_num("PF_NUW", 0.01), h->rho_g, tu_env_num("PF_NUG", h->nu_g), tu_env_num("PF_YB", 0.5),
-             -w, -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma,
+             tu_env("PF_SOLVER", cs == 1 ? "pcisph" : "wcsph\", \"pressure_scale\": \"common"), seed,
+             tu_env_num("PF_NUW", 0.01), h->rho_g, tu_env_num("PF_NUG", h->nu_g), tu_env_num("PF_YB", 0.5), -w, -w,
+             1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma,
              h->sigma * tu_env_num("PF_SWG", 1));
     pfsph_sim *sim = tu_sim_from_json(json, "hysing case");
     pfsph_error err = {0};
