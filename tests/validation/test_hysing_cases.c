@@ -29,11 +29,14 @@
  * the colour field (the resting bubble reads 0.994 +- 0.001, the grid contour's roughness).
  *
  * Checks (why these bounds): case 1, the issue's done-when targets are peak rise velocity within
- * 10 % and centroid within 5 % of Hysing's with default settings. Before issue 31's viscosity
- * change the default liquid is 2.4-3.7x too viscous (docs/thermostat.md), so this test asserts
- * what the default can be held to now and prints the targets' verdict: case 1 peak velocity
- * within 25 % and y(3) within 10 % (measured on main, 2026-12-05: see docs/validation.md), the
- * bubble deforms (circularity below 0.98, 15 sd of the resting noise). Case 2 (density ratio
+ * 10 % and centroid within 5 % of Hysing's with default settings. Since the 2D viscosity
+ * correction is on by default (2026-12-06; docs/validation.md, "Hysing case 1: what holds the
+ * bubble back") case 1 reads -10.0 % / -2.7 % (PCISPH, this test) and -6.5 / -10.7 / -3.3 % on
+ * the peak, -2.1 / -2.9 / -1.4 % on y(3) for three DFSPH seeds: y(3) is held to the issue's
+ * 5 %; the peak, a 0.2 s mean of 208 gas particles' thermal velocities whose seed-to-seed sd is
+ * about 3.7 points, to 15 % (the target plus 1.4 sd), and the verdict on 10 % is printed; the
+ * bubble deforms as Hysing's does (circularity below 0.95; measured 0.906-0.918, Hysing 0.901;
+ * the default before read 0.97-0.98). Case 2 (density ratio
  * 1000) misses the benchmark (docs/validation.md: the gas disperses into a ragged cap and stalls
  * after 2 s), so its checks only say that the case runs and the bubble rises: no gas particle
  * lost, the rise y(3) - 0.5 at least half of Hysing's, and the bubble deforms (circularity
@@ -41,7 +44,9 @@
  * Writes validation/hysing_case{1,2}.csv (t, yc, vy, circularity) in the working directory for
  * tools/validation_plots.py. Under AddressSanitizer it skips (tu_release_only).
  * Study knobs: PF_N (particles per diameter, 16), PF_CASES ("1,2"), PF_PW (pairwise text),
- * PF_SOLVER (both cases' solver text), PF_T (end, 3 s), PF_SWG (factor on the water-gas tension, 1), PF_SEED (the scene's seed). */
+ * PF_SOLVER (both cases' solver text), PF_T (end, 3 s), PF_SWG (factor on the water-gas tension, 1), PF_SEED (the scene's seed),
+ * PF_NUW / PF_NUG (water's / gas's viscosity), PF_G (gravity, 0.98), PF_YB (the bubble's centre
+ * height, 0.5), PF_LAP (the static bubble's Laplace jump, lap_study: with PF_G=0 PF_YB=1). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -235,9 +240,9 @@ static void test_hysing_cases(void **state)
         const series *s = &r[i];
         assert_false(s->lost);
         if (cs == 1) {
-            assert_true(fabs(s->vmax / h->vmax - 1) <= 0.25);
-            assert_true(fabs(s->yc[s->nk] / h->yc3 - 1) <= 0.10);
-            assert_true(s->cmin < 0.98);
+            assert_true(fabs(s->vmax / h->vmax - 1) <= 0.15);
+            assert_true(fabs(s->yc[s->nk] / h->yc3 - 1) <= 0.05);
+            assert_true(s->cmin < 0.95);
         } else {
             assert_true((s->yc[s->nk] - 0.5) / (h->yc3 - 0.5) >= 0.5);
             assert_true(s->cmin < 0.95);
