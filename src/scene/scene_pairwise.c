@@ -367,15 +367,15 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
         const double s13 = lam * pp->c[a][a] * rho[a] * rho[a], sg = f * s13;
         const double kTa = tp->kT_resolved * (tp->rho_ref > 0 ? rho[a] / tp->rho_ref : 1.0);
         const double tha = kTa / (s13 * dd);
-        /* 2D away from the temperatures of the wall-free tables: the box correction
-         * (docs/thermostat.md) and its estimate */
+        /* 2D away from the temperatures of the wall-free tables: applied as set, with the box
+         * estimate (docs/thermostat.md) for check; the box correction itself is retired (a
+         * wall/size term, docs/viscosity.md): the wall-free table replaced it at 0.01 */
         if (s->dim == 2 && !isfinite(pfsph_pairwise_visc_eff(2, tha, 0.0))) {
             const double g = pfsph_pairwise_visc_struct(s->dim, kTa / (s13 * dd));
             if (!(g > 0)) continue;
             const double nu0 = sqrt(sg * (double)spacing / rho[a]);
             pp->nu_struct[a] = g * nu0;
             pp->nu_floor[a] = PFSPH_VISC_FLOOR * nu0;
-            if (pp->visc_correct) pp->nu_morris[a] = fmax((nu - pp->nu_struct[a]) / PFSPH_VISC_GAIN, pp->nu_floor[a]);
             continue;
         }
         const double nu0 = sqrt(sg * (double)spacing / rho[a]);
@@ -424,32 +424,12 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
         else fprintf(out, "; viscosity 0: no friction, so no noise either (set a viscosity)\n");
         if (s->dim == 2 && !isfinite(pfsph_pairwise_visc_eff(2, pp->theta, 0.0))) {
             /* the hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid") */
-            if (!(pp->nu_struct[a] > 0)) {
-                if (pp->visc_correct)
-                    fprintf(out,
-                            "      viscosity_correction: no measured table for %dD at this temperature; "
-                            "the viscosity is applied as set\n",
-                            s->dim);
-                continue;
-            }
-            const double reach = pp->nu_struct[a] + PFSPH_VISC_GAIN * pp->nu_floor[a];
-            if (!pp->visc_correct) {
-                fprintf(out,
-                        "      viscosity %.4g m^2/s set; the hot liquid is expected to flow as ~%.3g "
-                        "(structural %.3g + %.3g x the set one, a box figure; wall-free this 2D liquid is "
-                        "shear-thinning, 4.7x at 1e-3 and 2.1 /s, docs/viscosity.md)\n",
-                        nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
-                continue;
-            }
+            if (!(pp->nu_struct[a] > 0)) continue;
             fprintf(out,
-                    "      viscosity %.4g m^2/s set: Morris viscosity %.4g applied (structural %.3g, "
-                    "gain %.3g, floor %.3g)\n",
-                    nu, num, pp->nu_struct[a], PFSPH_VISC_GAIN, pp->nu_floor[a]);
-            if (nu < reach)
-                fprintf(out,
-                        "      warning: %s's viscosity %.4g m^2/s is below what the hot liquid reaches "
-                        "(~%.3g m^2/s at this temperature, spacing and tension); it will flow as ~%.3g\n",
-                        s->phases[a].name, nu, reach, reach);
+                    "      viscosity %.4g m^2/s set and applied as the Morris viscosity (no wall-free table at "
+                    "this temperature); the hot liquid is expected to flow as ~%.3g (structural %.3g + %.3g x "
+                    "the set one, a box figure; docs/viscosity.md)\n",
+                    nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
             continue;
         }
         /* the hot liquid's own viscosity (docs/viscosity.md) */
