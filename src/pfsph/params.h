@@ -114,13 +114,12 @@ typedef struct pfsph_pairwise_params {
      * tension target was converted with (solid pairs: sigma_factor) */
     double sigma_factor_ab[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     /* Viscosity correction (docs/viscosity.md): the hot pair-force liquid flows with more than the
-     * Morris viscosity it is given. 3D: measured wall-free as nu_eff(nu_morris)
-     * (pfsph_pairwise_visc_eff); with `viscosity_correction` on (the default in a 3D "pairwise"
-     * block) each pair-force phase's Morris viscosity becomes the one that gives its
-     * `viscosity`, at least nu_floor. 2D: applied as set (at the 2D default temperature the
-     * liquid flows as set); opt-in, docs/thermostat.md: the box calibration,
-     * max((nu - nu_struct) / gain, nu_floor). */
-    bool visc_correct;                  /* scene key; 3D: on in a "pairwise" block unless it says false */
+     * Morris viscosity it is given, measured wall-free as nu_eff(nu_morris)
+     * (pfsph_pairwise_visc_eff); with `viscosity_correction` on (the default in a "pairwise"
+     * block, 2D since 2026-12-06) each pair-force phase's Morris viscosity becomes the one that
+     * gives its `viscosity`, at least nu_floor, where pfsph_pairwise_visc_corrects holds (3D at
+     * 0.01, 2D at 0.01); 2D at 0.04 (Newtonian) and away from the tables: applied as set. */
+    bool visc_correct;                  /* scene key; on in a "pairwise" block unless it says false */
     double nu_morris[PFSPH_MAX_PHASES]; /* the viscosity the step applies [m^2/s] */
     double nu_struct[PFSPH_MAX_PHASES]; /* expected bulk viscosity (wall-free table); 2D with the
                                            box correction or off its default temperature: the
