@@ -300,6 +300,13 @@ int pfsph_sim_create_ex(pfsph_sim **out, const pfsph_scene *scene, pfsph_setup_f
     }
     if (s->pairwise.enabled && (rc = pfsph_pairwise_resolve(s, c->spacing, c->h, err)) != PFSPH_OK) goto fail;
     pfsph__sim_apply_viscosity(c, s);
+    /* the viscous step limit: a pair of two fluid phases applies the harmonic mean of their
+     * dynamic viscosities over the lighter one's density, up to twice its own nu
+     * (viscosity.h); within one phase this is its nu, so single-fluid scenes keep their step */
+    for (int a = 0; a < s->nphases; a++)
+        for (int b = 0; b < s->nphases; b++)
+            if (a != b && s->phases[a].kind != PFSPH_PHASE_SOLID && s->phases[b].kind != PFSPH_PHASE_SOLID)
+                sim->st.nu_max = fmax(sim->st.nu_max, (double)pfsph__visc_pair_nu(c, a, b));
 
     if ((rc = pfsph_particles_init(&sim->fluid, 1024)) || (rc = pfsph_particles_init(&sim->boundary, 1024))) {
         pfsph_fail(err, rc, "out of memory");

@@ -114,13 +114,12 @@ typedef struct pfsph_pairwise_params {
      * tension target was converted with (solid pairs: sigma_factor) */
     double sigma_factor_ab[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
     /* Viscosity correction (docs/viscosity.md): the hot pair-force liquid flows with more than the
-     * Morris viscosity it is given. 3D: measured wall-free as nu_eff(nu_morris)
-     * (pfsph_pairwise_visc_eff); with `viscosity_correction` on (the default in a 3D "pairwise"
-     * block) each pair-force phase's Morris viscosity becomes the one that gives its
-     * `viscosity`, at least nu_floor. 2D: applied as set (at the 2D default temperature the
-     * liquid flows as set); opt-in, docs/thermostat.md: the box calibration,
-     * max((nu - nu_struct) / gain, nu_floor). */
-    bool visc_correct;                  /* scene key; 3D: on in a "pairwise" block unless it says false */
+     * Morris viscosity it is given, measured wall-free as nu_eff(nu_morris)
+     * (pfsph_pairwise_visc_eff); with `viscosity_correction` on (the default in a "pairwise"
+     * block, 2D since 2026-12-06) each pair-force phase's Morris viscosity becomes the one that
+     * gives its `viscosity`, at least nu_floor, where pfsph_pairwise_visc_corrects holds (3D at
+     * 0.01, 2D at 0.01); 2D at 0.04 (Newtonian) and away from the tables: applied as set. */
+    bool visc_correct;                  /* scene key; on in a "pairwise" block unless it says false */
     double nu_morris[PFSPH_MAX_PHASES]; /* the viscosity the step applies [m^2/s] */
     double nu_struct[PFSPH_MAX_PHASES]; /* expected bulk viscosity (wall-free table); 2D with the
                                            box correction or off its default temperature: the
@@ -170,11 +169,14 @@ double pfsph_pairwise_visc_struct(int dim, double theta);
 /* The bulk viscosity of the hot pair-force liquid, nu_eff / nu_0, for the Morris viscosity
  * x = nu_morris / nu_0 (nu_0 = sqrt(sigma d / rho), sigma the phase's own tension at temperature,
  * d the spacing, rho its rest density), measured wall-free at the default temperature of
- * dimension dim (docs/viscosity.md; 2D applies the Morris viscosity as set and uses its table
- * only for the expectation); NAN where no table applies (theta more than 25 % from the
- * default). pfsph_pairwise_visc_morris is its inverse: the x that gives nu_eff / nu_0 = y. */
+ * dimension dim (2D: at 0.01, its default, and at 0.04, where it is Newtonian and the table
+ * serves only the expectation; docs/viscosity.md); NAN where no table applies (theta more than
+ * 25 % from a table's). pfsph_pairwise_visc_morris is its inverse: the x that gives nu_eff / nu_0 = y. */
 double pfsph_pairwise_visc_eff(int dim, double theta, double x);
 double pfsph_pairwise_visc_morris(int dim, double theta, double y);
+/* Whether `viscosity_correction` applies the table at theta: 3D at its default temperature, 2D
+ * at its default 0.01; not 2D at 0.04 (Newtonian there: the Morris viscosity as set). */
+bool pfsph_pairwise_visc_corrects(int dim, double theta);
 /* The smallest Morris viscosity the correction applies, in units of sqrt(sigma d / rho): the
  * thermostat's noise is the fluctuation-dissipation partner of that friction, and at 0.047 of
  * the unit the kinetic temperature already reads 0.89 of its value at 0.16 (docs/thermostat.md). */

@@ -29,7 +29,7 @@ void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const ui
 typedef struct pfsph_pair_in {
     pfsph_kernel k;
     const pfsph_real *vx, *vy, *vz, *nd, *p;
-    const pfsph_real *nuj; /* per hit: nu of j's phase */
+    const pfsph_real *nuj; /* per hit: the pair's nu (viscosity.h, pfsph__visc_pair_nu) */
     pfsph_real vxi, vyi, vzi, nui, pi, eps;
 } pfsph_pair_in;
 

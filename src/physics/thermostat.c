@@ -2,6 +2,8 @@
  * and Akinci wall friction of viscosity.c (fluctuation-dissipation: sigma_ij^2 = 2 kT Gamma_ij). */
 #include "pfsph/thermostat.h"
 
+#include "physics/viscosity.h"
+
 #include <math.h>
 
 void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
@@ -39,7 +41,7 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
                 pfsph_real r2 = dx * dx + dy * dy + dz * dz;
                 if (r2 >= h2 || j == i || r2 <= 0) continue;
                 const int pb = f->phase[j];
-                double nu = 0.5 * (nui + (double)ctx->nu[pb]);
+                double nu = pfsph__visc_noise_nu(ctx, pa, pb, ndi, (double)ctx->nd[j]);
                 if (!(nu > 0)) continue;
                 double rr = sqrt((double)r2);
                 double s = pfsph__thermo_fluid(amp * ts[pa][pb], nu, mi, (double)ctx->mass[pb], ndi, (double)ctx->nd[j],

@@ -30,15 +30,15 @@ static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
                              const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, visc_acc *acc)
 {
     const pfsph_particles *f = ctx->fluid;
-    pfsph_real nu = (pfsph_real)0.5 * (I->nu + ctx->nu[f->phase[j]]);
+    const int pb = f->phase[j];
+    pfsph_real nu = pfsph__visc_pair_nu(ctx, I->phase, pb);
     pfsph_real vdx = (I->vx - f->vx[j]) * dx + (I->vy - f->vy[j]) * dy + (I->vz - f->vz[j]) * dz;
     pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
     acc->ax += s * dx;
     acc->ay += s * dy;
     acc->az += s * dz;
     if (thermo) {
-        const int pb = f->phase[j];
-        const double nud = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
+        const double nud = pfsph__visc_noise_nu(ctx, I->phase, pb, I->nd, (double)ctx->nd[j]);
         if (nud > 0 && r2 > 0) {
             const double rd = sqrt((double)r2);
             /* dwr, not dw_r((real) rd): (real) sqrt((double) r2) is pfsph_sqrt(r2), so the same bits */
@@ -113,11 +113,11 @@ static inline void thermo_hits(const pfsph_ctx *ctx, const visc_i *I, pfsph_hits
         for (int e = 0; e < n16; e++) {
             const uint32_t j = H->j[e];
             const int pb = f->phase[j];
-            H->t3[e] = ctx->nu[pb];
+            H->t3[e] = pfsph__visc_pair_nu(ctx, I->phase, pb);
             X->amp_ts[e] = amp * ts[I->phase][pb];
-            X->nu[e] = 0.5 * ((double)I->nu + (double)ctx->nu[pb]);
-            X->mj[e] = (double)ctx->mass[pb];
             X->ndj[e] = (double)ctx->nd[j];
+            X->nu[e] = pfsph__visc_noise_nu(ctx, I->phase, pb, I->nd, X->ndj[e]);
+            X->mj[e] = (double)ctx->mass[pb];
             X->idj[e] = f->id[j];
         }
     /* the pair hashes in vector code (pair_terms.c), the same bits as pfsph_thermo_theta */
@@ -161,7 +161,7 @@ static void thermo_fill_phase(const pfsph_ctx *ctx, int pa, pfsph_hits *H, therm
 {
     const pfsph_real nua = ctx->nu[pa];
     for (int e = 0; e < PFSPH_HITS_CAP + PFSPH_HITS_PAD; e++) {
-        H->t3[e] = nua;
+        H->t3[e] = pfsph__visc_pair_nu(ctx, pa, pa);
         X->amp_ts[e] = amp * ts[pa][pa];
         X->nu[e] = 0.5 * ((double)nua + (double)nua);
         X->mj[e] = (double)ctx->mass[pa];
@@ -262,7 +262,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                     const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi,
                                               vyi, vzi,   nui,   pi,    eps};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
-                        for (int e = 0; e < H.n; e++) H.t3[e] = ctx->nu[f->phase[H.j[e]]];
+                        for (int e = 0; e < H.n; e++) H.t3[e] = pfsph__visc_pair_nu(ctx, pa, f->phase[H.j[e]]);
                         pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);
                         for (int e = 0; e < H.n; e++) {
                             acc.ax += H.t1[e] * H.dx[e];

@@ -101,9 +101,9 @@ int pfsph__scene_parse_pairwise(const cJSON *node, const char *path, pfsph_scene
     pp->enabled = true;
     /* the default temperature depends on the dimension (docs/viscosity.md) */
     pp->thermo.reduced = pfsph_thermo_reduced_default(s->dim);
-    /* and in 3D the Morris viscosity is the one that makes the hot liquid flow as set (2D: the
-     * opt-in box correction, docs/viscosity.md) */
-    pp->visc_correct = s->dim == 3;
+    /* and the Morris viscosity is the one that makes the hot liquid flow as set, in 2D and 3D
+     * (docs/viscosity.md; 2D since 2026-12-06, docs/validation.md "Hysing case 1") */
+    pp->visc_correct = true;
     if ((rc = pfsph__json_bool(node, path, "enabled", &pp->enabled, ctx))) return rc;
     if ((rc = pfsph__json_bool(node, path, "viscosity_correction", &pp->visc_correct, ctx))) return rc;
     if ((rc = pfsph__json_number(node, path, "k", 1.0, 4.0, &pp->k, ctx))) return rc;
@@ -367,21 +367,21 @@ int pfsph_pairwise_resolve(pfsph_scene *s, pfsph_real spacing, pfsph_real h, pfs
         const double s13 = lam * pp->c[a][a] * rho[a] * rho[a], sg = f * s13;
         const double kTa = tp->kT_resolved * (tp->rho_ref > 0 ? rho[a] / tp->rho_ref : 1.0);
         const double tha = kTa / (s13 * dd);
-        /* 2D: the opt-in box correction (docs/thermostat.md), and the box estimate away from
-         * the default temperature, where no wall-free table applies */
-        if (s->dim == 2 && (pp->visc_correct || !isfinite(pfsph_pairwise_visc_eff(2, tha, 0.0)))) {
+        /* 2D away from the temperatures of the wall-free tables: applied as set, with the box
+         * estimate (docs/thermostat.md) for check; the box correction itself is retired (a
+         * wall/size term, docs/viscosity.md): the wall-free table replaced it at 0.01 */
+        if (s->dim == 2 && !isfinite(pfsph_pairwise_visc_eff(2, tha, 0.0))) {
             const double g = pfsph_pairwise_visc_struct(s->dim, kTa / (s13 * dd));
             if (!(g > 0)) continue;
             const double nu0 = sqrt(sg * (double)spacing / rho[a]);
             pp->nu_struct[a] = g * nu0;
             pp->nu_floor[a] = PFSPH_VISC_FLOOR * nu0;
-            if (pp->visc_correct) pp->nu_morris[a] = fmax((nu - pp->nu_struct[a]) / PFSPH_VISC_GAIN, pp->nu_floor[a]);
             continue;
         }
         const double nu0 = sqrt(sg * (double)spacing / rho[a]);
         if (!isfinite(pfsph_pairwise_visc_eff(s->dim, tha, 0.0)) || !(nu0 > 0)) continue;
         pp->nu_floor[a] = PFSPH_VISC_FLOOR * nu0;
-        if (pp->visc_correct)
+        if (pp->visc_correct && pfsph_pairwise_visc_corrects(s->dim, tha))
             pp->nu_morris[a] = fmax(pfsph_pairwise_visc_morris(s->dim, tha, nu / nu0), PFSPH_VISC_FLOOR) * nu0;
         pp->nu_struct[a] = pfsph_pairwise_visc_eff(s->dim, tha, pp->nu_morris[a] / nu0) * nu0;
     }
@@ -422,34 +422,14 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
         const double num = pp->nu_morris[a];
         if (num > 0) fprintf(out, ", velocity relaxation ~%.3g s\n", h * h / (2.0 * (s->dim + 2) * num));
         else fprintf(out, "; viscosity 0: no friction, so no noise either (set a viscosity)\n");
-        if (s->dim == 2 && (pp->visc_correct || !isfinite(pfsph_pairwise_visc_eff(2, pp->theta, 0.0)))) {
+        if (s->dim == 2 && !isfinite(pfsph_pairwise_visc_eff(2, pp->theta, 0.0))) {
             /* the hot liquid's own viscosity (docs/thermostat.md, "The viscosity of the hot liquid") */
-            if (!(pp->nu_struct[a] > 0)) {
-                if (pp->visc_correct)
-                    fprintf(out,
-                            "      viscosity_correction: no measured table for %dD at this temperature; "
-                            "the viscosity is applied as set\n",
-                            s->dim);
-                continue;
-            }
-            const double reach = pp->nu_struct[a] + PFSPH_VISC_GAIN * pp->nu_floor[a];
-            if (!pp->visc_correct) {
-                fprintf(out,
-                        "      viscosity %.4g m^2/s set; the hot liquid is expected to flow as ~%.3g "
-                        "(structural %.3g + %.3g x the set one, a box figure; wall-free this 2D liquid is "
-                        "shear-thinning, 4.7x at 1e-3 and 2.1 /s, docs/viscosity.md)\n",
-                        nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
-                continue;
-            }
+            if (!(pp->nu_struct[a] > 0)) continue;
             fprintf(out,
-                    "      viscosity %.4g m^2/s set: Morris viscosity %.4g applied (structural %.3g, "
-                    "gain %.3g, floor %.3g)\n",
-                    nu, num, pp->nu_struct[a], PFSPH_VISC_GAIN, pp->nu_floor[a]);
-            if (nu < reach)
-                fprintf(out,
-                        "      warning: %s's viscosity %.4g m^2/s is below what the hot liquid reaches "
-                        "(~%.3g m^2/s at this temperature, spacing and tension); it will flow as ~%.3g\n",
-                        s->phases[a].name, nu, reach, reach);
+                    "      viscosity %.4g m^2/s set and applied as the Morris viscosity (no wall-free table at "
+                    "this temperature); the hot liquid is expected to flow as ~%.3g (structural %.3g + %.3g x "
+                    "the set one, a box figure; docs/viscosity.md)\n",
+                    nu, pp->nu_struct[a] + PFSPH_VISC_GAIN * nu, pp->nu_struct[a], PFSPH_VISC_GAIN);
             continue;
         }
         /* the hot liquid's own viscosity (docs/viscosity.md) */
@@ -463,20 +443,22 @@ static void thermo_report(const pfsph_scene *s, FILE *out)
         }
         const double nu0 = pp->nu_floor[a] / PFSPH_VISC_FLOOR;
         const double reach = pfsph_pairwise_visc_eff(s->dim, pp->theta, PFSPH_VISC_FLOOR) * nu0;
+        const int corrected = pp->visc_correct && pfsph_pairwise_visc_corrects(s->dim, pp->theta);
         fprintf(out, "      viscosity %.4g m^2/s set, expected %.4g (Morris viscosity %.4g applied%s)\n", nu,
                 pp->nu_struct[a], num,
-                pp->visc_correct  ? ""
+                corrected                                                            ? ""
+                    : s->dim == 2 && pfsph_pairwise_visc_corrects(s->dim, pp->theta) ? "; viscosity_correction is off"
                     : s->dim == 2 ? ", as set: at this temperature the 2D liquid is Newtonian"
                                   : "; viscosity_correction is off");
         /* 2D applies the viscosity as set: the liquid's own excess is what it adds (docs/viscosity.md) */
-        if (s->dim == 2 && pp->nu_struct[a] > 1.15 * nu)
+        if (s->dim == 2 && !corrected && pp->nu_struct[a] > 1.15 * nu)
             fprintf(out,
                     "      warning: %s's viscosity %.4g m^2/s is below what the hot 2D liquid reaches with it "
                     "(its own excess is ~%.3g m^2/s at this spacing, tension and temperature): it will flow "
                     "as ~%.3g. A smaller viscosity is not reached at this spacing; how the excess scales "
                     "with spacing and temperature in 2D is not measured (docs/viscosity.md)\n",
                     s->phases[a].name, nu, pp->nu_struct[a] - nu, pp->nu_struct[a]);
-        if (pp->visc_correct && nu < 0.99 * reach)
+        if (corrected && nu < 0.99 * reach)
             fprintf(out,
                     "      warning: %s's viscosity %.4g m^2/s is below the least the hot liquid reaches with "
                     "the least Morris friction that holds its temperature (~%.3g m^2/s at this spacing, "

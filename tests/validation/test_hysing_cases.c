@@ -29,11 +29,14 @@
  * the colour field (the resting bubble reads 0.994 +- 0.001, the grid contour's roughness).
  *
  * Checks (why these bounds): case 1, the issue's done-when targets are peak rise velocity within
- * 10 % and centroid within 5 % of Hysing's with default settings. Before issue 31's viscosity
- * change the default liquid is 2.4-3.7x too viscous (docs/thermostat.md), so this test asserts
- * what the default can be held to now and prints the targets' verdict: case 1 peak velocity
- * within 25 % and y(3) within 10 % (measured on main, 2026-12-05: see docs/validation.md), the
- * bubble deforms (circularity below 0.98, 15 sd of the resting noise). Case 2 (density ratio
+ * 10 % and centroid within 5 % of Hysing's with default settings. Since the 2D viscosity
+ * correction is on by default (2026-12-06; docs/validation.md, "Hysing case 1: what holds the
+ * bubble back") case 1 reads -10.0 % / -2.7 % (PCISPH, this test) and -6.5 / -10.7 / -3.3 % on
+ * the peak, -2.1 / -2.9 / -1.4 % on y(3) for three DFSPH seeds: y(3) is held to the issue's
+ * 5 %; the peak, a 0.2 s mean of 208 gas particles' thermal velocities whose seed-to-seed sd is
+ * about 3.7 points, to 15 % (the target plus 1.4 sd), and the verdict on 10 % is printed; the
+ * bubble deforms as Hysing's does (circularity below 0.95; measured 0.906-0.918, Hysing 0.901;
+ * the default before read 0.97-0.98). Case 2 (density ratio
  * 1000) misses the benchmark (docs/validation.md: the gas disperses into a ragged cap and stalls
  * after 2 s), so its checks only say that the case runs and the bubble rises: no gas particle
  * lost, the rise y(3) - 0.5 at least half of Hysing's, and the bubble deforms (circularity
@@ -41,7 +44,9 @@
  * Writes validation/hysing_case{1,2}.csv (t, yc, vy, circularity) in the working directory for
  * tools/validation_plots.py. Under AddressSanitizer it skips (tu_release_only).
  * Study knobs: PF_N (particles per diameter, 16), PF_CASES ("1,2"), PF_PW (pairwise text),
- * PF_SOLVER (both cases' solver text), PF_T (end, 3 s), PF_SWG (factor on the water-gas tension, 1), PF_SEED (the scene's seed). */
+ * PF_SOLVER (both cases' solver text), PF_T (end, 3 s), PF_SWG (factor on the water-gas tension, 1), PF_SEED (the scene's seed),
+ * PF_NUW / PF_NUG (water's / gas's viscosity), PF_G (gravity, 0.98), PF_YB (the bubble's centre
+ * height, 0.5), PF_LAP (the static bubble's Laplace jump, lap_study: with PF_G=0 PF_YB=1). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -56,14 +61,14 @@
 enum { WATER = 0, GAS = 1, NMAX = 128, SMOOTH = 5 };
 
 static const char *SCENE =
-    "{\"dimension\": 2, \"particle_radius\": %.10g, \"gravity\": [0, -0.98],"
+    "{\"dimension\": 2, \"particle_radius\": %.10g, \"gravity\": [0, %g],"
     " \"domain\": {\"min\": [%.10g, %.10g], \"max\": [%.10g, %.10g]},"
     " \"solver\": {\"type\": \"%s\"}, %s \"time\": {\"end\": 3, \"fps\": 20},"
-    " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": 0.01},"
+    " \"phases\": [{\"name\": \"water\", \"rest_density\": 1000, \"viscosity\": %g},"
     "   {\"name\": \"gas\", \"kind\": \"gas\", \"rest_density\": %g, \"viscosity\": %g},"
     "   {\"name\": \"wall\", \"kind\": \"solid\"}],"
     " \"fluid\": [{\"shape\": \"box\", \"min\": [0, 0], \"max\": [1, 2], \"phase\": \"water\"},"
-    "   {\"shape\": \"sphere\", \"center\": [0.5, 0.5], \"radius\": 0.25, \"phase\": \"gas\"}],"
+    "   {\"shape\": \"sphere\", \"center\": [0.5, %g], \"radius\": 0.25, \"phase\": \"gas\"}],"
     " \"solids\": [{\"shape\": \"box\", \"min\": [%.10g, %.10g], \"max\": [%.10g, 0], \"layers\": 3},"
     "   {\"shape\": \"box\", \"min\": [%.10g, 2], \"max\": [%.10g, %.10g], \"layers\": 3},"
     "   {\"shape\": \"box\", \"min\": [%.10g, 0], \"max\": [0, 2], \"layers\": 3, \"slip\": \"free-slip\"},"
@@ -89,15 +94,57 @@ typedef struct series {
     unsigned long long steps;
 } series;
 
+/* Study (PF_LAP, with PF_G=0 PF_YB=1): the static bubble's Laplace jump, the mechanical pressure
+ * of the gas within R/2 of its centroid less that of the water between R + 3 d and R + 5 d,
+ * every step from 0.5 s to PF_T, against sigma / R_e (2D). */
+static void lap_study(pfsph_sim *sim, const pfsph_ctx *c, double sigma)
+{
+    pfsph_error err = {0};
+    const double tend = tu_env_num("PF_T", 3), d = c->spacing;
+    double sg = 0, sw = 0, sgg = 0;
+    long ns = 0;
+    pfsph_real *mp = NULL;
+    while (pfsph_sim_time(sim) < tend - 1e-9) {
+        assert_int_equal(pfsph_sim_step(sim, tend, &err), PFSPH_OK);
+        if (pfsph_sim_time(sim) < 0.5) continue;
+        const pfsph_particles *f = c->fluid;
+        mp = realloc(mp, f->n * sizeof *mp);
+        assert_int_equal(pfsph_sim_mechanical_pressure(sim, mp), PFSPH_OK);
+        pfm_bubble b;
+        pfm_bubble_measure(c, GAS, &b);
+        const double Re = sqrt(b.ngas * d * d / 3.14159265358979);
+        double pg = 0, pw = 0;
+        int ng = 0, nw = 0;
+        for (size_t i = 0; i < f->n; i++) {
+            const double rr = hypot(f->x[i] - b.cx, f->y[i] - b.cy);
+            if (f->phase[i] == GAS && rr < 0.5 * Re) pg += mp[i], ng++;
+            if (f->phase[i] == WATER && rr > Re + 3 * d && rr < Re + 5 * d) pw += mp[i], nw++;
+        }
+        if (!ng || !nw) continue;
+        sg += pg / ng;
+        sw += pw / nw;
+        sgg += (pg / ng - pw / nw) * (pg / ng - pw / nw);
+        ns++;
+        if (ns % 200 == 0)
+            printf("lap t=%.2f: p_gas %.2f p_water %.2f jump %.2f Pa (sigma/R_e %.2f), circ %.4f\n",
+                   pfsph_sim_time(sim), sg / ns, sw / ns, (sg - sw) / ns, sigma / Re, b.circ);
+    }
+    const double m = (sg - sw) / ns, sd = sqrt(fmax(0, sgg / ns - m * m));
+    printf("lap summary: %ld samples, jump %.2f Pa (sample sd %.1f), gas %.2f, water %.2f\n", ns, m, sd, sg / ns,
+           sw / ns);
+    free(mp);
+}
+
 static void run_case(int cs, int n, series *r)
 {
     const hysing_ref *h = &REF[cs - 1];
     const double d = 0.5 / n, w = 3 * d;
     char json[8192], seed[64] = "";
     if (getenv("PF_SEED")) snprintf(seed, sizeof seed, "\"seed\": %d,", (int)tu_env_num("PF_SEED", 0));
-    snprintf(json, sizeof json, SCENE, 0.5 * d, -w - d, -w - d, 1 + w + d, 2 + w + d,
-             tu_env("PF_SOLVER", cs == 1 ? "pcisph" : "wcsph\", \"pressure_scale\": \"common"), seed, h->rho_g, h->nu_g,
-             -w, -w, 1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma,
+    snprintf(json, sizeof json, SCENE, 0.5 * d, -tu_env_num("PF_G", 0.98), -w - d, -w - d, 1 + w + d, 2 + w + d,
+             tu_env("PF_SOLVER", cs == 1 ? "pcisph" : "wcsph\", \"pressure_scale\": \"common"), seed,
+             tu_env_num("PF_NUW", 0.01), h->rho_g, tu_env_num("PF_NUG", h->nu_g), tu_env_num("PF_YB", 0.5), -w, -w,
+             1 + w, -w, 1 + w, 2 + w, -w, 1 + w, tu_env("PF_PW", ""), h->sigma, 0.01 * h->sigma,
              h->sigma * tu_env_num("PF_SWG", 1));
     pfsph_sim *sim = tu_sim_from_json(json, "hysing case");
     pfsph_error err = {0};
@@ -112,6 +159,7 @@ static void run_case(int cs, int n, series *r)
     r->vy[0] = 0;
     r->circ[0] = s.circ;
     r->nk = (int)lround(tu_env_num("PF_T", 3) / 0.05); /* every 0.05 s to 3 s */
+    if (getenv("PF_LAP")) lap_study(sim, c, h->sigma * tu_env_num("PF_SWG", 1));
     for (int k = 1; k <= r->nk; k++) {
         rc = pfsph_sim_advance(sim, 0.05 * k, &err);
         if (rc) fprintf(stderr, "%s\n", err.msg);
@@ -192,9 +240,9 @@ static void test_hysing_cases(void **state)
         const series *s = &r[i];
         assert_false(s->lost);
         if (cs == 1) {
-            assert_true(fabs(s->vmax / h->vmax - 1) <= 0.25);
-            assert_true(fabs(s->yc[s->nk] / h->yc3 - 1) <= 0.10);
-            assert_true(s->cmin < 0.98);
+            assert_true(fabs(s->vmax / h->vmax - 1) <= 0.15);
+            assert_true(fabs(s->yc[s->nk] / h->yc3 - 1) <= 0.05);
+            assert_true(s->cmin < 0.95);
         } else {
             assert_true((s->yc[s->nk] - 0.5) / (h->yc3 - 0.5) >= 0.5);
             assert_true(s->cmin < 0.95);
