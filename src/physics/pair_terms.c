@@ -127,7 +127,7 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
 PFSPH__CLONES
 void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *restrict x,
                             const pfsph_real *restrict y, const pfsph_real *restrict z, const uint8_t *restrict phase,
-                            const pfsph_real *restrict nu_phase, pfsph_real xi, pfsph_real yi, pfsph_real zi, int n,
+                            const pfsph_real *restrict nu_row, pfsph_real xi, pfsph_real yi, pfsph_real zi, int n,
                             const uint32_t *restrict jj, const pfsph_real *restrict dw, pfsph_real *restrict dx,
                             pfsph_real *restrict dy, pfsph_real *restrict dz, pfsph_real *restrict sv)
 {
@@ -140,13 +140,13 @@ void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *
         dy[e] = ey;
         dz[e] = ez;
         r2[e] = ex * ex + ey * ey + ez * ez;
-        nuj[e] = nu_phase[phase[j]];
+        nuj[e] = nu_row[phase[j]];
     }
     const pfsph_real *restrict vx = in->vx, *restrict vy = in->vy, *restrict vz = in->vz, *restrict nd = in->nd;
-    const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, nui = in->nui, eps = in->eps;
+    const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, eps = in->eps;
     for (int e = 0; e < n; e++) {
         const uint32_t j = jj[e];
-        const pfsph_real nu = (pfsph_real)0.5 * (nui + nuj[e]);
+        const pfsph_real nu = nuj[e];
         const pfsph_real vdx = (vxi - vx[j]) * dx[e] + (vyi - vy[j]) * dy[e] + (vzi - vz[j]) * dz[e];
         sv[e] = nu / nd[j] * vdx / (r2[e] + eps) * dw[e];
     }

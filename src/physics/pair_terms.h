@@ -42,12 +42,13 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
                                 pfsph_real *restrict sv, pfsph_real *restrict sp);
 
 /* Per listed fluid neighbour jj[e], e < n <= PFSPH_LIST_TERMS_MAX, of particle i at (xi, yi, zi)
- * (the targets x, y, z, their phase and nu_phase[phase] their viscosity), with dw[e] its dW/r:
- * x_ij into dx, dy, dz and sv[e] the Morris factor of pfsph__terms_visc_pressure (in's vx, vy,
- * vz, nd, vxi, vyi, vzi, nui, eps; the same bits as viscosity.c visc_pair). */
+ * (the targets x, y, z, their phase, and nu_row[phase] the pair's viscosity with i's phase,
+ * pfsph__visc_pair_nu), with dw[e] its dW/r: x_ij into dx, dy, dz and sv[e] the Morris factor
+ * of pfsph__terms_visc_pressure (in's vx, vy, vz, nd, vxi, vyi, vzi, eps; the same bits as
+ * viscosity.c visc_pair). */
 void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *restrict x,
                             const pfsph_real *restrict y, const pfsph_real *restrict z, const uint8_t *restrict phase,
-                            const pfsph_real *restrict nu_phase, pfsph_real xi, pfsph_real yi, pfsph_real zi, int n,
+                            const pfsph_real *restrict nu_row, pfsph_real xi, pfsph_real yi, pfsph_real zi, int n,
                             const uint32_t *restrict jj, const pfsph_real *restrict dw, pfsph_real *restrict dx,
                             pfsph_real *restrict dy, pfsph_real *restrict dz, pfsph_real *restrict sv);
 

@@ -193,6 +193,10 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     const pfsph_hits_fn hits = pfsph_hits_select();
     const int phase1 = thermo && !nl ? fluid_one_phase(f) : -1, one_phase = phase1 >= 0;
     double amp = 0, ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    /* each phase pair's viscosity for the list walk's vector loop (pfsph__visc_pair_nu) */
+    pfsph_real nu_pair[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES];
+    for (int a = 0; a < ctx->nphases; a++)
+        for (int c = 0; c < ctx->nphases; c++) nu_pair[a][c] = pfsph__visc_pair_nu(ctx, a, c);
     uint64_t key = 0, wkey = 0;
     if (thermo) {
         amp = pfsph__thermo_amp(ctx);
@@ -230,7 +234,7 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 for (uint32_t e = nl->start[i], end = nl->start[i + 1]; e < end;) {
                     const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
                     const int m = (int)(e1 - e);
-                    pfsph__terms_visc_list(&in, f->x, f->y, f->z, f->phase, ctx->nu, xi, yi, zi, m, nl->idx + e,
+                    pfsph__terms_visc_list(&in, f->x, f->y, f->z, f->phase, nu_pair[pa], xi, yi, zi, m, nl->idx + e,
                                            nl->dw + e, H.dx, H.dy, H.dz, H.t1);
                     for (int q = 0; q < m; q++) {
                         acc.ax += H.t1[q] * H.dx[q];
