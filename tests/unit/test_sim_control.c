@@ -14,7 +14,9 @@
 static const double PI = 3.14159265358979323846;
 
 /* A small 2D drop resting on a plate: no gravity and no viscosity, so that a fluid particle's
- * non-pressure acceleration is its pair force alone. */
+ * non-pressure acceleration is its pair force alone (`viscosity_correction` off: the default
+ * correction would apply its floor, a Morris viscosity of 0.05 sqrt(sigma d / rho), whatever the
+ * scene sets; docs/viscosity.md). */
 static const char *SCENE =
     "{\"dimension\": 2, \"particle_radius\": 0.005, \"gravity\": [0, 0],"
     " \"domain\": {\"min\": [-0.1, -0.1], \"max\": [0.3, 0.3]},"
@@ -23,7 +25,7 @@ static const char *SCENE =
     "  {\"name\": \"plate\", \"kind\": \"solid\", \"rest_density\": 1000}],"
     " \"fluid\": [{\"shape\": \"box\", \"min\": [0.05, 0], \"max\": [0.15, 0.06], \"phase\": \"water\"}],"
     " \"solids\": [{\"shape\": \"box\", \"min\": [0, -0.03], \"max\": [0.2, 0], \"layers\": 3, \"phase\": \"plate\"}],"
-    " \"pairwise\": {\"k\": 1.7, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 2},"
+    " \"pairwise\": {\"k\": 1.7, \"viscosity_correction\": false, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 2},"
     "  {\"phases\": [\"water\", \"plate\"], \"contact_angle\": 60}]}}";
 
 static pfsph_sim *make(pfsph_scene *sc)
