@@ -25,7 +25,8 @@ static const char *SCENE =
     "  {\"name\": \"plate\", \"kind\": \"solid\", \"rest_density\": 1000}],"
     " \"fluid\": [{\"shape\": \"box\", \"min\": [0.05, 0], \"max\": [0.15, 0.06], \"phase\": \"water\"}],"
     " \"solids\": [{\"shape\": \"box\", \"min\": [0, -0.03], \"max\": [0.2, 0], \"layers\": 3, \"phase\": \"plate\"}],"
-    " \"pairwise\": {\"k\": 1.7, \"viscosity_correction\": false, \"coefficients\": [{\"phases\": [\"water\", \"water\"], \"sigma\": 2},"
+    " \"pairwise\": {\"k\": 1.7, \"viscosity_correction\": false, \"coefficients\": [{\"phases\": [\"water\", "
+    "\"water\"], \"sigma\": 2},"
     "  {\"phases\": [\"water\", \"plate\"], \"contact_angle\": 60}]}}";
 
 static pfsph_sim *make(pfsph_scene *sc)
