@@ -34,24 +34,6 @@ static void my_part(const pfsph_decomp *D, size_t *l0, uint64_t *g0, size_t *m)
     }
 }
 
-/* the first failure of any rank, its message on every rank; unlike agree() the run goes on
- * (a rejected checkpoint: the resume tries the previous one) */
-static int first_failure(pfsph_decomp *D, int rc, pfsph_error *err)
-{
-    int mine = rc ? D->rank : D->size, first;
-    MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, D->comm);
-    if (first == D->size) return PFSPH_OK;
-    struct {
-        int rc;
-        pfsph_error e;
-    } m;
-    memset(&m, 0, sizeof m);
-    if (D->rank == first) m.rc = rc, m.e = *err;
-    MPI_Bcast(&m, sizeof m, MPI_BYTE, first, D->comm);
-    *err = m.e;
-    return m.rc;
-}
-
 /* a string from the root to every rank (malloc'ed on the others) */
 static char *share_str(pfsph_decomp *D, const char *s)
 {
@@ -169,10 +151,10 @@ int pfsph_decomp_save(pfsph_decomp *D, const char *path, int frame, int durable,
                         tmp, D->rank, host, strerror(errno));
     }
     MPI_File fh = MPI_FILE_NULL;
-    if (!(rc = first_failure(D, rc, err)) &&
+    if (!(rc = pfsph_decomp_first_failure(D, rc, err)) &&
         MPI_File_open(D->comm, tmp, MPI_MODE_WRONLY, MPI_INFO_NULL, &fh) != MPI_SUCCESS)
         rc = pfsph_fail(err, PFSPH_EIO, "%s: MPI_File_open failed on rank %d", tmp, D->rank);
-    if ((rc = first_failure(D, rc, err))) {
+    if ((rc = pfsph_decomp_first_failure(D, rc, err))) {
         if (fh != MPI_FILE_NULL) MPI_File_close(&fh);
         if (D->rank == 0 && *tmp) unlink(tmp);
         free(dest);
@@ -226,7 +208,7 @@ int pfsph_decomp_save(pfsph_decomp *D, const char *path, int frame, int durable,
     if (MPI_File_close(&fh) != MPI_SUCCESS) bad = 1;
     if (!rc && (e || bad))
         rc = pfsph_fail(err, PFSPH_EIO, "%s: write failed on rank %d: %s", dest, D->rank, strerror(e ? e : EIO));
-    rc = first_failure(D, rc, err);
+    rc = pfsph_decomp_first_failure(D, rc, err);
     if (D->rank == 0 && !rc) { /* into place, as the serial writer does */
         if (durable) rc = pfsph__rename_durable(tmp, dest, err);
         else if (rename(tmp, dest) != 0)
@@ -298,7 +280,7 @@ int pfsph_decomp_load(pfsph_decomp *D, const char *path, long expect_frame, stru
                         "must be on a filesystem all ranks share)",
                         name, D->rank);
     else MPI_File_get_size(fh, &fsize);
-    if ((rc = first_failure(D, rc, err))) {
+    if ((rc = pfsph_decomp_first_failure(D, rc, err))) {
         if (fh != MPI_FILE_NULL) MPI_File_close(&fh);
         free(name);
         return rc;
@@ -328,7 +310,7 @@ int pfsph_decomp_load(pfsph_decomp *D, const char *path, long expect_frame, stru
         }
     }
     MPI_Bcast(hd, 3, MPI_UINT64_T, 0, D->comm);
-    if ((rc = first_failure(D, rc, err))) {
+    if ((rc = pfsph_decomp_first_failure(D, rc, err))) {
         MPI_File_close(&fh);
         free(buf);
         free(name);
@@ -356,7 +338,7 @@ int pfsph_decomp_load(pfsph_decomp *D, const char *path, long expect_frame, stru
     else rc = pfsph__checkpoint_check_set(&part, (size_t)a, name, "fluid", err);
     if (D->rank == 0 && !(all = malloc((size_t)D->size * sizeof *all))) MPI_Abort(D->comm, 1);
     MPI_Gather(&mine, sizeof mine, MPI_BYTE, all, sizeof mine, MPI_BYTE, 0, D->comm);
-    if (!(rc = first_failure(D, rc, err)) && D->rank == 0) {
+    if (!(rc = pfsph_decomp_first_failure(D, rc, err)) && D->rank == 0) {
         /* the tail, after the header and the head; the CRC over the head, the parts, the tail */
         const size_t tl = (size_t)(flen - (uint64_t)off);
         unsigned char *q = realloc(buf, PFSPH__CKPT_HEADER + h + tl);
@@ -375,7 +357,7 @@ int pfsph_decomp_load(pfsph_decomp *D, const char *path, long expect_frame, stru
     free(all);
     free(buf);
     MPI_File_close(&fh);
-    if (!(rc = first_failure(D, rc, err))) {
+    if (!(rc = pfsph_decomp_first_failure(D, rc, err))) {
         /* the root restored its range and the rest: the others their ranges, with its clock */
         pfsph_sim_state st;
         pfsph_sim_get_state(sim, &st);
@@ -383,7 +365,7 @@ int pfsph_decomp_load(pfsph_decomp *D, const char *path, long expect_frame, stru
         pfsph_particles none;
         memset(&none, 0, sizeof none);
         if (D->rank) rc = pfsph_sim_restore(sim, &st, &part, sim->st.df ? &none : NULL, 0, 0, err);
-        rc = first_failure(D, rc, err);
+        rc = pfsph_decomp_first_failure(D, rc, err);
     }
     if (!rc) { /* the next exchange sends each particle to its owners and shares the root's state */
         D->root_all = 0;

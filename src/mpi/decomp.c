@@ -617,9 +617,8 @@ static const pfsph_stage_ops stage_stats = {.name = "mpi_stats",
 
 /* ---- the hooks the simulation calls ---- */
 
-static int agree(pfsph_dist *d, int rc, pfsph_error *err)
+int pfsph_decomp_first_failure(pfsph_decomp *D, int rc, pfsph_error *err)
 {
-    pfsph_decomp *D = (pfsph_decomp *)d;
     int mine = rc ? D->rank : D->size, first;
     MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, D->comm);
     if (first == D->size) return PFSPH_OK;
@@ -634,8 +633,15 @@ static int agree(pfsph_dist *d, int rc, pfsph_error *err)
     }
     MPI_Bcast(&m, sizeof m, MPI_BYTE, first, D->comm);
     if (err) *err = m.e;
-    D->failed = 1;
     return m.rc;
+}
+
+static int agree(pfsph_dist *d, int rc, pfsph_error *err)
+{
+    pfsph_decomp *D = (pfsph_decomp *)d;
+    rc = pfsph_decomp_first_failure(D, rc, err);
+    if (rc) D->failed = 1; /* the run ends: the other ranks leave their command loop */
+    return rc;
 }
 
 static void step_begin(pfsph_dist *d, double t_limit)

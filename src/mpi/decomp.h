@@ -103,6 +103,9 @@ void pfsph_decomp_ckpt_hooks(pfsph_decomp *D);
 int pfsph_decomp_save(pfsph_decomp *D, const char *path, int frame, int durable, size_t *bytes, pfsph_error *err);
 int pfsph_decomp_load(pfsph_decomp *D, const char *path, long expect_frame, struct pfsph_checkpoint_info *info,
                       pfsph_error *err);
+/* The lowest failing rank's status and message (err may be NULL) on every rank, PFSPH_OK when
+ * none failed; unlike the agree hook it does not end the run (a rejected checkpoint is retried). */
+int pfsph_decomp_first_failure(pfsph_decomp *D, int rc, pfsph_error *err);
 /* Broadcast a command from the root. */
 void pfsph_decomp_cmd(pfsph_decomp *D, pfsph_mpi_cmd *c);
 
