@@ -133,6 +133,11 @@ def spheric2(data, out):
         v = np.array([float(r[p]) / 1000 for r in s])
         ax.plot(t, v, "-", lw=0.6, color="0.65", label="pfsph, d = 0.04 m, every 0.01 s")
         ax.plot(t[2:-2], np.convolve(v, np.ones(5) / 5, mode="same")[2:-2], "-", label="pfsph, 0.05 s running mean")
+        lcol = "L" + p[1:]
+        if lcol in s[0]:  # the first layer's own pressure, the reading before the force sensor
+            vl = np.array([float(r[lcol]) / 1000 for r in s])
+            ax.plot(t[2:-2], np.convolve(vl, np.ones(5) / 5, mode="same")[2:-2], "--", lw=0.8,
+                    label="first layer's pressure (0.05 s mean)")
         ax.plot(exp[:, 0], exp[:, col] / 1000, "ko", mfc="none", label="experiment (MARIN), ~50 ms means")
         if p == "P1":
             ax.plot([0.415], [11.24], "k^", label="experiment's peak, 11.2 kPa at 0.415 s")
