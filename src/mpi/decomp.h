@@ -66,7 +66,9 @@ struct pfsph_decomp {
     char *sbuf, *rbuf;
     size_t scap, rcap;
     /* figures for summary.json */
-    uint64_t cuts_checked; /* PFSPH_MPI_CHECK_CUT */
+    uint64_t cuts_checked;      /* PFSPH_MPI_CHECK_CUT */
+    uint64_t frames_collective; /* frame times whose fluid frames every rank wrote its slice of */
+    uint64_t gathers;           /* gathers of the whole fluid to the root (frames, root checkpoints) */
     /* the static walls this rank keeps: cells [wlo[q], whi[q]) for rank q (the root: all) */
     int trim_walls;
     size_t wall_slack; /* percent of the need added each side when a window moves */

@@ -9,10 +9,38 @@
 
 #include "mpi/decomp.h"
 #include "mpi/wire.h"
+#include "pfsph/thermostat.h"
 #include "sim_internal.h"
 
 static void frame_figures(pfsph_decomp *D);
 static void diffuse_to_root(pfsph_decomp *D);
+
+/* With the thermostat: stats.csv's kinetic temperature, pfsph_thermostat_measure's bits. Its two
+ * sums are sequential (each particle added to the running sum in the serial order), so no
+ * reduction tree gives them: each rank continues the running sums of the ranks before it over
+ * its own particles (a slice of the serial order) and passes them on, the last rank's the
+ * serial sums. The path is as long as the serial loop (two passes over the fluid, which the
+ * root alone made after a gather) plus 2 (N - 1) messages of 32 and 8 bytes. */
+static void frame_kT(pfsph_decomp *D)
+{
+    pfsph_ctx *c = &D->sim->ctx;
+    if (!(pfsph_thermostat_kT(c) > 0)) return;
+    const pfsph_particles *f = c->fluid;
+    const size_t lo = D->d.own_lo, hi = D->d.own_hi, n = D->d.nglobal;
+    const int r = D->rank, last = D->size - 1;
+    double acc[4] = {0, 0, 0, 0}, e = 0;
+    if (r > 0) MPI_Recv(acc, 4, MPI_DOUBLE, r - 1, 33, D->comm, MPI_STATUS_IGNORE);
+    pfsph__thermostat_moments(f, c->mass, lo, hi, acc);
+    if (r < last) MPI_Send(acc, 4, MPI_DOUBLE, r + 1, 33, D->comm);
+    MPI_Bcast(acc, 4, MPI_DOUBLE, last, D->comm);
+    const double vc[3] = {acc[1] / acc[0], acc[2] / acc[0], acc[3] / acc[0]};
+    if (r > 0) MPI_Recv(&e, 1, MPI_DOUBLE, r - 1, 34, D->comm, MPI_STATUS_IGNORE);
+    e = pfsph__thermostat_spread(f, c->mass, c->dim, lo, hi, vc, e);
+    if (r < last) MPI_Send(&e, 1, MPI_DOUBLE, r + 1, 34, D->comm);
+    else if (r) MPI_Send(&e, 1, MPI_DOUBLE, 0, 35, D->comm);
+    if (r == 0 && last) MPI_Recv(&e, 1, MPI_DOUBLE, last, 35, D->comm, MPI_STATUS_IGNORE);
+    D->d.kT_frame = n < 2 ? 0 : e / ((double)c->dim * (double)(n - 1));
+}
 
 int pfsph_decomp_frame(pfsph_decomp *D, pfsph_error *err)
 {
@@ -20,6 +48,7 @@ int pfsph_decomp_frame(pfsph_decomp *D, pfsph_error *err)
     if (!pfsph_mpi_frames_collective(D)) return pfsph_decomp_gather(D, err);
     frame_figures(D);
     diffuse_to_root(D);
+    frame_kT(D);
     D->framed = 1;
     return PFSPH_OK;
 }
@@ -78,6 +107,7 @@ int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err)
 {
     if (D->root_all || D->gathered) return PFSPH_OK;
     if (!D->framed) frame_figures(D); /* after a collective frame: sent with it */
+    D->gathers++;
     pfsph_sim *sim = D->sim;
     pfsph_ctx *c = &sim->ctx;
     pfsph_particles *f = c->fluid;
