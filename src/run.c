@@ -310,7 +310,10 @@ static void csv_row(FILE *f, int frame, const pfsph_sim *sim)
         fprintf(f, ",%zu,%zu,%zu", cnt[0], cnt[1], cnt[2]);
     }
     if (pfsph_thermostat_kT(c) > 0) /* kinetic temperature of the fluid and the one set */
-        fprintf(f, ",%.6g,%.6g", pfsph_thermostat_measure(c->fluid, c->mass, c->dim), pfsph_thermostat_kT(c));
+        fprintf(f, ",%.6g,%.6g",
+                c->dist && !c->dist->fluid_whole ? c->dist->kT_frame
+                                                 : pfsph_thermostat_measure(c->fluid, c->mass, c->dim),
+                pfsph_thermostat_kT(c));
     fputc('\n', f);
     fflush(f);
 }

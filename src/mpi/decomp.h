@@ -1,5 +1,5 @@
 /* The domain decomposition over MPI ranks (docs/cluster.md): the process's pfsph_dist, the
- * stages it inserts into the step, the halo refresh, the serial-order sum and the frame gather.
+ * stages it inserts into the step, the halo refresh, the serial-order sum; the frame gather in gather.c.
  * Program code: compiled only with -DPFSPH_MPI=ON, never part of the library. */
 #ifndef PFSPH_MPI_DECOMP_H
 #define PFSPH_MPI_DECOMP_H
@@ -66,7 +66,9 @@ struct pfsph_decomp {
     char *sbuf, *rbuf;
     size_t scap, rcap;
     /* figures for summary.json */
-    uint64_t cuts_checked; /* PFSPH_MPI_CHECK_CUT */
+    uint64_t cuts_checked;      /* PFSPH_MPI_CHECK_CUT */
+    uint64_t frames_collective; /* frame times whose fluid frames every rank wrote its slice of */
+    uint64_t gathers;           /* gathers of the whole fluid to the root (frames, root checkpoints) */
     /* the static walls this rank keeps: cells [wlo[q], whi[q]) for rank q (the root: all) */
     int trim_walls;
     size_t wall_slack; /* percent of the need added each side when a window moves */
@@ -85,7 +87,7 @@ struct pfsph_decomp {
 
 /* The decomposition of the world communicator (not yet attached to a simulation). */
 int pfsph_decomp_init(pfsph_decomp *D, MPI_Comm comm);
-/* The frame gather: every rank's owned particles to the root, in the serial order. */
+/* The frame gather (src/mpi/gather.c): every rank's owned particles to the root, in the serial order. */
 int pfsph_decomp_gather(pfsph_decomp *D, pfsph_error *err);
 /* A frame time on every rank: the gather, or only the figures and the diffuse set where the
  * scene's fluid frames are written collectively (pfsph_mpi_frames_collective). */

@@ -14,7 +14,6 @@
 #include "io/frame_layout.h"
 #include "io/io_internal.h"
 #include "mpi/decomp.h"
-#include "pfsph/thermostat.h"
 #include "sim_internal.h"
 
 /* particles per collective write (a buffer of at most 16384 x 96 bytes on each rank) */
@@ -26,9 +25,11 @@ int pfsph_mpi_frames_collective(const pfsph_decomp *D)
     const pfsph_scene *s = &sim->scene;
     const char *g = getenv("PFSPH_MPI_GATHER_FRAMES"); /* the gather, as before (comparisons) */
     if (g && atoi(g) > 0) return 0;
-    /* what the frame needs of the whole fluid on the root: the mechanical pressure's walk (pair
-     * forces), the kinetic temperature (stats.csv with the thermostat), the surface meshes */
-    return !sim->st.pw && !(pfsph_thermostat_kT(&sim->ctx) > 0) && !s->output.surface.on;
+    /* what the frame needs of the whole fluid on the root: the surface meshes (the mesher's
+     * field reads every particle near a surface point; docs/cluster.md). The mechanical pressure
+     * (pair forces) is computed by every rank on its slice, the kinetic temperature (stats.csv
+     * with the thermostat) from its sums passed on rank to rank (src/mpi/gather.c). */
+    return !s->output.surface.on;
 }
 
 /* The particles each rank owns: [gofs[q], gofs[q + 1]), the last rank also the emitters' new
@@ -41,10 +42,9 @@ static uint64_t owned_count(const pfsph_decomp *D, int q)
 
 /* One file: the root writes the literals, every rank its slice of each region, in rounds of
  * collective writes (the same number on every rank: the largest slice's). */
-static int write_one(pfsph_decomp *D, const char *path, long pid, const pfsph__frame_layout *L, const uint8_t *layer,
-                     pfsph_error *err)
+static int write_one(pfsph_decomp *D, const char *path, long pid, const pfsph__frame_layout *L,
+                     const pfsph_particles *f, const uint8_t *layer, pfsph_error *err)
 {
-    const pfsph_particles *f = D->sim->ctx.fluid;
     char tmp[PFSPH_PATH_LEN + 96];
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, pid);
     char msg[MPI_MAX_ERROR_STRING] = "";
@@ -117,9 +117,9 @@ static int write_one(pfsph_decomp *D, const char *path, long pid, const pfsph__f
 
 /* output.pieces: every rank writes its own particles as one VTP piece ("fluid_NNNNN_QQQQ.vtp",
  * Q its rank), then the root the .pvtp that names them, once every piece is in place. */
-static int write_pieces(pfsph_decomp *D, const char *dir, int frame, const pfsph_io_opts *o, pfsph_error *err)
+static int write_pieces(pfsph_decomp *D, const char *dir, int frame, const pfsph_particles *f, const pfsph_io_opts *o,
+                        pfsph_error *err)
 {
-    const pfsph_particles *f = D->sim->ctx.fluid;
     const size_t lo = D->d.own_lo, n = (size_t)owned_count(D, D->rank);
     pfsph_particles v = *f; /* a view of the owned slice */
     for (int k = 0; k < PFSPH_NFIELDS; k++) v.f[k] = f->f[k] + lo;
@@ -127,6 +127,7 @@ static int write_pieces(pfsph_decomp *D, const char *dir, int frame, const pfsph
     v.wall = f->wall + lo;
     v.bubble = f->bubble + lo;
     v.id = f->id + lo;
+    if (o->aux_name) v.aux = f->aux + lo;
     v.n = n;
     pfsph_io_opts po = *o;
     if (o->surface_layer) po.surface_layer = o->surface_layer + lo;
@@ -149,12 +150,18 @@ static int write_frames(pfsph_decomp *D, const char *dir, int frame, double time
     /* the integrator moved the owned particles only: the surface layers' walks read the halo */
     pfsph_real *const pos[3] = {f->x, f->y, f->z};
     D->d.halo(&D->d, pos, 3);
+    D->frames_collective++;
     int rc = pfsph_sim_output(sim, err); /* the surface layers: src/core/surface_detect.c refreshes its halo */
     if ((rc = D->d.agree(&D->d, rc, err))) return rc;
+    /* with pair forces the mechanical pressure as the extra field, as the serial frame has it
+     * (src/run_frame.c); each rank computed it for its own particles */
+    const pfsph_real *mech = pfsph_sim_output_mechanical_pressure(sim);
+    pfsph_particles fl = *f;
+    if (mech) fl.aux = (pfsph_real *)mech; /* read only: the writers read aux as the extra field */
     pfsph_io_opts o = {.dim = s->dim,
                        .write_id = (s->output.fields & PFSPH_OUT_ID) != 0,
                        .write_speed = (s->output.fields & PFSPH_OUT_SPEED) != 0,
-                       .aux_name = NULL,
+                       .aux_name = mech ? "mechanical_pressure" : NULL,
                        .time = time,
                        .surface_layer = pfsph_sim_output_surface_layer(sim),
                        .write_film = s->film.nbubbles > 0,
@@ -163,14 +170,14 @@ static int write_frames(pfsph_decomp *D, const char *dir, int frame, double time
     for (int fmt = 0; fmt < 2 && !rc; fmt++) { /* the serial writer's order: VTP, then PLY */
         if (!(fmt ? s->output.ply : s->output.vtp)) continue;
         if (!fmt && s->output.pieces) {
-            rc = write_pieces(D, dir, frame, &o, err);
+            rc = write_pieces(D, dir, frame, &fl, &o, err);
             continue;
         }
         snprintf(path, sizeof path, "%s/frames/fluid_%05d.%s", dir, frame, fmt ? "ply" : "vtp");
         pfsph__frame_layout L;
         int lr = fmt ? pfsph__ply_layout(&L, D->d.nglobal, &o) : pfsph__vtp_layout(&L, D->d.nglobal, &o);
         if (lr) MPI_Abort(D->comm, 1); /* a few KiB of header: the others wait in the write */
-        rc = write_one(D, path, pid, &L, o.surface_layer, err);
+        rc = write_one(D, path, pid, &L, &fl, o.surface_layer, err);
         pfsph__frame_layout_free(&L);
     }
     return rc;

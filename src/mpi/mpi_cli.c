@@ -70,6 +70,9 @@ static void report(pfsph_dist *d, void *json)
               "and read by every rank (MPI-IO)"
             : "frames gathered to rank 0 rank by rank through a bounded buffer, written by it; "
               "checkpoints written and read by every rank (MPI-IO)");
+    /* what happened: frame times written collectively, gathers of the whole fluid to rank 0 */
+    cJSON_AddNumberToObject(m, "frames_written_collectively", (double)D->frames_collective);
+    cJSON_AddNumberToObject(m, "fluid_gathers", (double)D->gathers);
     cJSON *cut = cJSON_AddObjectToObject(m, "cut"); /* src/mpi/cut.c: the histogram of occupied cells */
     if (cut) {
         cJSON_AddNumberToObject(cut, "coarse_buckets", (double)D->C.buckets);

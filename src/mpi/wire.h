@@ -12,6 +12,9 @@
  * wall, bubble. A homogeneous cluster is assumed (the same byte order and pfsph_real). */
 #define REC (((PFSPH_NFIELDS + 1) * sizeof(pfsph_real) + 7 + 7) & ~(size_t)7)
 
+/* particles per message of the start's scatter and the frame gather (their buffers: 3 MB) */
+#define GATHER_RUN ((size_t)65536)
+
 static inline int grow(char **buf, size_t *cap, size_t n)
 {
     if (n <= *cap) return PFSPH_OK;

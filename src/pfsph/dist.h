@@ -51,6 +51,9 @@ struct pfsph_dist {
     /* the root holds every fluid particle (the start, a resume, after a gather): the serial code
      * applies; else each rank holds its slice and the fluid frames are written collectively */
     int fluid_whole;
+    /* with the thermostat, while the root holds its slice only (!fluid_whole): the fluid's kinetic
+     * temperature at the last frame (pfsph_thermostat_measure's bits), computed by every rank */
+    double kT_frame;
     /* the root only (src/run.c): the fluid frames of `frame` into dir, every rank its slice */
     int (*write_fluid)(pfsph_dist *d, const char *dir, int frame, double time, pfsph_error *err);
     /* the root only: gather the whole fluid now (a checkpoint after a collective frame) */

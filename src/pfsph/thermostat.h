@@ -105,5 +105,10 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3]);
 
 /* Kinetic temperature of the fluid: sum m_i |v_i - v_cm|^2 / (dim (N - 1)) [J]; 0 if N < 2. */
 double pfsph_thermostat_measure(const pfsph_particles *f, const pfsph_real *mass, int dim);
+/* Its two sequential sums over [lo, hi), continuing those of the particles before lo: acc =
+ * {sum m, sum m vx, sum m vy, sum m vz}, then e += sum m |v - vc|^2 (returned); vc = P / M. */
+void pfsph__thermostat_moments(const pfsph_particles *f, const pfsph_real *mass, size_t lo, size_t hi, double acc[4]);
+double pfsph__thermostat_spread(const pfsph_particles *f, const pfsph_real *mass, int dim, size_t lo, size_t hi,
+                                const double vc[3], double e);
 
 #endif

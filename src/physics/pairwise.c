@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/dist.h"
 #include "core/hits.h"
 #include "core/nlist.h"
 #include "pfsph/eigen.h"
@@ -501,21 +502,20 @@ void pfsph_pairwise_diagnose(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *v
     pfsph_pairwise_diagnose_tensor(pw, ctx, vir, T, NULL);
 }
 
-void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T, double *W)
+/* pfsph_pairwise_diagnose_tensor for the particles [lo, hi) */
+static void diagnose_range(const pfsph_ctx *ctx, size_t lo, size_t hi, double *vir, double *T, double *W)
 {
-    (void)pw;
     pw_job J;
     /* called between steps too, on positions moved since the sort: the whole reach */
     job_init(&J, ctx, false);
     if (!ctx->pairwise->enabled)
         for (int a = 0; a < PFSPH_MAX_PHASES; a++)
             for (int b = 0; b < PFSPH_MAX_PHASES; b++) J.coef[a][b] = 0;
-    const size_t n = ctx->fluid->n;
 #pragma omp parallel
     {
         pw_scratch Ws;
 #pragma omp for schedule(dynamic, 256)
-        for (size_t i = 0; i < n; i++) {
+        for (size_t i = lo; i < hi; i++) {
             double acc[3], v = 0;
             particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws, NULL, NULL, NULL);
             if (vir) vir[i] = v;
@@ -523,18 +523,27 @@ void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, do
     }
 }
 
+void pfsph_pairwise_diagnose_tensor(pfsph_pairwise *pw, const pfsph_ctx *ctx, double *vir, double *T, double *W)
+{
+    (void)pw;
+    diagnose_range(ctx, 0, ctx->fluid->n, vir, T, W);
+}
+
 void pfsph_pairwise_mechanical_pressure(pfsph_pairwise *pw, const pfsph_ctx *ctx, const pfsph_real *p, double *vir,
                                         pfsph_real *out)
 {
     const pfsph_particles *f = ctx->fluid;
     if (!p) p = f->p;
-    const size_t n = f->n;
+    (void)pw;
+    /* a distributed run: the owned particles (out and vir hold nothing for the halo) */
+    size_t lo, hi;
+    pfsph__owned(ctx, &lo, &hi);
     const int dim = ctx->dim;
-    pfsph_pairwise_diagnose(pw, ctx, vir, NULL);
+    diagnose_range(ctx, lo, hi, vir, NULL, NULL);
     const pfsph_kernel *k = &ctx->kern;
     const pfsph_real h2 = k->h * k->h;
 #pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = lo; i < hi; i++) {
         /* peculiar velocity against the kernel-weighted mean of the neighbours (self excluded);
          * for uncorrelated thermal velocities E|u|^2 = <v'^2> (1 + sum w^2 / (sum w)^2) */
         double sw = 0, sw2 = 0, m[3] = {0, 0, 0}, pv = 0;
@@ -697,6 +706,15 @@ int pfsph__mechanical_pressure(const pfsph_step *st, pfsph_real *out)
     const pfsph_real *p = st->solver->wall_pressure && c->fluid->n
         ? st->solver->wall_pressure(st->solver_state, c, st->solver_scratch)
         : NULL;
+    /* a distributed run whose ranks each compute their slice: the step integrated the owned
+     * particles only, and the walks read the neighbours' velocities, number densities, pressures
+     * and film fractions: the halo copies get the owners' values, the serial ones (the positions
+     * were refreshed before the frame's stages: src/mpi/frame_io.c) */
+    if (c->dist && !c->dist->fluid_whole) {
+        pfsph_particles *f = c->fluid;
+        pfsph_real *const a[6] = {f->vx, f->vy, f->vz, c->nd, (pfsph_real *)(p ? p : f->p), f->film};
+        c->dist->halo(c->dist, a, 6);
+    }
     pfsph_pairwise_mechanical_pressure(st->pw, c, p, vir, out);
     free(vir);
     return PFSPH_OK;

@@ -81,23 +81,42 @@ void pfsph_thermostat_apply(const pfsph_ctx *ctx, pfsph_real *const noise[3])
     }
 }
 
-double pfsph_thermostat_measure(const pfsph_particles *f, const pfsph_real *mass, int dim)
+/* The two passes of the measure, each over [lo, hi) and continuing the running sums of the
+ * particles before lo: a distributed run hands them on from rank to rank in the global order,
+ * which gives the serial sums' bits (src/mpi/gather.c). */
+void pfsph__thermostat_moments(const pfsph_particles *f, const pfsph_real *mass, size_t lo, size_t hi, double acc[4])
 {
-    const size_t n = f->n;
-    if (n < 2) return 0;
-    double M = 0, P[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; i++) {
+    double M = acc[0], P[3] = {acc[1], acc[2], acc[3]};
+    for (size_t i = lo; i < hi; i++) {
         double m = (double)mass[f->phase[i]];
         M += m;
         P[0] += m * f->vx[i];
         P[1] += m * f->vy[i];
         P[2] += m * f->vz[i];
     }
-    double vc[3] = {P[0] / M, P[1] / M, P[2] / M}, e = 0;
-    for (size_t i = 0; i < n; i++) {
+    acc[0] = M;
+    acc[1] = P[0];
+    acc[2] = P[1];
+    acc[3] = P[2];
+}
+
+double pfsph__thermostat_spread(const pfsph_particles *f, const pfsph_real *mass, int dim, size_t lo, size_t hi,
+                                const double vc[3], double e)
+{
+    for (size_t i = lo; i < hi; i++) {
         double m = (double)mass[f->phase[i]];
         double ux = f->vx[i] - vc[0], uy = f->vy[i] - vc[1], uz = dim == 3 ? f->vz[i] - vc[2] : 0;
         e += m * (ux * ux + uy * uy + uz * uz);
     }
-    return e / ((double)dim * (double)(n - 1));
+    return e;
+}
+
+double pfsph_thermostat_measure(const pfsph_particles *f, const pfsph_real *mass, int dim)
+{
+    const size_t n = f->n;
+    if (n < 2) return 0;
+    double acc[4] = {0, 0, 0, 0};
+    pfsph__thermostat_moments(f, mass, 0, n, acc);
+    const double vc[3] = {acc[1] / acc[0], acc[2] / acc[0], acc[3] / acc[0]};
+    return pfsph__thermostat_spread(f, mass, dim, 0, n, vc, 0) / ((double)dim * (double)(n - 1));
 }

@@ -1,6 +1,11 @@
 #!/bin/sh
 # MPI runs against serial ones (docs/cluster.md), byte for byte. Usage:
-#   mpi_test.sh compare SCENE END NP...   frames/ and stats.csv of -np NP equal the serial run's
+#   mpi_test.sh compare SCENE END NP...   frames/ and stats.csv of -np NP equal the serial run's, and
+#                                          (NP > 1) every frame after frame 0 was written
+#                                          collectively, the fluid never gathered to rank 0 (scenes
+#                                          without surface meshes, which alone still gather)
+#   mpi_test.sh gather SCENE END NP...    as compare with PFSPH_MPI_GATHER_FRAMES=1: every frame
+#                                          gathered to rank 0, none written collectively
 #   mpi_test.sh resume SCENE T1 T2 NP1 NP2 run to T1 on NP1 ranks, resume to T2 on NP2 ranks:
 #                                          the same bytes as an uninterrupted serial run to T2
 #   mpi_test.sh kill SCENE END NP1 NP2     kill -9 one rank of NP1 once checkpoints exist, resume on
@@ -63,6 +68,19 @@ ckpt_same() { # A B: checkpoint files equal but for the CRC32s (bytes 33-40, 1-b
         END { exit bad > 0 }' || return 1
 }
 
+frames_path() { # DIR WANT: summary.json's frame path is WANT (collective or gather)
+    fc=$(grep -Eo '"frames_written_collectively":[[:space:]]*[0-9]+' "$1/summary.json" | grep -Eo '[0-9]+$')
+    fg=$(grep -Eo '"fluid_gathers":[[:space:]]*[0-9]+' "$1/summary.json" | grep -Eo '[0-9]+$')
+    if [ "$2" = collective ]; then
+        [ "${fc:-0}" -gt 0 ] && [ "${fg:-1}" = 0 ] ||
+            { echo "FAIL: $1: not the collective path ($fc frames written collectively, $fg gathers)"; return 1; }
+    else
+        [ "${fc:-1}" = 0 ] && [ "${fg:-0}" -gt 0 ] ||
+            { echo "FAIL: $1: not the gather ($fc frames written collectively, $fg gathers)"; return 1; }
+    fi
+    echo "ok: $1: $fc frames written collectively, $fg gathers"
+}
+
 same() { # DIR_A DIR_B: frames, stats.csv (and bodies.csv) byte for byte
     if ! diff -r "$1/frames" "$2/frames" >/dev/null; then
         echo "FAIL: $1/frames and $2/frames differ:"
@@ -93,6 +111,19 @@ compare)
         same "$TMP/serial" "$TMP/np$np" || exit 1
         [ "$np" = 1 ] || grep -q '"ranks":' "$TMP/np$np/summary.json" ||
             { echo "FAIL: no per-rank figures in summary.json"; exit 1; }
+        [ "$np" = 1 ] || frames_path "$TMP/np$np" collective || exit 1
+    done
+    ;;
+gather)
+    scene=$SRC/$1 end=$2
+    shift 2
+    "$BIN" run "$scene" -o "$TMP/serial" --end "$end" --quiet || { echo "FAIL: the serial run"; exit 1; }
+    export PFSPH_MPI_GATHER_FRAMES=1
+    for np in "$@"; do
+        "$MPIRUN" $ROOTOPT --oversubscribe -x PFSPH_MPI_GATHER_FRAMES -np "$np" "$BIN" run "$scene" -o "$TMP/np$np" \
+            --end "$end" --quiet || { echo "FAIL: -np $np exited $?"; exit 1; }
+        same "$TMP/serial" "$TMP/np$np" || exit 1
+        frames_path "$TMP/np$np" gather || exit 1
     done
     ;;
 ckpt)
