@@ -211,7 +211,10 @@ static void contact_scene(const pfm_contact *cfg, const double *target, const do
     const int wc = (int)tu_env_num("PF_WALL", 6);
     /* layers enough to fill the box; 2 at least, so that every plate of more than one cell has
      * the fluid's volume V0 (sim.c: a one-layer wall takes Akinci's volumes) */
-    const int wl = (wc - skin + 1) / 2 > 2 || wc - skin < 2 ? (wc - skin + 1) / 2 : 2;
+    int wl = (wc - skin + 1) / 2 > 2 || wc - skin < 2 ? (wc - skin + 1) / 2 : 2;
+    /* PF_AKINCI=1: "layers": 1, so the wall takes Akinci's volumes 1 / sum W (larger than V0 on a
+     * thin plate: the liquid is held further off); fills plates of one or two cells only */
+    if (tu_env_num("PF_AKINCI", 0) > 0) wl = 1;
     for (int q = 0; q < nd; q++)
         len += snprintf(json + len, cap - (size_t)len,
                         "%s{\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": %d, \"phase\": \"p%d\"}",
