@@ -220,6 +220,14 @@ static void contact_scene(const pfm_contact *cfg, const double *target, const do
                         "%s{\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": %d, \"phase\": \"p%d\"}",
                         q ? ", " : "", vec(a, sizeof a, D, q * P, -0.01 * wc, -0.5 * P),
                         vec(b, sizeof b, D, (q + 1) * P, skin ? -0.01 : 0, 0.5 * P), wl, q);
+    /* PF_BCC=1 (a study knob): a second lattice of the plate's phase offset by half a cell along
+     * every axis (a body-centred wall of twice the liquid's number density, each particle with
+     * V0: the wall's density term holds the liquid further off) */
+    for (int q = 0; q < nd && tu_env_num("PF_BCC", 0) > 0; q++)
+        len += snprintf(json + len, cap - (size_t)len,
+                        ", {\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": %d, \"phase\": \"p%d\"}",
+                        vec(a, sizeof a, D, q * P + 0.005, -0.01 * wc + 0.005, -0.5 * P + 0.005),
+                        vec(b, sizeof b, D, (q + 1) * P - 0.005, -0.005, 0.5 * P - 0.005), wc > 2 ? wc / 2 : 2, q);
     for (int q = 0; q < nd && skin; q++)
         len += snprintf(json + len, cap - (size_t)len,
                         ", {\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": 1, \"phase\": \"s%d\"}",
