@@ -192,19 +192,46 @@ static void contact_scene(const pfm_contact *cfg, const double *target, const do
                        " \"phases\": [{\"name\": \"water\", \"viscosity\": %s}",
                        D, cfg->seed, vec(g, sizeof g, D, 0, 0, 0), vec(a, sizeof a, D, -0.05, -0.1, -0.5 * P - 0.05),
                        vec(b, sizeof b, D, nd * P + 0.05, cfg->top, 0.5 * P + 0.05), cfg->nu);
-    for (int q = 0; q < nd; q++)
+    /* PF_SKIN=1 (a study knob): the plate's top layer is a solid phase of its own without
+     * adhesion, so the wall attracts from its second layer down */
+    const int skin = (int)tu_env_num("PF_SKIN", 0);
+    for (int q = 0; q < nd; q++) {
         len += snprintf(json + len, cap - (size_t)len, ", {\"name\": \"p%d\", \"kind\": \"solid\"}", q);
+        if (skin) len += snprintf(json + len, cap - (size_t)len, ", {\"name\": \"s%d\", \"kind\": \"solid\"}", q);
+    }
     len += snprintf(json + len, cap - (size_t)len, "], \"fluid\": [");
     for (int q = 0; q < nd; q++)
         len += snprintf(json + len, cap - (size_t)len, "%s{\"shape\": \"box\", \"min\": %s, \"max\": %s}",
                         q ? ", " : "", vec(a, sizeof a, D, q * P + 0.5 * P - H, 0, -H),
                         vec(b, sizeof b, D, q * P + 0.5 * P + H, 2 * H, H));
     len += snprintf(json + len, cap - (size_t)len, "], \"solids\": [");
+    /* the plate: 6 cells (0.06 m) thick, filled (a box keeps the 3 layers inside each face),
+     * deeper than the pair reach k h = 3.4 d; PF_WALL gives another thickness in cells (a study
+     * knob: docs/pairwise.md, "The wall's thickness and make") */
+    const int wc = (int)tu_env_num("PF_WALL", 6);
+    /* layers enough to fill the box; 2 at least, so that every plate of more than one cell has
+     * the fluid's volume V0 (sim.c: a one-layer wall takes Akinci's volumes) */
+    int wl = (wc - skin + 1) / 2 > 2 || wc - skin < 2 ? (wc - skin + 1) / 2 : 2;
+    /* PF_AKINCI=1: "layers": 1, so the wall takes Akinci's volumes 1 / sum W (larger than V0 on a
+     * thin plate: the liquid is held further off); fills plates of one or two cells only */
+    if (tu_env_num("PF_AKINCI", 0) > 0) wl = 1;
     for (int q = 0; q < nd; q++)
         len += snprintf(json + len, cap - (size_t)len,
-                        "%s{\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": 3, \"phase\": \"p%d\"}",
-                        q ? ", " : "", vec(a, sizeof a, D, q * P, -0.06, -0.5 * P),
-                        vec(b, sizeof b, D, (q + 1) * P, 0, 0.5 * P), q);
+                        "%s{\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": %d, \"phase\": \"p%d\"}",
+                        q ? ", " : "", vec(a, sizeof a, D, q * P, -0.01 * wc, -0.5 * P),
+                        vec(b, sizeof b, D, (q + 1) * P, skin ? -0.01 : 0, 0.5 * P), wl, q);
+    /* PF_BCC=1 (a study knob): a second lattice of the plate's phase offset by half a cell along
+     * every axis (a body-centred wall of twice the liquid's number density, each particle with
+     * V0: the wall's density term holds the liquid further off) */
+    for (int q = 0; q < nd && tu_env_num("PF_BCC", 0) > 0; q++)
+        len += snprintf(json + len, cap - (size_t)len,
+                        ", {\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": %d, \"phase\": \"p%d\"}",
+                        vec(a, sizeof a, D, q * P + 0.005, -0.01 * wc + 0.005, -0.5 * P + 0.005),
+                        vec(b, sizeof b, D, (q + 1) * P - 0.005, -0.005, 0.5 * P - 0.005), wc > 2 ? wc / 2 : 2, q);
+    for (int q = 0; q < nd && skin; q++)
+        len += snprintf(json + len, cap - (size_t)len,
+                        ", {\"shape\": \"box\", \"min\": %s, \"max\": %s, \"layers\": 1, \"phase\": \"s%d\"}",
+                        vec(a, sizeof a, D, q * P, -0.01, -0.5 * P), vec(b, sizeof b, D, (q + 1) * P, 0, 0.5 * P), q);
     len += snprintf(json + len, cap - (size_t)len,
                     "], \"pairwise\": {%s \"k\": %g, \"coefficients\": [{\"phases\": [\"water\", "
                     "\"water\"], \"sigma\": 4}",
@@ -272,7 +299,9 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
                             cx += c->fluid->x[i], cz += c->dim == 3 ? c->fluid->z[i] : 0, m++;
                     cx /= m, cz /= m;
                     for (size_t i = 0; i < c->fluid->n; i++) {
-                        const int L = (int)floor(c->fluid->y[i] / c->spacing);
+                        /* the layers' centres sit near y = 0 and d (the first below the face on
+                         * a wetting plate): bins centred on them */
+                        const int L = (int)floor(c->fluid->y[i] / c->spacing + 0.5);
                         if (c->fluid->x[i] < q * P || c->fluid->x[i] >= (q + 1) * P || L < 0 || L > 1) continue;
                         const double dx = c->fluid->x[i] - cx, dz = c->dim == 3 ? c->fluid->z[i] - cz : 0;
                         r2[L] += dx * dx + dz * dz, nl[L]++;
@@ -280,6 +309,25 @@ void pfm_contact_run(const pfm_contact *cfg, const double *target, const double 
                     print_message("  drop %d: layer 1: %d, radius %.1f d; layer 2: %d, radius %.1f d\n", q, nl[0],
                                   sqrt(2 * r2[0] / fmax(nl[0], 1)) / c->spacing, nl[1],
                                   sqrt(2 * r2[1] / fmax(nl[1], 1)) / c->spacing);
+                    /* the liquid next to the plate: particles below 0.5 d (centres sink below
+                     * the face on a wetting plate), their mean height and their registry with
+                     * the plate's lattice (cell centres at q P + (i + 1/2) w, w = P / round(P / d)):
+                     * <cos> of the phase along x and z is +1 on top of wall particles, -1 in the
+                     * hollows between four, 0 for no registry */
+                    const double w = P / floor(P / c->spacing + 0.5);
+                    double sy0 = 0, cxs = 0, czs = 0, cc = 0;
+                    int n0 = 0, nb = 0;
+                    for (size_t i = 0; i < c->fluid->n; i++) {
+                        const double y = c->fluid->y[i] / c->spacing;
+                        if (c->fluid->x[i] < q * P || c->fluid->x[i] >= (q + 1) * P || y >= 0.5) continue;
+                        const double px = cos(2 * PI * (c->fluid->x[i] - q * P) / w - PI),
+                                     pz = c->dim == 3 ? cos(2 * PI * (c->fluid->z[i] + 0.5 * P) / w - PI) : 1;
+                        sy0 += y, cxs += px, czs += pz, cc += px * pz, n0++, nb += y < 0;
+                    }
+                    if (n0)
+                        print_message("  drop %d: below 0.5 d: %d (%d below the face), mean height %.2f d, "
+                                      "registry x %.2f z %.2f xz %.2f\n",
+                                      q, n0, nb, sy0 / n0, cxs / n0, czs / n0, cc / n0);
                 }
         }
     }

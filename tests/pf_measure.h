@@ -76,7 +76,11 @@ int pfm_contact_knobs(double *target, double *ratio, int nd);
 void pfm_contact_angles(int dim, const double *targets, int nd);
 /* The same with drops of half side `half` on plates `pitch` apart, the angle checked that of
  * pfm_drop_angle_cap when cap is 1 (knobs: PF_HALF, PF_PITCH, PF_CAP; PF_LAYERS prints the first
- * two layers' counts and radii with each report line). */
+ * two layers' counts and radii, bins of d centred on y = 0 and d, and the liquid below 0.5 d:
+ * its mean height and registry with the plate's lattice; the plate: PF_WALL its thickness in
+ * cells (6, filled), PF_SKIN=1 a top layer of its own phase without adhesion, PF_AKINCI=1
+ * "layers": 1 so that Akinci's volumes replace V0, PF_BCC=1 a second lattice offset by half a
+ * cell (a body-centred wall); docs/pairwise.md, "The wall's thickness and make"). */
 void pfm_contact_drops(int dim, const double *targets, int nd, double half, double pitch, int cap);
 
 /* ---- Laplace's law (test_pf_laplace.c, test_pf_laplace_3d.c) ---- */
