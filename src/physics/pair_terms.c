@@ -322,3 +322,100 @@ void pfsph__sums_pair(int n, const pfsph_real *restrict dx, const pfsph_real *re
         ST4D(P->sxx[3], q3), ST4D(P->sxx[4], q4), ST4D(P->sxx[5], q5);
     }
 }
+
+/* The interactive mode's eight-lane sums (pair_terms.h): entry q of n goes to lane q % 8, the
+ * lanes are added in a fixed tree, so every clone and thread count gives the same bits (the
+ * association is the source's, not the vector width's). GCC's vector type (plain arrays of
+ * accumulators were not kept in registers); the last, partial vector is read whole and its
+ * lanes past n masked to 0 (x + 0 = x; whatever those entries hold, even not finite), so the
+ * inputs need 7 readable entries past n. */
+#define PF__LANES 8
+typedef pfsph_real pf__v8r __attribute__((vector_size(PF__LANES * sizeof(pfsph_real))));
+#ifdef PFSPH_DOUBLE
+typedef int64_t pf__v8m __attribute__((vector_size(PF__LANES * sizeof(pfsph_real))));
+#else
+typedef int32_t pf__v8m __attribute__((vector_size(PF__LANES * sizeof(pfsph_real))));
+#endif
+#define LD8(v, p) __builtin_memcpy(&(v), (p), sizeof(pf__v8r))
+/* lanes 0..7 of l added in a fixed tree; v with its lanes >= r set to 0 (macros: a function
+ * taking or returning a vector changes the ABI in the baseline clone) */
+#define LANES8(l) ((((l)[0] + (l)[1]) + ((l)[2] + (l)[3])) + (((l)[4] + (l)[5]) + ((l)[6] + (l)[7])))
+#define MASK8(v, r) ((pf__v8r)((pf__v8m)(v) & ((pf__v8m){0, 1, 2, 3, 4, 5, 6, 7} < (r))))
+
+PFSPH__CLONES
+pfsph_real pfsph__lanes_sum(int n, const pfsph_real *restrict w)
+{
+    pf__v8r a = {0};
+    int e = 0;
+    for (; e + PF__LANES <= n; e += PF__LANES) {
+        pf__v8r v;
+        LD8(v, w + e);
+        a += v;
+    }
+    if (e < n) {
+        pf__v8r v;
+        LD8(v, w + e);
+        a += MASK8(v, n - e);
+    }
+    return LANES8(a);
+}
+
+PFSPH__CLONES
+void pfsph__lanes_sx(int n, const pfsph_real *restrict s, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                     const pfsph_real *restrict dz, pfsph_real out[3])
+{
+    pf__v8r ax = {0}, ay = {0}, az = {0};
+    for (int e = 0; e < n; e += PF__LANES) {
+        pf__v8r v, x, y, z;
+        LD8(v, s + e);
+        LD8(x, dx + e);
+        LD8(y, dy + e);
+        LD8(z, dz + e);
+        if (n - e < PF__LANES) {
+            v = MASK8(v, n - e);
+            x = MASK8(x, n - e);
+            y = MASK8(y, n - e);
+            z = MASK8(z, n - e);
+        }
+        ax += v * x;
+        ay += v * y;
+        az += v * z;
+    }
+    out[0] = LANES8(ax);
+    out[1] = LANES8(ay);
+    out[2] = LANES8(az);
+}
+
+PFSPH__CLONES
+void pfsph__lanes_pressure(int n, const uint32_t *restrict idx, const pfsph_real *restrict pn, pfsph_real pi,
+                           const pfsph_real *restrict cw, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                           const pfsph_real *restrict dz, pfsph_real out[3])
+{
+    pf__v8r ax = {0}, ay = {0}, az = {0};
+    for (int e = 0; e < n; e += PF__LANES) {
+        const uint32_t *q = idx + e;
+        pf__v8r g;
+        if (n - e >= PF__LANES)
+            g = (pf__v8r){pn[q[0]], pn[q[1]], pn[q[2]], pn[q[3]], pn[q[4]], pn[q[5]], pn[q[6]], pn[q[7]]};
+        else
+            for (int l = 0; l < PF__LANES; l++) g[l] = l < n - e ? pn[q[l]] : 0;
+        pf__v8r w, x, y, z;
+        LD8(w, cw + e);
+        LD8(x, dx + e);
+        LD8(y, dy + e);
+        LD8(z, dz + e);
+        if (n - e < PF__LANES) {
+            w = MASK8(w, n - e);
+            x = MASK8(x, n - e);
+            y = MASK8(y, n - e);
+            z = MASK8(z, n - e);
+        }
+        const pf__v8r s = (pi + g) * w;
+        ax += s * x;
+        ay += s * y;
+        az += s * z;
+    }
+    out[0] = LANES8(ax);
+    out[1] = LANES8(ay);
+    out[2] = LANES8(az);
+}

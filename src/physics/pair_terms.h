@@ -115,4 +115,17 @@ void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t
                           const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict cf,
                           double *restrict sc, pfsph_real *restrict w);
 
+/* The interactive mode's sums in eight lanes (pcisph_lists.c, viscosity.c's list walk): entry q
+ * of n goes to lane q % 8 and the lanes are added in a fixed tree, so the bits are the same on
+ * every CPU and thread count, but not those of a sum in the entries' order (the physical mode
+ * never calls these). pfsph__lanes_sum: the sum of w; pfsph__lanes_sx: out = sum s x_ij;
+ * pfsph__lanes_pressure: out = sum (pi + pn[idx[q]]) cw[q] x_ij (the pressure pass's terms).
+ * The arrays but idx and pn must have 7 readable entries past n (their values do not matter). */
+pfsph_real pfsph__lanes_sum(int n, const pfsph_real *restrict w);
+void pfsph__lanes_sx(int n, const pfsph_real *restrict s, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                     const pfsph_real *restrict dz, pfsph_real out[3]);
+void pfsph__lanes_pressure(int n, const uint32_t *restrict idx, const pfsph_real *restrict pn, pfsph_real pi,
+                           const pfsph_real *restrict cw, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                           const pfsph_real *restrict dz, pfsph_real out[3]);
+
 #endif
