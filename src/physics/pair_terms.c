@@ -134,7 +134,7 @@ void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *
     /* the gather apart (scalar), then viscosity.c visc_pair's factor in a vector loop */
     pfsph_real r2[PFSPH_LIST_TERMS_MAX], nuj[PFSPH_LIST_TERMS_MAX];
     for (int e = 0; e < n; e++) {
-        const uint32_t j = jj[e];
+        const int32_t j = (int32_t)jj[e]; /* signed: a vector gather where the clone has one */
         const pfsph_real ex = xi - x[j], ey = yi - y[j], ez = zi - z[j];
         dx[e] = ex;
         dy[e] = ey;
@@ -145,7 +145,7 @@ void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *
     const pfsph_real *restrict vx = in->vx, *restrict vy = in->vy, *restrict vz = in->vz, *restrict nd = in->nd;
     const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, eps = in->eps;
     for (int e = 0; e < n; e++) {
-        const uint32_t j = jj[e];
+        const int32_t j = (int32_t)jj[e];
         const pfsph_real nu = nuj[e];
         const pfsph_real vdx = (vxi - vx[j]) * dx[e] + (vyi - vy[j]) * dy[e] + (vzi - vz[j]) * dz[e];
         sv[e] = nu / nd[j] * vdx / (r2[e] + eps) * dw[e];
