@@ -76,7 +76,7 @@ void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const ui
      * masked terms (rounded once, as there) */
     pfsph_real r2[PFSPH_LIST_TERMS_MAX], a[PFSPH_LIST_TERMS_MAX];
     for (int q = 0; q < n; q++) {
-        const uint32_t j = idx[q];
+        const int32_t j = (int32_t)idx[q]; /* signed: a vector gather where the clone has one */
         const pfsph_real dx = x - tx[j], dy = y - ty[j], dz = z - tz[j];
         cx[q] = dx;
         cy[q] = dy;
@@ -85,7 +85,7 @@ void pfsph__terms_list_wdw(const pfsph_kernel *k, pfsph_real h2, int n, const ui
     }
     const pfsph_kernel K = *k;
     if (aux) {
-        for (int q = 0; q < n; q++) a[q] = aux[idx[q]];
+        for (int q = 0; q < n; q++) a[q] = aux[(int32_t)idx[q]];
         for (int q = 0; q < n; q++) {
             const pfsph_real r = pfsph_sqrt(r2[q]);
             const pfsph_real wq = r2[q] < h2 ? pfsph_kernel_w(&K, r) : 0;
@@ -134,7 +134,7 @@ void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *
     /* the gather apart (scalar), then viscosity.c visc_pair's factor in a vector loop */
     pfsph_real r2[PFSPH_LIST_TERMS_MAX], nuj[PFSPH_LIST_TERMS_MAX];
     for (int e = 0; e < n; e++) {
-        const uint32_t j = jj[e];
+        const int32_t j = (int32_t)jj[e]; /* signed: a vector gather where the clone has one */
         const pfsph_real ex = xi - x[j], ey = yi - y[j], ez = zi - z[j];
         dx[e] = ex;
         dy[e] = ey;
@@ -145,7 +145,7 @@ void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *
     const pfsph_real *restrict vx = in->vx, *restrict vy = in->vy, *restrict vz = in->vz, *restrict nd = in->nd;
     const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, eps = in->eps;
     for (int e = 0; e < n; e++) {
-        const uint32_t j = jj[e];
+        const int32_t j = (int32_t)jj[e];
         const pfsph_real nu = nuj[e];
         const pfsph_real vdx = (vxi - vx[j]) * dx[e] + (vyi - vy[j]) * dy[e] + (vzi - vz[j]) * dz[e];
         sv[e] = nu / nd[j] * vdx / (r2[e] + eps) * dw[e];
@@ -321,4 +321,182 @@ void pfsph__sums_pair(int n, const pfsph_real *restrict dx, const pfsph_real *re
         ST4D(P->sxx[0], q0), ST4D(P->sxx[1], q1), ST4D(P->sxx[2], q2);
         ST4D(P->sxx[3], q3), ST4D(P->sxx[4], q4), ST4D(P->sxx[5], q5);
     }
+}
+
+/* The interactive mode's eight-lane sums (pair_terms.h): entry q of n goes to lane q % 8, the
+ * lanes are added in a fixed tree, so every clone and thread count gives the same bits (the
+ * association is the source's, not the vector width's). GCC's vector type (plain arrays of
+ * accumulators were not kept in registers); the last, partial vector is read whole and its
+ * lanes past n masked to 0 (x + 0 = x; whatever those entries hold, even not finite), so the
+ * inputs need 7 readable entries past n. */
+#define PF__LANES 8
+typedef pfsph_real pf__v8r __attribute__((vector_size(PF__LANES * sizeof(pfsph_real))));
+#ifdef PFSPH_DOUBLE
+typedef int64_t pf__v8m __attribute__((vector_size(PF__LANES * sizeof(pfsph_real))));
+#else
+typedef int32_t pf__v8m __attribute__((vector_size(PF__LANES * sizeof(pfsph_real))));
+#endif
+#define LD8(v, p) __builtin_memcpy(&(v), (p), sizeof(pf__v8r))
+/* lanes 0..7 of l added in a fixed tree; v with its lanes >= r set to 0 (macros: a function
+ * taking or returning a vector changes the ABI in the baseline clone) */
+#define LANES8(l) ((((l)[0] + (l)[1]) + ((l)[2] + (l)[3])) + (((l)[4] + (l)[5]) + ((l)[6] + (l)[7])))
+#define MASK8(v, r) ((pf__v8r)((pf__v8m)(v) & ((pf__v8m){0, 1, 2, 3, 4, 5, 6, 7} < (r))))
+
+PFSPH__CLONES
+pfsph_real pfsph__lanes_sum(int n, const pfsph_real *restrict w)
+{
+    pf__v8r a = {0};
+    int e = 0;
+    for (; e + PF__LANES <= n; e += PF__LANES) {
+        pf__v8r v;
+        LD8(v, w + e);
+        a += v;
+    }
+    if (e < n) {
+        pf__v8r v;
+        LD8(v, w + e);
+        a += MASK8(v, n - e);
+    }
+    return LANES8(a);
+}
+
+PFSPH__CLONES
+void pfsph__lanes_sx(int n, const pfsph_real *restrict s, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                     const pfsph_real *restrict dz, pfsph_real out[3])
+{
+    pf__v8r ax = {0}, ay = {0}, az = {0};
+    for (int e = 0; e < n; e += PF__LANES) {
+        pf__v8r v, x, y, z;
+        LD8(v, s + e);
+        LD8(x, dx + e);
+        LD8(y, dy + e);
+        LD8(z, dz + e);
+        if (n - e < PF__LANES) {
+            v = MASK8(v, n - e);
+            x = MASK8(x, n - e);
+            y = MASK8(y, n - e);
+            z = MASK8(z, n - e);
+        }
+        ax += v * x;
+        ay += v * y;
+        az += v * z;
+    }
+    out[0] = LANES8(ax);
+    out[1] = LANES8(ay);
+    out[2] = LANES8(az);
+}
+
+PFSPH__CLONES
+void pfsph__lanes_pressure(int n, const uint32_t *restrict idx, const pfsph_real *restrict pn, pfsph_real pi,
+                           const pfsph_real *restrict cw, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                           const pfsph_real *restrict dz, pfsph_real out[3])
+{
+    /* the gather lane by lane: a loop's vector gather with its remainder cost more at ~35
+     * entries a particle (callgrind) */
+    pf__v8r ax = {0}, ay = {0}, az = {0};
+    for (int e = 0; e < n; e += PF__LANES) {
+        const uint32_t *q = idx + e;
+        pf__v8r g;
+        if (n - e >= PF__LANES)
+            g = (pf__v8r){pn[q[0]], pn[q[1]], pn[q[2]], pn[q[3]], pn[q[4]], pn[q[5]], pn[q[6]], pn[q[7]]};
+        else
+            for (int l = 0; l < PF__LANES; l++) g[l] = l < n - e ? pn[q[l]] : 0;
+        pf__v8r w, x, y, z;
+        LD8(w, cw + e);
+        LD8(x, dx + e);
+        LD8(y, dy + e);
+        LD8(z, dz + e);
+        if (n - e < PF__LANES) {
+            w = MASK8(w, n - e);
+            x = MASK8(x, n - e);
+            y = MASK8(y, n - e);
+            z = MASK8(z, n - e);
+        }
+        const pf__v8r s = (pi + g) * w;
+        ax += s * x;
+        ay += s * y;
+        az += s * z;
+    }
+    out[0] = LANES8(ax);
+    out[1] = LANES8(ay);
+    out[2] = LANES8(az);
+}
+
+PFSPH__CLONES
+void pfsph__terms_pair_sc_r(pfsph_real U_R, const pfsph_real *restrict coef, const uint8_t *restrict phase, int n,
+                            const uint32_t *restrict jj, const pfsph_real *restrict r2, pfsph_real *restrict cf,
+                            pfsph_real *restrict sc, pfsph_real *restrict w)
+{
+    for (int e = 0; e < n; e++) cf[e] = coef[phase[jj[e]]];
+    for (int e = 0; e < n; e++) {
+        const pfsph_real r = pfsph_sqrt(r2[e]);
+        const pfsph_real cr = (pfsph_real)pfsph__cos_pair((float)(U_R * r)) / r;
+        sc[e] = r2[e] > 0 && cf[e] != 0 ? cf[e] * cr : 0;
+    }
+    if (w)
+        for (int e = 0; e < n; e++) w[e] = r2[e] > 0 ? w[e] : 0;
+}
+
+PFSPH__CLONES
+void pfsph__sums_pair_r(int n, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                        const pfsph_real *restrict dz, const pfsph_real *restrict sc, const pfsph_real *restrict w,
+                        int filter, pfsph_pair_sums_r *restrict P)
+{
+    /* lane l of each vector is hit e + l (n a multiple of 8) */
+    pf__v8r a0, a1, a2;
+    LD8(a0, P->acc[0]);
+    LD8(a1, P->acc[1]);
+    LD8(a2, P->acc[2]);
+    for (int e = 0; e < n; e += PF__LANES) {
+        pf__v8r x, y, z, s;
+        LD8(x, dx + e);
+        LD8(y, dy + e);
+        LD8(z, dz + e);
+        LD8(s, sc + e);
+        a0 += s * x;
+        a1 += s * y;
+        a2 += s * z;
+    }
+    __builtin_memcpy(P->acc[0], &a0, sizeof a0);
+    __builtin_memcpy(P->acc[1], &a1, sizeof a1);
+    __builtin_memcpy(P->acc[2], &a2, sizeof a2);
+    if (!filter) return;
+    pf__v8r sw, x0, x1, x2, q0, q1, q2, q3, q4, q5;
+    LD8(sw, P->sw);
+    LD8(x0, P->sx[0]);
+    LD8(x1, P->sx[1]);
+    LD8(x2, P->sx[2]);
+    LD8(q0, P->sxx[0]);
+    LD8(q1, P->sxx[1]);
+    LD8(q2, P->sxx[2]);
+    LD8(q3, P->sxx[3]);
+    LD8(q4, P->sxx[4]);
+    LD8(q5, P->sxx[5]);
+    for (int e = 0; e < n; e += PF__LANES) {
+        pf__v8r x, y, z, v;
+        LD8(x, dx + e);
+        LD8(y, dy + e);
+        LD8(z, dz + e);
+        LD8(v, w + e);
+        sw += v;
+        x0 += v * x;
+        x1 += v * y;
+        x2 += v * z;
+        q0 += v * x * x;
+        q1 += v * x * y;
+        q2 += v * x * z;
+        q3 += v * y * y;
+        q4 += v * y * z;
+        q5 += v * z * z;
+    }
+    __builtin_memcpy(P->sw, &sw, sizeof sw);
+    __builtin_memcpy(P->sx[0], &x0, sizeof x0);
+    __builtin_memcpy(P->sx[1], &x1, sizeof x1);
+    __builtin_memcpy(P->sx[2], &x2, sizeof x2);
+    __builtin_memcpy(P->sxx[0], &q0, sizeof q0);
+    __builtin_memcpy(P->sxx[1], &q1, sizeof q1);
+    __builtin_memcpy(P->sxx[2], &q2, sizeof q2);
+    __builtin_memcpy(P->sxx[3], &q3, sizeof q3);
+    __builtin_memcpy(P->sxx[4], &q4, sizeof q4);
+    __builtin_memcpy(P->sxx[5], &q5, sizeof q5);
 }

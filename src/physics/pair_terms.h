@@ -115,4 +115,39 @@ void pfsph__terms_pair_sc(double U_R, const double *restrict coef, const uint8_t
                           const uint32_t *restrict jj, const pfsph_real *restrict r2, double *restrict cf,
                           double *restrict sc, pfsph_real *restrict w);
 
+/* The interactive mode's sums in eight lanes (pcisph_lists.c, viscosity.c's list walk): entry q
+ * of n goes to lane q % 8 and the lanes are added in a fixed tree, so the bits are the same on
+ * every CPU and thread count, but not those of a sum in the entries' order (the physical mode
+ * never calls these). pfsph__lanes_sum: the sum of w; pfsph__lanes_sx: out = sum s x_ij;
+ * pfsph__lanes_pressure: out = sum (pi + pn[idx[q]]) cw[q] x_ij (the pressure pass's terms).
+ * The arrays but idx and pn must have 7 readable entries past n (their values do not matter). */
+pfsph_real pfsph__lanes_sum(int n, const pfsph_real *restrict w);
+void pfsph__lanes_sx(int n, const pfsph_real *restrict s, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                     const pfsph_real *restrict dz, pfsph_real out[3]);
+void pfsph__lanes_pressure(int n, const uint32_t *restrict idx, const pfsph_real *restrict pn, pfsph_real pi,
+                           const pfsph_real *restrict cw, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                           const pfsph_real *restrict dz, pfsph_real out[3]);
+
+/* The interactive mode's pair pass in the particles' precision (pairwise.c, the list walk):
+ * sc as pfsph__terms_pair_sc computes it, in pfsph_real, with coef in pfsph_real; and the pair
+ * sums of pfsph__sums_pair (no virial) in eight lanes of pfsph_real, n a multiple of 8 (padding
+ * entries zero), lanes added by pfsph__lanes8 in a fixed tree: the same bits on every CPU and
+ * thread count, not those of the physical mode's double sums. */
+typedef struct pfsph_pair_sums_r {
+    pfsph_real acc[3][8];
+    pfsph_real sw[8];
+    pfsph_real sx[3][8];
+    pfsph_real sxx[6][8];
+} pfsph_pair_sums_r;
+void pfsph__terms_pair_sc_r(pfsph_real U_R, const pfsph_real *restrict coef, const uint8_t *restrict phase, int n,
+                            const uint32_t *restrict jj, const pfsph_real *restrict r2, pfsph_real *restrict cf,
+                            pfsph_real *restrict sc, pfsph_real *restrict w);
+void pfsph__sums_pair_r(int n, const pfsph_real *restrict dx, const pfsph_real *restrict dy,
+                        const pfsph_real *restrict dz, const pfsph_real *restrict sc, const pfsph_real *restrict w,
+                        int filter, pfsph_pair_sums_r *restrict P);
+static inline pfsph_real pfsph__lanes8(const pfsph_real l[8])
+{
+    return ((l[0] + l[1]) + (l[2] + l[3])) + ((l[4] + l[5]) + (l[6] + l[7]));
+}
+
 #endif

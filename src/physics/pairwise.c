@@ -154,6 +154,8 @@ typedef struct pw_job {
     int center;
     bool trim; /* walk only the cells the k h ball touches (positions as sorted) */
     pfsph_hits_fn hits;
+    /* the interactive list walk's pair pass in the particles' precision (pfsph__sums_pair_r) */
+    pfsph_real coef_r[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], U_Rr;
 } pw_job;
 
 static void job_init(pw_job *J, const pfsph_ctx *ctx, bool sorted)
@@ -170,6 +172,9 @@ static void job_init(pw_job *J, const pfsph_ctx *ctx, bool sorted)
     J->R = (pfsph_real)R;
     J->R2 = (pfsph_real)(R * R);
     J->U_R = 1.5 * PI / R;
+    J->U_Rr = (pfsph_real)J->U_R;
+    for (int a = 0; a < PFSPH_MAX_PHASES; a++)
+        for (int b = 0; b < PFSPH_MAX_PHASES; b++) J->coef_r[a][b] = (pfsph_real)J->coef[a][b];
     pfsph_kernel_init(&J->kk, ctx->dim, (pfsph_real)R);
     J->inv_v0 = (pfsph_real)1 / ctx->V0;
     J->filter = pp->filter && pp->eta > 0;
@@ -194,12 +199,17 @@ typedef struct pw_scratch {
     pfsph_hits H;
     double cr[PFSPH_HITS_CAP + PFSPH_HITS_PAD], sc[PFSPH_HITS_CAP + PFSPH_HITS_PAD];
     int sp[PFSPH_HITS_CAP + PFSPH_HITS_PAD]; /* hits that take Eq. 24 (sum_hits) */
+    pfsph_real cfr[PFSPH_HITS_CAP + PFSPH_HITS_PAD], scr[PFSPH_HITS_CAP + PFSPH_HITS_PAD]; /* rp */
 } pw_scratch;
 
 /* Adds the pairs in W->H (targets in ps) to P's four-lane sums (pair_terms.h): sc = c m_j f(r) / r
- * (Eq. 3 divided by m_i, times x_ij) and, if J->filter, the kernel w of Eq. 7 (NOTES item 2). */
+ * (Eq. 3 divided by m_i, times x_ij) and, if J->filter, the kernel w of Eq. 7 (NOTES item 2).
+ * rp (a constant at each call, so that the compiler makes two versions): sc and the sums in the
+ * particles' precision and eight lanes, into PR (the interactive list walk, docs/interactive.md,
+ * "The fifth pass"). */
 static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scratch *W, int pa, double ai, int bi,
-                            bool want_vir, pfsph_pair_sums *P, pfsph_real *ds, pw_sink *sk)
+                            bool want_vir, pfsph_pair_sums *P, pfsph_real *ds, pw_sink *sk, const bool rp,
+                            pfsph_pair_sums_r *PR)
 {
     pfsph_hits *H = &W->H;
     const double *coef = J->coef[pa];
@@ -212,7 +222,8 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
         /* Eq. 7's kernel, W_h and (lists) dW_h / r from one sqrt */
         pfsph__terms_w_dwr(&J->kk, &J->ctx->kern, n16, H->r2, J->filter ? H->t0 : NULL, H->t1, sk ? H->t2 : NULL);
         pfsph_real s = *ds;
-        if (ps == J->ctx->fluid)
+        if (ps == J->ctx->fluid && rp) s += pfsph__lanes_sum(n, H->t1); /* eight lanes (the arrays are padded) */
+        else if (ps == J->ctx->fluid)
             for (int e = 0; e < n; e++) s += H->t1[e];
         else
             for (int e = 0; e < n; e++) s += ps->aux[H->j[e]] * H->t1[e];
@@ -244,7 +255,10 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
             sk->pos = pos;
         }
     }
-    if (!J->two_phase) {
+    if (!J->two_phase && rp)
+        pfsph__terms_pair_sc_r(J->U_Rr, J->coef_r[pa], ps->phase, n16, H->j, H->r2, W->cfr, W->scr,
+                               J->filter ? H->t0 : NULL);
+    else if (!J->two_phase) {
         /* Eq. 3 with NOTES item 1: +c m_i m_j f(r) r_ij / r on i (repulsive f > 0); r = 0: no
          * direction, no force, and not in Eq. 7's sum. The cosine in float (pfsph__cos_pair,
          * error < 2e-7): the force is summed in double, its shape needs 1e-7. */
@@ -289,6 +303,14 @@ static inline void sum_hits(const pw_job *J, const pfsph_particles *ps, pw_scrat
             if (!live) H->t0[e] = 0;
         }
     }
+    if (rp) {
+        if (J->two_phase) /* Eq. 24's coefficients in double, as above */
+            for (int e = 0; e < n; e++) W->scr[e] = (pfsph_real)W->sc[e];
+        const int m = (n + 7) & ~7; /* padding entries add zeros */
+        for (int e = n; e < m; e++) W->scr[e] = H->t0[e] = H->dx[e] = H->dy[e] = H->dz[e] = 0;
+        pfsph__sums_pair_r(m, H->dx, H->dy, H->dz, W->scr, H->t0, J->filter, PR);
+        return;
+    }
     const int m = (n + 3) & ~3; /* padding entries add zeros */
     for (int e = n; e < m; e++) {
         W->sc[e] = 0;
@@ -304,49 +326,61 @@ static inline double lanes(const double l[4]) { return (l[0] + l[1]) + (l[2] + l
  * k h of a grid walk, filtered in SIMD (core/hits.h), in the walk's order. */
 static inline void sum_set(const pw_job *J, const pfsph_particles *ps, const pfsph_grid *g, size_t self, pfsph_real xi,
                            pfsph_real yi, pfsph_real zi, int pa, double ai, int bi, bool want_vir, pfsph_pair_sums *P,
-                           pw_scratch *W, pfsph_real *ds, pw_sink *sk)
+                           pw_scratch *W, pfsph_real *ds, pw_sink *sk, const bool rp, pfsph_pair_sums_r *PR)
 {
     pfsph_ranges rg;
     if (J->trim) pfsph_grid_ranges_radius(g, xi, yi, zi, J->R, &rg);
     else pfsph_grid_ranges_far(g, xi, yi, zi, &rg);
     PFSPH_HITS_WALK(J->hits, &W->H, rg, ps->x, ps->y, ps->z, xi, yi, zi, J->R2, (uint32_t)self,
-                    sum_hits(J, ps, W, pa, ai, bi, want_vir, P, ds, sk));
+                    sum_hits(J, ps, W, pa, ai, bi, want_vir, P, ds, sk, rp, PR));
 }
 
 /* Everything for fluid particle i: the acceleration (T_i applied), optionally the virial,
- * T_i itself and (nd not NULL) the number density delta_i of Eq. 23 into nd[i]. */
+ * T_i itself and (nd not NULL) the number density delta_i of Eq. 23 into nd[i]. rp (a
+ * constant): the pair sums in the particles' precision (sum_hits; no virial). */
 static inline void particle(const pw_job *J, size_t i, double acc[3], bool want_vir, double *vir, double Tout[9],
-                            double Wout[9], pw_scratch *W, pfsph_real *nd, pw_sink *sk, pw_sink *skb)
+                            double Wout[9], pw_scratch *W, pfsph_real *nd, pw_sink *sk, pw_sink *skb, const bool rp)
 {
     const pfsph_ctx *ctx = J->ctx;
     const pfsph_particles *f = ctx->fluid;
     pfsph_real xi = f->x[i], yi = f->y[i], zi = f->z[i];
     int pa = f->phase[i];
     pfsph_pair_sums P;
-    memset(&P, 0, sizeof P);
+    pfsph_pair_sums_r PR;
+    if (rp) memset(&PR, 0, sizeof PR);
+    else memset(&P, 0, sizeof P);
     const double ai = J->two_phase ? (double)f->film[i] : 0.0;
     const int bi = J->two_phase ? f->bubble[i] : 0;
     /* the density as density.c sums it, self term first, walls apart and scaled by 1 / V0 */
     pfsph_real s = nd ? pfsph_kernel_w0(&ctx->kern) : 0, sb = 0;
-    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, want_vir, &P, W, nd ? &s : NULL, sk);
+    sum_set(J, f, ctx->grid, i, xi, yi, zi, pa, ai, bi, want_vir, &P, W, nd ? &s : NULL, sk, rp, &PR);
     /* most of a liquid has no wall within k h: its empty walk (rows, flush) cost ~5 % of the pass;
      * the flags cover k h >= h, so the density's wall term is 0 where they skip */
     if (ctx->boundary && ctx->bgrid && ctx->boundary->n > 0 && pfsph_grid_near_far(ctx->bgrid, xi, yi, zi))
         sum_set(J, ctx->boundary, ctx->bgrid, (size_t)UINT32_MAX, xi, yi, zi, pa, ai, bi, want_vir, &P, W,
-                nd ? &sb : NULL, skb);
+                nd ? &sb : NULL, skb, rp, &PR);
     if (nd) nd[i] = s + sb * J->inv_v0;
     /* the lanes' totals; the filter's d = x_j - x_i = -x_ij */
-    double S[6], sx[3], sxx[6];
-    for (int a = 0; a < 3; a++) {
-        acc[a] = lanes(P.acc[a]);
-        sx[a] = -lanes(P.sx[a]);
+    double S[6] = {0, 0, 0, 0, 0, 0}, sx[3], sxx[6], sw;
+    if (rp) {
+        for (int a = 0; a < 3; a++) {
+            acc[a] = (double)pfsph__lanes8(PR.acc[a]);
+            sx[a] = -(double)pfsph__lanes8(PR.sx[a]);
+        }
+        for (int a = 0; a < 6; a++) sxx[a] = (double)pfsph__lanes8(PR.sxx[a]);
+        sw = (double)pfsph_kernel_w0(&J->kk) + (double)pfsph__lanes8(PR.sw);
+    } else {
+        for (int a = 0; a < 3; a++) {
+            acc[a] = lanes(P.acc[a]);
+            sx[a] = -lanes(P.sx[a]);
+        }
+        for (int a = 0; a < 6; a++) {
+            S[a] = lanes(P.S[a]);
+            sxx[a] = lanes(P.sxx[a]);
+        }
+        /* the sum of Eq. 7 includes j = i */
+        sw = (double)pfsph_kernel_w0(&J->kk) + lanes(P.sw);
     }
-    for (int a = 0; a < 6; a++) {
-        S[a] = lanes(P.S[a]);
-        sxx[a] = lanes(P.sxx[a]);
-    }
-    /* the sum of Eq. 7 includes j = i */
-    const double sw = (double)pfsph_kernel_w0(&J->kk) + lanes(P.sw);
     double T[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     if (J->filter) {
         double inv = 1.0 / sw;
@@ -404,7 +438,7 @@ static void apply(pfsph_pairwise *pw, const pfsph_ctx *ctx, pfsph_real *nd, pfsp
 #pragma omp for schedule(dynamic, 256) reduction(max : a2max)
         for (size_t i = 0; i < n; i++) {
             double acc[3];
-            particle(&J, i, acc, false, NULL, NULL, NULL, &W, nd, NULL, NULL);
+            particle(&J, i, acc, false, NULL, NULL, NULL, &W, nd, NULL, NULL, false);
             if (add) {
                 ax[i] += (pfsph_real)acc[0];
                 ay[i] += (pfsph_real)acc[1];
@@ -443,7 +477,9 @@ static double apply_lists_block(const pw_job *J, pw_scratch *W, size_t i0, size_
     for (size_t i = i0; i < i1; i++) {
         double acc[3];
         const size_t p0 = sk->pos, b0 = skb->pos;
-        particle(J, i, acc, false, NULL, NULL, NULL, W, nd, sk, skb);
+        /* the interactive mode's list walk (sim.c schedules it for the interactive PCISPH only):
+         * the pair sums in the particles' precision, eight lanes */
+        particle(J, i, acc, false, NULL, NULL, NULL, W, nd, sk, skb, true);
         cnt[i] = (uint32_t)(sk->pos - p0);
         bcnt[i] = (uint32_t)(skb->pos - b0);
         out[0][i] = (pfsph_real)acc[0];
@@ -517,7 +553,7 @@ static void diagnose_range(const pfsph_ctx *ctx, size_t lo, size_t hi, double *v
 #pragma omp for schedule(dynamic, 256)
         for (size_t i = lo; i < hi; i++) {
             double acc[3], v = 0;
-            particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws, NULL, NULL, NULL);
+            particle(&J, i, acc, true, &v, T ? T + 9 * i : NULL, W ? W + 9 * i : NULL, &Ws, NULL, NULL, NULL, false);
             if (vir) vir[i] = v;
         }
     }

@@ -193,6 +193,7 @@ void pfsph__pcisph_pressure(const pfsph_ctx *ctx, const pfsph_nlist *l, const pf
 
 int pfsph__pcisph_pairs_reserve(pfsph_pcisph_pairs *c, size_t m)
 {
+    m += 8; /* the eight-lane sums read up to 7 entries past the last (pair_terms.h) */
     if (m <= c->cap) return PFSPH_OK;
     const size_t cap = m + m / 8 + 64;
     pfsph_real **arr[4] = {&c->dx, &c->dy, &c->dz, &c->dw};
@@ -225,18 +226,18 @@ void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, con
     const size_t n = ctx->fluid->n;
 #pragma omp parallel
     {
-        pfsph_real w[PFSPH_LIST_TERMS_MAX];
+        pfsph_real w[PFSPH_LIST_TERMS_MAX + 8]; /* pfsph__lanes_sum reads 7 past the end */
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const pfsph_real xi = x[i], yi = y[i], zi = z[i];
-            /* the terms in the list's order, zeros for the pairs beyond h: pfsph__pcisph_density's sum */
+            /* the terms in eight lanes (pair_terms.h), zeros for the pairs beyond h */
             pfsph_real s = w0;
             for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end;) {
                 const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
                 const int m = (int)(e1 - e);
                 pfsph__terms_list_wdw(k, h2, m, l->idx + e, x, y, z, xi, yi, zi, NULL, cf->dx + e, cf->dy + e,
                                       cf->dz + e, cf->dw + e, w);
-                for (int q = 0; q < m; q++) s += w[q];
+                s += pfsph__lanes_sum(m, w);
                 e = e1;
             }
             /* the walls' entries hold aux_j W and aux_j dW/r: the products both passes form */
@@ -246,7 +247,7 @@ void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, con
                 const int m = (int)(e1 - e);
                 pfsph__terms_list_wdw(k, h2, m, lb->idx + e, b->x, b->y, b->z, xi, yi, zi, b->aux, cb->dx + e,
                                       cb->dy + e, cb->dz + e, cb->dw + e, w);
-                for (int q = 0; q < m; q++) sb += w[q];
+                sb += pfsph__lanes_sum(m, w);
                 e = e1;
             }
             nd[i] = s + sb * inv_v0;
@@ -272,27 +273,20 @@ void pfsph__pcisph_pressure_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, co
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const pfsph_real pi = pn[i];
-            pfsph_real ax = 0, ay = 0, az = 0;
-            /* pfsph__pcisph_pressure's terms in its order; a pair beyond h adds s = 0 times x_ij */
-            for (uint32_t e = l->start[i], end = l->start[i + 1]; e < end; e++) {
-                const uint32_t j = l->idx[e];
-                const pfsph_real s = (pi + pn[j]) * cw[e];
-                ax += s * cx[e];
-                ay += s * cy[e];
-                az += s * cz[e];
-            }
+            /* the terms in eight lanes (pair_terms.h); a pair beyond h adds s = 0 times x_ij */
+            const uint32_t e0 = l->start[i];
+            pfsph_real a[3];
+            pfsph__lanes_pressure((int)(l->start[i + 1] - e0), l->idx + e0, pn, pi, cw + e0, cx + e0, cy + e0, cz + e0,
+                                  a);
+            pfsph_real ax = a[0], ay = a[1], az = a[2];
             if (pi > 0) {
-                pfsph_real bx = 0, by = 0, bz = 0;
-                for (uint32_t e = lb->start[i], end = lb->start[i + 1]; e < end; e++) {
-                    const pfsph_real s = bws[e]; /* aux_j dW/r (pfsph__pcisph_density_pairs) */
-                    bx += s * bxs[e];
-                    by += s * bys[e];
-                    bz += s * bzs[e];
-                }
+                const uint32_t b0 = lb->start[i];
+                pfsph_real bs[3]; /* the walls' dw holds aux_j dW/r (pfsph__pcisph_density_pairs) */
+                pfsph__lanes_sx((int)(lb->start[i + 1] - b0), bws + b0, bxs + b0, bys + b0, bzs + b0, bs);
                 const pfsph_real wb = pi * inv_v0;
-                ax += wb * bx;
-                ay += wb * by;
-                az += wb * bz;
+                ax += wb * bs[0];
+                ay += wb * bs[1];
+                az += wb * bs[2];
             }
             const pfsph_real inv_m = -(pfsph_real)1 / ctx->mass[f->phase[i]];
             apx[i] = inv_m * ax;

@@ -36,13 +36,13 @@ typedef struct pfsph_pcisph_pairs {
 int pfsph__pcisph_pairs_reserve(pfsph_pcisph_pairs *c, size_t m);
 void pfsph__pcisph_pairs_free(pfsph_pcisph_pairs *c);
 
-/* pfsph__pcisph_density (the same bits), filling cf and cb (room for l's and lb's entries); cb's dw
+/* pfsph__pcisph_density summed in eight lanes (pair_terms.h: the last bits differ), filling cf and cb (room for l's and lb's entries); cb's dw
  * holds aux_j dW/r, the product the pressure pass forms for a wall particle j. */
 void pfsph__pcisph_density_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb, const pfsph_real *x,
                                  const pfsph_real *y, const pfsph_real *z, pfsph_real *nd, pfsph_pcisph_pairs *cf,
                                  pfsph_pcisph_pairs *cb);
 
-/* pfsph__pcisph_pressure at the positions cf and cb were filled at (the same bits); pn: scratch of
+/* pfsph__pcisph_pressure at the positions cf and cb were filled at, summed in eight lanes; pn: scratch of
  * the fluid's count (p / delta^2 per particle). */
 void pfsph__pcisph_pressure_pairs(const pfsph_ctx *ctx, const pfsph_nlist *l, const pfsph_nlist *lb,
                                   const pfsph_real *nd, const pfsph_real *p, const pfsph_pcisph_pairs *cf,

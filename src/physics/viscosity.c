@@ -23,6 +23,28 @@ typedef struct visc_acc {
     double fx, fy, fz;     /* thermostat */
 } visc_acc;
 
+/* a[0..2] += sum_q s[q] x_ij[q], q < n: one after another, or the eight-lane total */
+typedef void (*visc_sum_fn)(int n, const pfsph_real *s, const pfsph_real *dx, const pfsph_real *dy,
+                            const pfsph_real *dz, pfsph_real *a);
+static void sum_ordered(int n, const pfsph_real *s, const pfsph_real *dx, const pfsph_real *dy, const pfsph_real *dz,
+                        pfsph_real *a)
+{
+    pfsph_real ax = a[0], ay = a[1], az = a[2];
+    for (int q = 0; q < n; q++) {
+        ax += s[q] * dx[q];
+        ay += s[q] * dy[q];
+        az += s[q] * dz[q];
+    }
+    a[0] = ax, a[1] = ay, a[2] = az;
+}
+static void sum_lanes(int n, const pfsph_real *s, const pfsph_real *dx, const pfsph_real *dy, const pfsph_real *dz,
+                      pfsph_real *a)
+{
+    pfsph_real t[3];
+    pfsph__lanes_sx(n, s, dx, dy, dz, t);
+    a[0] += t[0], a[1] += t[1], a[2] += t[2];
+}
+
 /* Fluid neighbour j's Morris viscosity term (and with thermo its thermostat force) on i, added
  * to acc; x_ij = (dx, dy, dz), r2 = |x_ij|^2 < h^2, dwr = pfsph_kernel_dw_r(|x_ij|). */
 static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, pfsph_real dx, pfsph_real dy,
@@ -206,6 +228,9 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
         key = pfsph_thermo_step_key(ctx->seed, ctx->step, 0);
         wkey = pfsph_thermo_step_key(ctx->seed, ctx->step, PFSPH_THERMO_SALT_WALL);
     }
+    /* the list walk's sums: in the list's order, or in the interactive mode in eight lanes
+     * (docs/interactive.md, "The fifth pass"; IISPH's and DFSPH's physical lists keep the order) */
+    const visc_sum_fn list_sum = ctx->interactive ? sum_lanes : sum_ordered;
 #pragma omp parallel
     {
         pfsph_hits H;
@@ -229,18 +254,16 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
             const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
             visc_acc acc = {0, 0, 0, 0, 0, 0};
             if (nl && !thermo) {
-                /* visc_pair's factor in vector code (pair_terms.c), added in the list's order */
+                /* visc_pair's factor in vector code (pair_terms.c), added by list_sum */
                 const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, nd, NULL, vxi, vyi, vzi, nui, 0, eps};
                 for (uint32_t e = nl->start[i], end = nl->start[i + 1]; e < end;) {
                     const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
                     const int m = (int)(e1 - e);
                     pfsph__terms_visc_list(&in, f->x, f->y, f->z, f->phase, nu_pair[pa], xi, yi, zi, m, nl->idx + e,
                                            nl->dw + e, H.dx, H.dy, H.dz, H.t1);
-                    for (int q = 0; q < m; q++) {
-                        acc.ax += H.t1[q] * H.dx[q];
-                        acc.ay += H.t1[q] * H.dy[q];
-                        acc.az += H.t1[q] * H.dz[q];
-                    }
+                    pfsph_real a3[3] = {acc.ax, acc.ay, acc.az};
+                    list_sum(m, H.t1, H.dx, H.dy, H.dz, a3);
+                    acc.ax = a3[0], acc.ay = a3[1], acc.az = a3[2];
                     e = e1;
                 }
             } else if (nl) {
