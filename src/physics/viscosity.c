@@ -12,7 +12,7 @@
 
 /* particle i as its fluid pairs see it */
 typedef struct visc_i {
-    pfsph_real x, y, z, vx, vy, vz, nu;
+    pfsph_real x, y, z, vx, vy, vz, nu, ndr; /* ndr: delta_i as stored (the pair's mean density) */
     double m, nd;
     uint32_t id;
     int phase;
@@ -33,7 +33,7 @@ static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
     const int pb = f->phase[j];
     pfsph_real nu = pfsph__visc_pair_nu(ctx, I->phase, pb);
     pfsph_real vdx = (I->vx - f->vx[j]) * dx + (I->vy - f->vy[j]) * dy + (I->vz - f->vz[j]) * dz;
-    pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
+    pfsph_real s = 2 * nu / (I->ndr + ctx->nd[j]) * vdx / (r2 + eps) * dwr;
     acc->ax += s * dx;
     acc->ay += s * dy;
     acc->az += s * dz;
@@ -226,11 +226,11 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
             pfsph_real ax = 0, ay = 0, az = 0;
             pfsph_ranges r;
             /* the same terms in the same order from a list or a grid walk: the same bits */
-            const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
+            const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, nd[i], mi, ndi, idi, pa};
             visc_acc acc = {0, 0, 0, 0, 0, 0};
             if (nl && !thermo) {
                 /* visc_pair's factor in vector code (pair_terms.c), added in the list's order */
-                const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, nd, NULL, vxi, vyi, vzi, nui, 0, eps};
+                const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, nd, NULL, vxi, vyi, vzi, nui, 0, eps, nd[i]};
                 for (uint32_t e = nl->start[i], end = nl->start[i + 1]; e < end;) {
                     const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
                     const int m = (int)(e1 - e);
@@ -254,8 +254,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
                 /* the pairs within h of the grid walk, in its order */
                 if (thermo) {
-                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi,
-                                              vyi, vzi,   nui,   pi,    eps};
+                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd,  fused ? p : nd, H.t3, vxi,
+                                              vyi, vzi,   nui,   pi,    eps, nd[i]};
                     pfsph_real pa3[3] = {0, 0, 0};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i,
                                     thermo_hits(ctx, &vi, &H, X, &in, eps, amp, ts, key, fused, one_phase, &acc, pa3));
@@ -263,8 +263,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 } else {
                     /* the factors of visc_pair and of the pressure term in vector code
                      * (pair_terms.c), added in order: the same bits */
-                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi,
-                                              vyi, vzi,   nui,   pi,    eps};
+                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd,  fused ? p : nd, H.t3, vxi,
+                                              vyi, vzi,   nui,   pi,    eps, nd[i]};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
                         for (int e = 0; e < H.n; e++) H.t3[e] = pfsph__visc_pair_nu(ctx, pa, f->phase[H.j[e]]);
                         pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);
