@@ -24,7 +24,8 @@ typedef struct visc_acc {
 } visc_acc;
 
 /* Fluid neighbour j's Morris viscosity term (and with thermo its thermostat force) on i, added
- * to acc; x_ij = (dx, dy, dz), r2 = |x_ij|^2 < h^2, dwr = pfsph_kernel_dw_r(|x_ij|). */
+ * to acc; x_ij = (dx, dy, dz), r2 = |x_ij|^2 < h^2, dwr = pfsph_kernel_dw_r(|x_ij|). The factor
+ * 2 nu / (delta_i + delta_j) (v_ij . x_ij) / (r2 + eps) dW/r has the same bits seen from j. */
 static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, pfsph_real dx, pfsph_real dy,
                              pfsph_real dz, pfsph_real r2, pfsph_real dwr, pfsph_real eps, const int thermo, double amp,
                              const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, visc_acc *acc)
@@ -183,7 +184,11 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     const pfsph_real gx = (pfsph_real)ctx->gravity[0], gy = (pfsph_real)ctx->gravity[1],
                      gz = (pfsph_real)ctx->gravity[2];
     /* Morris et al. 1997 / SPlisHSPlasH "standard" viscosity: 2(d+2) nu sum_j (m_j/rho_j)
-     * (v_ij . x_ij)/(|x_ij|^2 + 0.01 h^2) grad W_ij, with m_j/rho_j = 1/delta_j. */
+     * (v_ij . x_ij)/(|x_ij|^2 + 0.01 h^2) grad W_ij, with m_j/rho_j the pair's mean 2 /
+     * (delta_i + delta_j): the same factor from both sides, so each pair's friction is equal
+     * and opposite (with 1/delta_j alone it was not where delta_i != delta_j: a surface, a
+     * wall, an interface; a free drop stirred by a body lost 1e-3 of its momentum, issue 31),
+     * and it is the friction of the thermostat's noise (fluctuation-dissipation per pair). */
     const pfsph_real visc_c = (pfsph_real)(2 * (ctx->dim + 2));
     const size_t n = f->n;
     const int mixed = ctx->nwalls > 1;
