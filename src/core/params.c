@@ -106,12 +106,12 @@ double pfsph_pairwise_visc_struct(int dim, double theta)
  * Morris viscosity nu_morris / nu_0 applied, nu_0 = sqrt(sigma d / rho), measured wall-free with
  * bench/pf_shear.c (a free slab, the decay of its shear mode u_x = A cos(2 pi y / H); DFSPH,
  * sigma 4 N/m, d = 1 cm, rho 1000) at the 3D default temperature, theta 0.01 (Eq. 5's k,
- * H = 24 d; nu_morris 3e-4 / 1e-3 / 3e-3 m^2/s read 1.39 / 2.28 / 6.55e-3; at d = 5 mm 2.03e-3
- * for 1e-3): the 3D liquid multiplies the Morris viscosity by about 2.2. Linear in between and
- * beyond the ends. 2D keeps the opt-in box correction above (docs/viscosity.md: the 2D liquid
+ * H = 24 d; nu_morris 3e-4 / 1e-3 / 3e-3 m^2/s read 1.23 / 1.64 / 6.23e-3 with the symmetric
+ * Morris term, one seed each, docs/viscosity.md "Momentum"; with 1 / delta_j they read 1.39 /
+ * 2.28 / 6.55e-3, a gain of about 2.2). Linear in between and beyond the ends. 2D keeps the opt-in box correction above (docs/viscosity.md: the 2D liquid
  * at its default temperature is shear-thinning, so no single viscosity table fits it). */
 static const double visc_x3[] = {0.0475, 0.158, 0.475};
-static const double visc_y3[] = {0.219, 0.361, 1.036};
+static const double visc_y3[] = {0.194, 0.260, 0.985};
 
 /* 2D at theta 0.04, PFSPH_VISC_TABLE_THETA_2D (k 1.7, H = 30 d, the same slab, A 0.1 m/s; docs/
  * viscosity.md, "2D at theta 0.04"): nu_morris 3e-4 / 1e-3 / 3e-3 / 1e-2 m^2/s read 1.62 / 1.92 /

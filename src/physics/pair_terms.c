@@ -110,15 +110,15 @@ void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const u
     const pfsph_kernel K = in->k;
     const pfsph_real *restrict vx = in->vx, *restrict vy = in->vy, *restrict vz = in->vz, *restrict nd = in->nd,
                                *restrict p = in->p, *restrict nuj = in->nuj;
-    const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, pi = in->pi, eps = in->eps;
+    const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, pi = in->pi, eps = in->eps, ndi = in->ndi;
     for (int e = 0; e < n; e++) {
         const uint32_t j = jj[e];
         const pfsph_real dwr = pfsph_kernel_dw_r(&K, pfsph_sqrt(r2[e]));
         dw[e] = dwr;
-        /* viscosity.c visc_pair: nu_ij / delta_j (v_ij . x_ij) / (r2 + eps) dW/r */
+        /* viscosity.c visc_pair: 2 nu_ij / (delta_i + delta_j) (v_ij . x_ij) / (r2 + eps) dW/r */
         const pfsph_real nu = nuj[e];
         const pfsph_real vdx = (vxi - vx[j]) * dx[e] + (vyi - vy[j]) * dy[e] + (vzi - vz[j]) * dz[e];
-        sv[e] = nu / nd[j] * vdx / (r2[e] + eps) * dwr;
+        sv[e] = 2 * nu / (ndi + nd[j]) * vdx / (r2[e] + eps) * dwr;
         /* pressure.c: (p_i / delta_i^2 + p_j / delta_j^2) dW/r */
         sp[e] = (pi + p[j] / (nd[j] * nd[j])) * dwr;
     }
@@ -143,12 +143,12 @@ void pfsph__terms_visc_list(const pfsph_pair_in *restrict in, const pfsph_real *
         nuj[e] = nu_row[phase[j]];
     }
     const pfsph_real *restrict vx = in->vx, *restrict vy = in->vy, *restrict vz = in->vz, *restrict nd = in->nd;
-    const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, eps = in->eps;
+    const pfsph_real vxi = in->vxi, vyi = in->vyi, vzi = in->vzi, eps = in->eps, ndi = in->ndi;
     for (int e = 0; e < n; e++) {
         const int32_t j = (int32_t)jj[e];
         const pfsph_real nu = nuj[e];
         const pfsph_real vdx = (vxi - vx[j]) * dx[e] + (vyi - vy[j]) * dy[e] + (vzi - vz[j]) * dz[e];
-        sv[e] = nu / nd[j] * vdx / (r2[e] + eps) * dw[e];
+        sv[e] = 2 * nu / (ndi + nd[j]) * vdx / (r2[e] + eps) * dw[e];
     }
 }
 

@@ -31,10 +31,11 @@ typedef struct pfsph_pair_in {
     const pfsph_real *vx, *vy, *vz, *nd, *p;
     const pfsph_real *nuj; /* per hit: the pair's nu (viscosity.h, pfsph__visc_pair_nu) */
     pfsph_real vxi, vyi, vzi, nui, pi, eps;
+    pfsph_real ndi; /* delta_i: the Morris factor takes the pair's mean delta (viscosity.h) */
 } pfsph_pair_in;
 
 /* Per fluid hit e (index jj[e], x_ij, r2): dw[e] = dW/r, sv[e] the Morris viscosity factor
- * nu_ij / delta_j (v_ij . x_ij) / (r2 + eps) dW/r (viscosity.c), sp[e] the pressure factor
+ * 2 nu_ij / (delta_i + delta_j) (v_ij . x_ij) / (r2 + eps) dW/r (viscosity.c), sp[e] the pressure factor
  * (p_i / delta_i^2 + p_j / delta_j^2) dW/r (pressure.c); the terms are sv x_ij, sp x_ij. */
 void pfsph__terms_visc_pressure(const pfsph_pair_in *restrict in, int n, const uint32_t *restrict jj,
                                 const pfsph_real *restrict dx, const pfsph_real *restrict dy,

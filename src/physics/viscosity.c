@@ -12,7 +12,7 @@
 
 /* particle i as its fluid pairs see it */
 typedef struct visc_i {
-    pfsph_real x, y, z, vx, vy, vz, nu;
+    pfsph_real x, y, z, vx, vy, vz, nu, ndr; /* ndr: delta_i as stored (the pair's mean density) */
     double m, nd;
     uint32_t id;
     int phase;
@@ -46,7 +46,8 @@ static void sum_lanes(int n, const pfsph_real *s, const pfsph_real *dx, const pf
 }
 
 /* Fluid neighbour j's Morris viscosity term (and with thermo its thermostat force) on i, added
- * to acc; x_ij = (dx, dy, dz), r2 = |x_ij|^2 < h^2, dwr = pfsph_kernel_dw_r(|x_ij|). */
+ * to acc; x_ij = (dx, dy, dz), r2 = |x_ij|^2 < h^2, dwr = pfsph_kernel_dw_r(|x_ij|). The factor
+ * 2 nu / (delta_i + delta_j) (v_ij . x_ij) / (r2 + eps) dW/r has the same bits seen from j. */
 static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, pfsph_real dx, pfsph_real dy,
                              pfsph_real dz, pfsph_real r2, pfsph_real dwr, pfsph_real eps, const int thermo, double amp,
                              const double ts[PFSPH_MAX_PHASES][PFSPH_MAX_PHASES], uint64_t key, visc_acc *acc)
@@ -55,7 +56,7 @@ static inline void visc_pair(const pfsph_ctx *ctx, const visc_i *I, uint32_t j, 
     const int pb = f->phase[j];
     pfsph_real nu = pfsph__visc_pair_nu(ctx, I->phase, pb);
     pfsph_real vdx = (I->vx - f->vx[j]) * dx + (I->vy - f->vy[j]) * dy + (I->vz - f->vz[j]) * dz;
-    pfsph_real s = nu / ctx->nd[j] * vdx / (r2 + eps) * dwr;
+    pfsph_real s = 2 * nu / (I->ndr + ctx->nd[j]) * vdx / (r2 + eps) * dwr;
     acc->ax += s * dx;
     acc->ay += s * dy;
     acc->az += s * dz;
@@ -205,7 +206,11 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
     const pfsph_real gx = (pfsph_real)ctx->gravity[0], gy = (pfsph_real)ctx->gravity[1],
                      gz = (pfsph_real)ctx->gravity[2];
     /* Morris et al. 1997 / SPlisHSPlasH "standard" viscosity: 2(d+2) nu sum_j (m_j/rho_j)
-     * (v_ij . x_ij)/(|x_ij|^2 + 0.01 h^2) grad W_ij, with m_j/rho_j = 1/delta_j. */
+     * (v_ij . x_ij)/(|x_ij|^2 + 0.01 h^2) grad W_ij, with m_j/rho_j the pair's mean 2 /
+     * (delta_i + delta_j): the same factor from both sides, so each pair's friction is equal
+     * and opposite (with 1/delta_j alone it was not where delta_i != delta_j: a surface, a
+     * wall, an interface; a free drop stirred by a body lost 1e-3 of its momentum, issue 31),
+     * and it is the friction of the thermostat's noise (fluctuation-dissipation per pair). */
     const pfsph_real visc_c = (pfsph_real)(2 * (ctx->dim + 2));
     const size_t n = f->n;
     const int mixed = ctx->nwalls > 1;
@@ -251,11 +256,11 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
             pfsph_real ax = 0, ay = 0, az = 0;
             pfsph_ranges r;
             /* the same terms in the same order from a list or a grid walk: the same bits */
-            const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, mi, ndi, idi, pa};
+            const visc_i vi = {xi, yi, zi, vxi, vyi, vzi, nui, nd[i], mi, ndi, idi, pa};
             visc_acc acc = {0, 0, 0, 0, 0, 0};
             if (nl && !thermo) {
                 /* visc_pair's factor in vector code (pair_terms.c), added by list_sum */
-                const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, nd, NULL, vxi, vyi, vzi, nui, 0, eps};
+                const pfsph_pair_in in = {*k, f->vx, f->vy, f->vz, nd, nd, NULL, vxi, vyi, vzi, nui, 0, eps, nd[i]};
                 for (uint32_t e = nl->start[i], end = nl->start[i + 1]; e < end;) {
                     const uint32_t e1 = end - e > PFSPH_LIST_TERMS_MAX ? e + PFSPH_LIST_TERMS_MAX : end;
                     const int m = (int)(e1 - e);
@@ -277,8 +282,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 pfsph_grid_ranges(ctx->grid, xi, yi, zi, &r);
                 /* the pairs within h of the grid walk, in its order */
                 if (thermo) {
-                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi,
-                                              vyi, vzi,   nui,   pi,    eps};
+                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd,  fused ? p : nd, H.t3, vxi,
+                                              vyi, vzi,   nui,   pi,    eps, nd[i]};
                     pfsph_real pa3[3] = {0, 0, 0};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i,
                                     thermo_hits(ctx, &vi, &H, X, &in, eps, amp, ts, key, fused, one_phase, &acc, pa3));
@@ -286,8 +291,8 @@ static inline void nonpressure(const pfsph_ctx *ctx, pfsph_real *const noise[3],
                 } else {
                     /* the factors of visc_pair and of the pressure term in vector code
                      * (pair_terms.c), added in order: the same bits */
-                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd, fused ? p : nd, H.t3, vxi,
-                                              vyi, vzi,   nui,   pi,    eps};
+                    const pfsph_pair_in in = {*k,  f->vx, f->vy, f->vz, nd,  fused ? p : nd, H.t3, vxi,
+                                              vyi, vzi,   nui,   pi,    eps, nd[i]};
                     PFSPH_HITS_WALK(hits, &H, r, f->x, f->y, f->z, xi, yi, zi, h2, (uint32_t)i, {
                         for (int e = 0; e < H.n; e++) H.t3[e] = pfsph__visc_pair_nu(ctx, pa, f->phase[H.j[e]]);
                         pfsph__terms_visc_pressure(&in, H.n, H.j, H.dx, H.dy, H.dz, H.r2, H.t0, H.t1, H.t2);

@@ -7,10 +7,11 @@
 /* The kinematic viscosity of the Morris friction on a particle of phase a from one of phase b.
  * Within a phase nu_a, as 0.5 (nu_a + nu_a) was (the same bits). Across phases the dynamic
  * viscosity of the pair is the harmonic mean mu_ab = 2 mu_a mu_b / (mu_a + mu_b), mu = rho nu
- * (Morris et al. 1997 with Cleary's mean; Hu & Adams 2006), applied as mu_ab / rho_a: the
- * force on i, m_i mu_ab / (rho_a delta_j) = V0 mu_ab / delta_j, and the reaction on j, V0
- * mu_ab / delta_i, are equal and opposite to the difference of delta_i and delta_j, so the pair
- * conserves momentum and the interface carries the stress of two viscosities in series. The
+ * (Morris et al. 1997 with Cleary's mean; Hu & Adams 2006), applied as mu_ab / rho_a with the
+ * pair's mean number density (viscosity.c): the force on i, m_i mu_ab / rho_a 2 / (delta_i +
+ * delta_j) = V0 mu_ab 2 / (delta_i + delta_j), and the reaction on j are equal and opposite to
+ * round-off, so the pair conserves momentum and the interface carries the stress of two
+ * viscosities in series. The
  * arithmetic mean of nu applied per particle gave a water-gas pair (rho 1000 / 100, mu 10 / 1)
  * a friction of mu 10 on the water and mu 1 on the gas (docs/validation.md, "Hysing case 1:
  * what holds the bubble back"). A phase without a rest density (a hand-made context) keeps the
@@ -25,11 +26,11 @@ static inline pfsph_real pfsph__visc_pair_nu(const pfsph_ctx *c, int pa, int pb)
 }
 
 /* The viscosity that the thermostat's noise (pfsph__thermo_fluid: nu 2 m_i m_j / (m_i delta_i +
- * m_j delta_j)) needs so that its friction is the harmonic mean of the pair's two frictions
- * (pfsph__visc_pair_nu): within a phase 0.5 (nu_a + nu_b) in double as before; across phases
- * mu_ab (rho_a delta_i + rho_b delta_j) / (rho_a rho_b (delta_i + delta_j)), whose friction is
- * V0 mu_ab 2 / (delta_i + delta_j), the harmonic mean of V0 mu_ab / delta_j and V0 mu_ab /
- * delta_i (fluctuation-dissipation per pair). */
+ * m_j delta_j)) needs so that its friction is the pair's Morris friction (pfsph__visc_pair_nu
+ * with 2 / (delta_i + delta_j), viscosity.c): within a phase 0.5 (nu_a + nu_b) in double as
+ * before; across phases mu_ab (rho_a delta_i + rho_b delta_j) / (rho_a rho_b (delta_i +
+ * delta_j)), whose friction is V0 mu_ab 2 / (delta_i + delta_j) (fluctuation-dissipation per
+ * pair, exact since the friction itself takes the pair's mean delta). */
 static inline double pfsph__visc_noise_nu(const pfsph_ctx *c, int pa, int pb, double ndi, double ndj)
 {
     if (pa == pb) return 0.5 * ((double)c->nu[pa] + (double)c->nu[pb]);

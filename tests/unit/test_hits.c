@@ -111,7 +111,8 @@ static void test_terms(void **state)
     }
     pfsph__terms_w(&k, N, r2, w);
     pfsph__terms_dwr(&k, N, r2, dw);
-    const pfsph_pair_in in = {k, vx, vy, vz, nd, p, nuj, 0.3f, -0.2f, 0.1f, 0.01f, 0.02f, (pfsph_real)0.01 * h2};
+    const pfsph_pair_in in = {k,      vx, vy, vz, nd, p, nuj, 0.3f, -0.2f, 0.1f, 0.01f, 0.02f, (pfsph_real)0.01 * h2,
+                              7500.0f};
     pfsph__terms_visc_pressure(&in, N, jj, dx, dy, dz, r2, dw2, sv, sp);
     for (int e = 0; e < N; e++) {
         const pfsph_real r = pfsph_sqrt(r2[e]), wr = pfsph_kernel_w(&k, r), dwr = pfsph_kernel_dw_r(&k, r);
@@ -121,7 +122,7 @@ static void test_terms(void **state)
         const uint32_t j = jj[e];
         const pfsph_real nu = nuj[e]; /* the pair's viscosity (viscosity.h, pfsph__visc_pair_nu) */
         const pfsph_real vdx = (in.vxi - vx[j]) * dx[e] + (in.vyi - vy[j]) * dy[e] + (in.vzi - vz[j]) * dz[e];
-        const pfsph_real s = nu / nd[j] * vdx / (r2[e] + in.eps) * dwr;
+        const pfsph_real s = 2 * nu / (in.ndi + nd[j]) * vdx / (r2[e] + in.eps) * dwr;
         const pfsph_real t = (in.pi + p[j] / (nd[j] * nd[j])) * dwr;
         assert_memory_equal(&sv[e], &s, sizeof s);
         assert_memory_equal(&sp[e], &t, sizeof t);
